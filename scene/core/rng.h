@@ -1,0 +1,28 @@
+// Counter-based random numbers: a value is a pure function of (seed, stream, counter), so
+// results never depend on thread count or evaluation order.
+#pragma once
+
+#include <cstdint>
+
+namespace seasense::scene {
+
+// SplitMix64 finaliser (Steele, Lea & Flood, "Fast splittable pseudorandom number
+// generators", OOPSLA 2014): a bijective 64-bit mixer.
+constexpr uint64_t Mix64(uint64_t z) {
+    z += 0x9e3779b97f4a7c15ULL;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+}
+
+// 64 random bits for (seed, stream, counter).
+constexpr uint64_t HashBits(uint64_t seed, uint64_t stream, uint64_t counter) {
+    return Mix64(Mix64(Mix64(seed) ^ stream) ^ counter);
+}
+
+// Uniform double in [0, 1) with 53 random bits.
+constexpr double Uniform01(uint64_t seed, uint64_t stream, uint64_t counter) {
+    return double(HashBits(seed, stream, counter) >> 11) * 0x1.0p-53;
+}
+
+}  // namespace seasense::scene

@@ -1,0 +1,128 @@
+// The typed, validated scenario: what a configs/*.yaml file describes, in SI units and radians.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "scene/core/time.h"
+
+namespace seasense::scene {
+
+// Orientation as yaw (heading, clockwise from north), pitch (nose up) and roll (right side
+// down), applied in that order (intrinsic z-y'-x''), all radians.
+struct Attitude {
+    double heading_rad = 0.0;
+    double pitch_rad = 0.0;
+    double roll_rad = 0.0;
+};
+
+struct WorldSettings {
+    double latitude_deg = 0.0;   // origin of the local ENU frame
+    double longitude_deg = 0.0;
+    UtcTime start;               // simulation time of frame 0
+    double timeScale = 1.0;      // simulated seconds per real second
+    double frameRate_hz = 30.0;  // simulated frames per (scaled) second
+    uint64_t seed = 1;
+};
+
+// A directional sun set by the user (the ephemeris issue adds the real sun).
+struct SunSettings {
+    double azimuth_rad = 0.0;    // from true north, clockwise
+    double elevation_rad = 0.5;  // above the horizon
+    double illuminance_lux = 1.0e5;  // on a surface normal to the sun, above the atmosphere path
+};
+
+struct SkySettings {
+    double turbidity = 3.0;  // Linke-style turbidity of Preetham et al. (1999), 1.7 .. 10
+};
+
+struct GerstnerWaveSettings {
+    double direction_rad = 0.0;  // direction of travel, azimuth from north clockwise
+    double wavelength_m = 10.0;
+    double amplitude_m = 0.1;
+    double steepness = 0.5;      // Q in [0, 1]: 0 sine wave, 1 sharpest trochoid without loops
+    double phase_rad = 0.0;
+};
+
+struct OceanSettings {
+    std::vector<GerstnerWaveSettings> waves;
+    double depth_m = 1.0e4;  // water depth for dispersion ω² = g k tanh(k h)
+};
+
+struct EnvironmentSettings {
+    SunSettings sun;
+    SkySettings sky;
+    double visibility_m = 20000.0;  // meteorological optical range (Koschmieder, 2 % contrast)
+    double windSpeed_mps = 5.0;     // at 10 m
+    double windDirection_rad = 0.0;  // direction the wind blows toward, from north clockwise
+    OceanSettings ocean;
+};
+
+// A static mesh placed in the world. Positions are ENU metres at the model origin.
+struct EntitySettings {
+    std::string name;
+    std::filesystem::path model;  // resolved against the scenario file's folder
+    glm::dvec3 position_m{0.0};
+    Attitude attitude;
+    double scale = 1.0;
+    std::string material;  // a name from the material table
+};
+
+struct EyepointSettings {
+    glm::dvec3 position_m{0.0, 0.0, 2.0};
+    Attitude attitude;
+};
+
+enum class ChannelKind { Otw, Flir, Nvg };
+
+enum class ExposureMode { Manual, Auto };
+
+struct ExposureSettings {
+    ExposureMode mode = ExposureMode::Auto;
+    // Manual: display value = scene-linear × 2^ev. Auto: ev chosen so that the frame's
+    // log-average luminance maps to keyValue (Reinhard et al. 2002 key).
+    double ev = 0.0;
+    double keyValue = 0.18;
+};
+
+struct ChannelSettings {
+    std::string name;
+    ChannelKind kind = ChannelKind::Otw;
+    int width = 640;
+    int height = 480;
+    double hfov_rad = 1.0471975511965976;  // 60°
+    glm::dvec3 offset_m{0.0};               // position relative to the eyepoint, eyepoint frame
+    Attitude attitude;                      // relative to the eyepoint
+    int supersampling = 2;                  // N: N×N samples per pixel
+    double near_m = 0.25;
+    bool shadows = true;
+    std::vector<std::string> formats{"exr", "png"};
+    ExposureSettings exposure;
+    std::string ocioView = "ACES 1.0 - SDR Video";  // display view of configs/ocio/config.ocio
+};
+
+struct MaterialSettings {
+    std::string name;
+    glm::dvec3 reflectanceRgb{0.5};  // linear Rec.709 diffuse reflectance (hemispherical)
+};
+
+struct Scenario {
+    std::filesystem::path file;  // the file it was read from
+    std::string hash;            // hex digest of the file's bytes, for capture.json
+    WorldSettings world;
+    EnvironmentSettings environment;
+    std::vector<EntitySettings> entities;
+    EyepointSettings eyepoint;
+    std::vector<ChannelSettings> channels;
+    std::vector<MaterialSettings> materials;  // from the material table file
+
+    const ChannelSettings* FindChannel(const std::string& name) const;
+    const MaterialSettings* FindMaterial(const std::string& name) const;
+};
+
+}  // namespace seasense::scene
