@@ -125,7 +125,7 @@ std::string FormatIso8601(UtcTime t) {
     CivilFromDays(days, y, m, d);
     int64_t secOfDay = rem / 1000000000LL;
     int64_t ms = (rem % 1000000000LL) / 1000000LL;
-    char buf[40];
+    char buf[80];
     std::snprintf(buf, sizeof buf, "%04lld-%02u-%02uT%02lld:%02lld:%02lld.%03lldZ", (long long)y, m,
                   d, (long long)(secOfDay / 3600), (long long)(secOfDay / 60 % 60),
                   (long long)(secOfDay % 60), (long long)ms);

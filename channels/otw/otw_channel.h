@@ -1,0 +1,56 @@
+// The out-the-window (visible) channel: rasterized sea and models shaded in scene-linear
+// Rec.709 luminance units (cd/m²) under an analytic sky and sun, with Embree shadows and fog.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "channels/camera/channel_camera.h"
+#include "channels/occlusion/occlusion.h"
+#include "channels/raster/rasterizer.h"
+#include "scene/core/image.h"
+#include "scene/models/triangle_mesh.h"
+#include "scene/ocean/ocean_mesh.h"
+#include "scene/world/world.h"
+
+namespace seasense::channels {
+
+struct OtwFrameStats {
+    uint64_t oceanTriangles = 0;
+    uint64_t modelTriangles = 0;
+    uint64_t shadowRays = 0;  // rays actually traced (after the caster-bounds test)
+    RasterStats raster;
+};
+
+class OtwChannel {
+public:
+    // Builds the occlusion scene from the world's models (committed once; static).
+    OtwChannel(const scene::World& world, const scene::ChannelSettings& settings);
+
+    // Renders the supersampled at-aperture radiance of frame `state` into radiance:
+    // (width·N)×(height·N)×3, linear Rec.709, cd/m² (Y = luminance). Runs in the caller's
+    // oneTBB arena; bit-identical for any thread count.
+    void Render(const scene::SceneState& state, Image& radiance);
+
+    const OtwFrameStats& Stats() const { return stats_; }
+    const ChannelCamera& Camera() const { return camera_; }
+
+private:
+    const scene::World& world_;
+    scene::ChannelSettings settings_;
+    ChannelCamera camera_;
+    Rasterizer rasterizer_;
+    OcclusionScene occlusion_;
+    std::vector<scene::TriangleMesh> worldMeshes_;  // entity meshes in the world frame
+    std::vector<glm::dvec3> reflectance_;           // per entity
+    scene::OceanMesh ocean_;
+    VisibilityBuffer vis_;
+    OtwFrameStats stats_;
+};
+
+// Azimuth sector [min, max] (radians, clockwise from north) that the camera's frustum covers,
+// widened by margin_rad; max − min = 2π when it looks close to straight up or down.
+void FrustumAzimuthSector(const ChannelCamera& camera, double margin_rad, double& min_rad,
+                          double& max_rad);
+
+}  // namespace seasense::channels

@@ -1,0 +1,140 @@
+// Channel pipeline: the sensor owns the pixel, so radiance samples become pixels only here.
+#include "channels/pipeline/channel_pipeline.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+#include "scene/core/error.h"
+#include "sensors/detector/detector.h"
+#include "sensors/output/image_writer.h"
+
+#ifndef SEASENSE_SOURCE_DIR
+#define SEASENSE_SOURCE_DIR "."
+#endif
+
+namespace seasense::channels {
+
+namespace {
+
+double MsSince(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+const char* KindName(scene::ChannelKind k) {
+    switch (k) {
+        case scene::ChannelKind::Otw: return "otw";
+        case scene::ChannelKind::Flir: return "flir";
+        case scene::ChannelKind::Nvg: return "nvg";
+    }
+    return "?";
+}
+
+sensors::Matrix44f RowMajor(const glm::dmat4& m) {
+    sensors::Matrix44f out;
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) out.m[size_t(r * 4 + c)] = float(m[c][r]);
+    return out;
+}
+
+sensors::ImageMetadata FrameMetadata(const scene::World& world, const scene::ChannelSettings& ch,
+                                     const scene::SceneState& state, const ChannelCamera& cam,
+                                     double ev) {
+    const scene::Scenario& sc = world.GetScenario();
+    sensors::ImageMetadata md;
+    md.SetCaptureTime(state.utc);
+    md.Set("seasense:channel", ch.name);
+    md.Set("seasense:kind", std::string(KindName(ch.kind)));
+    md.Set("seasense:frame_index", int(state.frame));
+    md.Set("seasense:time_utc", scene::FormatIso8601(state.utc));
+    md.Set("seasense:sim_time_s", float(state.time_s));
+    md.Set("seasense:scenario_hash", sc.hash);
+    md.Set("seasense:seed", std::to_string(sc.world.seed));
+    const glm::dvec3 eye = state.eyepoint.position_m;
+    md.Set("seasense:eyepoint_position_m", sensors::Vector3f{{float(eye.x), float(eye.y), float(eye.z)}});
+    const glm::dvec3 cp = cam.worldFromCamera.position_m;
+    md.Set("seasense:camera_position_m", sensors::Vector3f{{float(cp.x), float(cp.y), float(cp.z)}});
+    sensors::Matrix33f rot;
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) rot.m[size_t(r * 3 + c)] = float(cam.worldFromCamera.worldFromBody[c][r]);
+    md.Set("seasense:world_from_camera_rotation", rot);
+    md.Set("seasense:frame", std::string("world ENU (x east, y north, z up), origin lat ") +
+                                 std::to_string(sc.world.latitude_deg) + " lon " +
+                                 std::to_string(sc.world.longitude_deg) +
+                                 "; camera body x right, y forward, z up");
+    md.Set("seasense:hfov_deg", float(cam.hfov_rad * 180.0 / M_PI));
+    md.Set("seasense:vfov_deg", float(2.0 * std::atan(cam.TanHalfV()) * 180.0 / M_PI));
+    md.Set("seasense:supersampling", cam.supersampling);
+    md.Set("seasense:units", std::string("cd/m^2 (linear Rec.709 D65 RGB; Y = luminance)"));
+    md.Set("seasense:exposure_ev", float(ev));
+    md.Set("seasense:exposure_mode",
+           std::string(ch.exposure.mode == scene::ExposureMode::Auto ? "auto" : "manual"));
+    md.Set("seasense:ocio_view", ch.ocioView);
+    md.Set("oiio:ColorSpace", std::string("Linear Rec.709 (sRGB)"));
+    // Row-major, column-vector convention: p_camera = M · (p_world, 1).
+    glm::dmat4 worldFromCamera(cam.worldFromCamera.worldFromBody);
+    worldFromCamera[3] = glm::dvec4(cam.worldFromCamera.position_m, 1.0);
+    md.Set("seasense:camera_from_world", RowMajor(glm::inverse(worldFromCamera)));
+    return md;
+}
+
+}  // namespace
+
+std::filesystem::path DefaultOcioConfig() {
+    if (const char* env = std::getenv("SEASENSE_OCIO"); env && *env) return env;
+    return std::filesystem::path(SEASENSE_SOURCE_DIR) / "configs" / "ocio" / "config.ocio";
+}
+
+ChannelPipeline::ChannelPipeline(const scene::World& world, const scene::ChannelSettings& channel,
+                                 std::filesystem::path outDir, std::vector<std::string> formats,
+                                 const std::filesystem::path& ocioConfig)
+    : world_(world), channel_(channel), channelDir_(std::move(outDir) / channel.name),
+      formats_(std::move(formats)) {
+    if (channel_.kind != scene::ChannelKind::Otw)
+        throw InputError("channel '" + channel_.name + "': kind '" + KindName(channel_.kind) +
+                         "' is not available yet; this build renders kind 'otw'");
+    otw_ = std::make_unique<OtwChannel>(world_, channel_);
+    display_ = std::make_unique<sensors::OcioDisplay>(ocioConfig, "sRGB", channel_.ocioView);
+}
+
+FrameRecord ChannelPipeline::RenderAndWrite(int64_t frame) {
+    FrameRecord rec;
+    const scene::SceneState state = world_.State(frame);
+    rec.frame = frame;
+    rec.utc = state.utc;
+    rec.time_s = state.time_s;
+
+    auto t0 = std::chrono::steady_clock::now();
+    otw_->Render(state, samples_);
+    rec.renderMs = MsSince(t0);
+
+    t0 = std::chrono::steady_clock::now();
+    const Image pixels = sensors::IntegrateFootprint(samples_, channel_.supersampling);
+    const double ev = channel_.exposure.mode == scene::ExposureMode::Auto
+                          ? sensors::AutoExposureEv(pixels, channel_.exposure.keyValue)
+                          : channel_.exposure.ev;
+    rec.exposureEv = ev;
+    const float scale = float(std::exp2(ev));
+    rec.sensorMs = MsSince(t0);
+
+    t0 = std::chrono::steady_clock::now();
+    const sensors::ImageMetadata md = FrameMetadata(world_, channel_, state, otw_->Camera(), ev);
+    char stem[64];
+    std::snprintf(stem, sizeof stem, "_%06lld", (long long)frame);
+    const std::string base = channel_.name + stem;
+    for (const std::string& fmt : formats_) {
+        const std::filesystem::path path = channelDir_ / (base + "." + fmt);
+        if (fmt == "exr") {
+            sensors::WriteExr(path, pixels, md);
+        } else {
+            const std::vector<uint8_t> display = display_->ToDisplay8(pixels, scale);
+            sensors::WriteDisplayImage8(path, display, pixels.width, pixels.height, 3, md);
+        }
+        rec.files.push_back(path);
+    }
+    rec.writeMs = MsSince(t0);
+    return rec;
+}
+
+}  // namespace seasense::channels

@@ -1,0 +1,55 @@
+// One channel end to end for a frame: render at-aperture radiance, apply the sensor model
+// (detector footprint, exposure), display through OCIO and write the frame's files.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "channels/otw/otw_channel.h"
+#include "scene/world/world.h"
+#include "sensors/display/ocio_display.h"
+
+namespace seasense::channels {
+
+struct FrameRecord {
+    int64_t frame = 0;
+    scene::UtcTime utc;
+    double time_s = 0.0;
+    double renderMs = 0.0;  // rasterize + shade
+    double sensorMs = 0.0;  // detector, exposure, display
+    double writeMs = 0.0;
+    double exposureEv = 0.0;
+    std::vector<std::filesystem::path> files;
+};
+
+class ChannelPipeline {
+public:
+    // outDir: files go to outDir/<channel>/. formats ⊂ {exr, png, tiff}. ocioConfig: path of
+    // the OCIO config for visible channels. Throws InputError for an unsupported channel kind.
+    ChannelPipeline(const scene::World& world, const scene::ChannelSettings& channel,
+                    std::filesystem::path outDir, std::vector<std::string> formats,
+                    const std::filesystem::path& ocioConfig);
+
+    // Renders frame n and writes its files atomically. Runs in the caller's oneTBB arena.
+    FrameRecord RenderAndWrite(int64_t frame);
+
+    const std::filesystem::path& ChannelDir() const { return channelDir_; }
+    const OtwChannel& Otw() const { return *otw_; }
+
+private:
+    const scene::World& world_;
+    scene::ChannelSettings channel_;
+    std::filesystem::path channelDir_;
+    std::vector<std::string> formats_;
+    std::unique_ptr<OtwChannel> otw_;
+    std::unique_ptr<sensors::OcioDisplay> display_;
+    Image samples_;
+};
+
+// The project's OCIO config: $SEASENSE_OCIO if set, else configs/ocio/config.ocio found
+// beside the executable's source tree (compiled-in path), else next to the scenario.
+std::filesystem::path DefaultOcioConfig();
+
+}  // namespace seasense::channels

@@ -1,0 +1,53 @@
+// Analytic clear daylight sky (Preetham, Shirley & Smits 1999) in scene-linear Rec.709
+// luminance units (cd/m²), with the sun disc and a direction table for per-sample lookups.
+#pragma once
+
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace seasense::radiometry {
+
+// Angular radius of the sun seen from Earth, mean (IAU nominal solar radius 695 700 km at
+// 1 au = 149 597 870.7 km → 0.2666°).
+inline constexpr double kSunAngularRadius_rad = 4.6526e-3;
+
+class AnalyticSky {
+public:
+    // sunDirection: unit ENU vector toward the sun. sunIlluminance_lux: illuminance on a
+    // plane normal to the sun. turbidity: Preetham's T (clear 2, hazy 6+). The sky's own
+    // luminance comes from Preetham's zenith-luminance fit; it is valid for sun elevations
+    // ≥ 0 (the sun is held at the horizon below that: twilight belongs to the sky model of
+    // the ephemeris issue).
+    AnalyticSky(const glm::dvec3& sunDirection, double sunIlluminance_lux, double turbidity);
+
+    // Sky radiance (cd/m², linear Rec.709) toward unit ENU direction d, without the sun disc.
+    // Directions below the horizon see the horizon's radiance.
+    glm::dvec3 Radiance(const glm::dvec3& d) const;
+    // As Radiance, bilinear from a precomputed 256×64 table (max relative error < 1 %).
+    glm::vec3 LookUp(const glm::vec3& d) const;
+
+    // Sun disc luminance (cd/m², Rec.709 RGB): illuminance / solid angle of the disc.
+    glm::dvec3 SunRadiance() const { return sunRadiance_; }
+    glm::dvec3 SunIlluminance() const { return sunIlluminanceRgb_; }
+    const glm::dvec3& SunDirection() const { return sunDir_; }
+
+    // Illuminance (lx, RGB) from the sky dome alone on an upward horizontal surface, by
+    // numerical integration of L·cosθ over the hemisphere.
+    glm::dvec3 HorizontalSkyIlluminance() const { return skyHorizontal_; }
+
+private:
+    double Perez(const double coeffs[5], double cosTheta, double gamma) const;
+
+    glm::dvec3 sunDir_;
+    glm::dvec3 sunRadiance_;
+    glm::dvec3 sunIlluminanceRgb_;
+    double thetaSun_;
+    double zenithY_, zenithX_, zenithYchroma_;
+    double coefY_[5], coefX_[5], coefYc_[5];
+    double normY_, normX_, normYc_;
+    glm::dvec3 skyHorizontal_{0.0};
+    std::vector<glm::vec3> table_;  // kTableAz × (kTableEl + 1), elevation 0 … 90°
+};
+
+}  // namespace seasense::radiometry

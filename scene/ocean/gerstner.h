@@ -1,0 +1,64 @@
+// Sum-of-Gerstner-waves sea surface: trochoidal displacement, normals, folding and truthful
+// height queries, with finite-depth dispersion ω² = g k tanh(k h).
+#pragma once
+
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "scene/scenario/scenario.h"
+
+namespace seasense::scene {
+
+// Standard gravity, m/s² (CGPM 1901; BIPM SI Brochure, 9th ed.).
+inline constexpr double kGravity_mps2 = 9.80665;
+
+// Angular frequency of a linear surface gravity wave of wavenumber k (rad/m) in water of
+// depth h (m): ω² = g k tanh(k h) (Airy theory; physics.md).
+double DispersionOmega(double k_radpm, double depth_m);
+
+// Phase speed ω/k and group speed ½ c (1 + 2kh / sinh 2kh), m/s.
+double PhaseSpeed(double k_radpm, double depth_m);
+double GroupSpeed(double k_radpm, double depth_m);
+
+// A displaced surface point: the horizontal rest position x0 = (x, y) in the world ENU frame
+// moves to position; normal is the unit upward surface normal there.
+struct SurfaceSample {
+    glm::dvec3 position{0.0};
+    glm::dvec3 normal{0.0, 0.0, 1.0};
+    double jacobian = 1.0;  // det ∂(x,y)/∂(x0,y0): < 0 where the surface folds over
+};
+
+// Precomputed per-wave constants, structure of arrays for the hot loops.
+class GerstnerOcean {
+public:
+    GerstnerOcean() = default;
+    explicit GerstnerOcean(const OceanSettings& settings);
+
+    // Surface at rest position (x0, y0) in world metres at time t_s (seconds since frame 0).
+    SurfaceSample Evaluate(double x0, double y0, double t_s) const;
+
+    // Vertical elevation of the drawn surface above the world point (x, y) at time t_s: solves
+    // for the rest position whose displaced horizontal position is (x, y) by fixed-point
+    // iteration, so the answer is the surface the renderer draws.
+    double HeightAt(double x, double y, double t_s) const;
+    SurfaceSample SampleAt(double x, double y, double t_s) const;
+
+    size_t WaveCount() const { return k_.size(); }
+    // Largest |elevation| the waves can reach: Σ A_i (m).
+    double MaxAmplitude_m() const { return maxAmplitude_m_; }
+    // Shortest wavelength among the waves (m), for mesh resolution choices.
+    double MinWavelength_m() const { return minWavelength_m_; }
+
+private:
+    std::vector<double> dirX_, dirY_;  // unit direction of travel (east, north)
+    std::vector<double> k_;            // wavenumber, rad/m
+    std::vector<double> omega_;        // angular frequency, rad/s
+    std::vector<double> amplitude_;    // vertical amplitude A, m
+    std::vector<double> horizontal_;   // horizontal orbit semi-axis Q·A / tanh(kh), m
+    std::vector<double> phase_;        // rad
+    double maxAmplitude_m_ = 0.0;
+    double minWavelength_m_ = 1e30;
+};
+
+}  // namespace seasense::scene

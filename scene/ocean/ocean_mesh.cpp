@@ -1,0 +1,88 @@
+// Polar-grid sea mesh: chosen over a clipmap for now because a grid centred on the eye gives a
+// screen-uniform vertex density from the eye to the horizon with one crack-free mesh.
+#include "scene/ocean/ocean_mesh.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <tbb/parallel_for.h>
+
+#include "scene/core/check.h"
+
+namespace seasense::scene {
+
+double HorizonDistance_m(double h) {
+    h = std::max(h, 0.0);
+    return std::sqrt(2.0 * kEarthRadius_m * h + h * h);
+}
+
+double CurvatureDrop_m(double r) {
+    const double R = kEarthRadius_m;
+    r = std::min(std::abs(r), R);
+    // r² / (R + √(R² − r²)) equals R − √(R² − r²) without cancellation.
+    return r * r / (R + std::sqrt(R * R - r * r));
+}
+
+void BuildOceanMesh(const GerstnerOcean& ocean, const OceanMeshRequest& req, OceanMesh& out) {
+    CHECK(req.angularStep_rad > 0.0);
+    const double amplitude = ocean.MaxAmplitude_m();
+    const double eyeHeight = std::max(req.eye_m.z, 0.05);
+    // Crests up to `amplitude` high stay visible until the two horizon distances add up.
+    const double maxRange = HorizonDistance_m(eyeHeight) + HorizonDistance_m(amplitude) + 100.0;
+    // Heights seen from the eye: foreshortening uses the eye's height above the lowest trough.
+    const double hEff = eyeHeight + amplitude;
+    const double dphi = req.angularStep_rad;
+
+    std::vector<double> radii;
+    // Start well inside the nearest visible water: horizontal orbits can pull crests inward.
+    double r = std::max(0.05, 0.25 * hEff);
+    radii.push_back(0.0);
+    while (r < maxRange) {
+        radii.push_back(r);
+        const double step = std::min(r * dphi * std::max(1.0, r / hEff), 8.0 * r * dphi);
+        r += std::max(step, 1e-3);
+    }
+    radii.push_back(maxRange);
+
+    const bool full = req.azimuthMax_rad - req.azimuthMin_rad >= 2.0 * M_PI - 1e-9;
+    const double span = full ? 2.0 * M_PI : req.azimuthMax_rad - req.azimuthMin_rad;
+    CHECK(span > 0.0);
+    const int segments = std::max(3, int(std::ceil(span / dphi)));
+    const int columns = full ? segments : segments + 1;  // the full circle wraps its last column
+    const int rings = int(radii.size());
+
+    out.rings = rings;
+    out.segments = segments;
+    out.positions.resize(size_t(rings) * size_t(columns));
+    out.normals.resize(out.positions.size());
+    out.jacobian.resize(out.positions.size());
+    tbb::parallel_for(0, rings, [&](int j) {
+        const double radius = radii[size_t(j)];
+        const double drop = CurvatureDrop_m(radius);
+        for (int i = 0; i < columns; ++i) {
+            const double az = req.azimuthMin_rad + span * double(i) / double(segments);
+            const double x0 = req.eye_m.x + radius * std::sin(az);
+            const double y0 = req.eye_m.y + radius * std::cos(az);
+            const SurfaceSample s = ocean.Evaluate(x0, y0, req.time_s);
+            const size_t v = size_t(j) * size_t(columns) + size_t(i);
+            out.positions[v] = glm::vec3(s.position.x, s.position.y, s.position.z - drop);
+            out.normals[v] = glm::vec3(s.normal);
+            out.jacobian[v] = float(s.jacobian);
+        }
+    });
+
+    out.indices.clear();
+    out.indices.reserve(size_t(rings - 1) * size_t(segments) * 6);
+    for (int j = 0; j + 1 < rings; ++j) {
+        for (int i = 0; i < segments; ++i) {
+            const int i1 = full ? (i + 1) % segments : i + 1;
+            const uint32_t a = uint32_t(j * columns + i), b = uint32_t(j * columns + i1);
+            const uint32_t c = uint32_t((j + 1) * columns + i), d = uint32_t((j + 1) * columns + i1);
+            // Azimuth increases clockwise seen from above and radius outward, so (a, b, c)
+            // and (b, d, c) are counter-clockwise seen from above.
+            out.indices.insert(out.indices.end(), {a, b, c, b, d, c});
+        }
+    }
+}
+
+}  // namespace seasense::scene

@@ -1,0 +1,59 @@
+// The scene core: built once from a Scenario, it yields an immutable SceneState per frame.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "scene/core/frames.h"
+#include "scene/models/triangle_mesh.h"
+#include "scene/ocean/gerstner.h"
+#include "scene/scenario/scenario.h"
+
+namespace seasense::scene {
+
+// A placed model: its body-frame mesh, world pose and material, for one frame.
+struct EntityState {
+    std::string name;
+    std::string material;
+    glm::dvec3 reflectanceRgb{0.5};
+    Pose pose;
+    std::shared_ptr<const TriangleMesh> bodyMesh;  // shared, immutable
+};
+
+struct SunState {
+    glm::dvec3 direction{0.0, 0.0, 1.0};  // unit ENU vector toward the sun
+    double elevation_rad = 0.0;
+    double azimuth_rad = 0.0;
+    double illuminance_lux = 0.0;  // on a surface normal to the sun
+};
+
+// Everything a channel needs to render frame `frame`, fixed for that frame.
+struct SceneState {
+    int64_t frame = 0;
+    double time_s = 0.0;  // simulated seconds since frame 0
+    UtcTime utc;
+    SunState sun;
+    Pose eyepoint;
+    std::vector<EntityState> entities;
+};
+
+class World {
+public:
+    // Loads every model the scenario names (InputError on failure).
+    explicit World(const Scenario& scenario);
+
+    // State of frame n: simulated time n · timeScale / frameRate after the start.
+    SceneState State(int64_t frame) const;
+
+    const Scenario& GetScenario() const { return scenario_; }
+    const GerstnerOcean& Ocean() const { return ocean_; }
+
+private:
+    Scenario scenario_;
+    GerstnerOcean ocean_;
+    std::vector<std::shared_ptr<const TriangleMesh>> models_;  // one per entity
+};
+
+}  // namespace seasense::scene

@@ -1,0 +1,57 @@
+// Box-footprint detector integration and log-average auto exposure.
+#include "sensors/detector/detector.h"
+
+#include <cmath>
+#include <vector>
+
+#include <tbb/parallel_for.h>
+
+#include "radiometry/color/rec709.h"
+
+namespace seasense::sensors {
+
+Image IntegrateFootprint(const Image& samples, int n) {
+    CHECK(n >= 1);
+    CHECK(samples.width % n == 0 && samples.height % n == 0);
+    Image out(samples.width / n, samples.height / n, samples.channels);
+    const int c = samples.channels;
+    const float inv = 1.0f / float(n * n);
+    tbb::parallel_for(0, out.height, [&](int y) {
+        std::vector<float> acc(size_t(c) * size_t(out.width));
+        for (int sy = 0; sy < n; ++sy) {
+            const float* row = samples.At(0, y * n + sy);
+            for (int x = 0; x < out.width; ++x)
+                for (int sx = 0; sx < n; ++sx)
+                    for (int k = 0; k < c; ++k)
+                        acc[size_t(x * c + k)] += row[size_t((x * n + sx) * c + k)];
+        }
+        float* dst = out.At(0, y);
+        for (size_t i = 0; i < acc.size(); ++i) dst[i] = acc[i] * inv;
+    });
+    return out;
+}
+
+double LogAverageLuminance(const Image& rgb) {
+    CHECK(rgb.channels >= 3);
+    // Row sums first, then a serial sum of rows: the same order for any thread count.
+    std::vector<double> rowSums(size_t(rgb.height), 0.0);
+    tbb::parallel_for(0, rgb.height, [&](int y) {
+        double s = 0.0;
+        for (int x = 0; x < rgb.width; ++x) {
+            const float* p = rgb.At(x, y);
+            const double Y = radiometry::LuminanceRec709({p[0], p[1], p[2]});
+            s += std::log(1e-4 + std::max(Y, 0.0));
+        }
+        rowSums[size_t(y)] = s;
+    });
+    double total = 0.0;
+    for (double s : rowSums) total += s;
+    const double count = double(rgb.width) * double(rgb.height);
+    return count > 0 ? std::exp(total / count) : 0.0;
+}
+
+double AutoExposureEv(const Image& rgb, double key) {
+    return std::log2(key / LogAverageLuminance(rgb));
+}
+
+}  // namespace seasense::sensors

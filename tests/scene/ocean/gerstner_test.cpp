@@ -1,0 +1,158 @@
+// Gerstner waves against linear wave theory: dispersion, trochoid geometry, truthful queries.
+#include "scene/ocean/gerstner.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "scene/ocean/ocean_mesh.h"
+
+namespace seasense::scene {
+namespace {
+
+OceanSettings OneWave(double wavelength, double amplitude, double steepness, double depth,
+                      double direction_deg = 90.0) {
+    OceanSettings s;
+    s.depth_m = depth;
+    GerstnerWaveSettings w;
+    w.direction_rad = direction_deg * M_PI / 180.0;
+    w.wavelength_m = wavelength;
+    w.amplitude_m = amplitude;
+    w.steepness = steepness;
+    s.waves.push_back(w);
+    return s;
+}
+
+// Position of the crest nearest x_guess along a wave travelling east (+x), by golden-section
+// search on the drawn height.
+double CrestX(const GerstnerOcean& o, double xGuess, double halfWidth, double t) {
+    double a = xGuess - halfWidth, b = xGuess + halfWidth;
+    const double g = (std::sqrt(5.0) - 1.0) / 2.0;
+    for (int i = 0; i < 200; ++i) {
+        const double c = b - g * (b - a), d = a + g * (b - a);
+        if (o.HeightAt(c, 0.0, t) > o.HeightAt(d, 0.0, t)) b = d; else a = c;
+    }
+    return 0.5 * (a + b);
+}
+
+TEST(Gerstner, DeepWaterCrestsTravelAtPhaseSpeed) {
+    // Deep water: c = √(g λ / 2π) (Airy theory, e.g. Lamb, Hydrodynamics §229).
+    const double lambda = 40.0;
+    const GerstnerOcean o(OneWave(lambda, 0.5, 0.8, 1e4));
+    const double expected = std::sqrt(kGravity_mps2 * lambda / (2.0 * M_PI));
+    const double t = 3.0;
+    const double x0 = CrestX(o, 0.0, 0.25 * lambda, 0.0);
+    const double x1 = CrestX(o, expected * t, 0.25 * lambda, t);
+    EXPECT_NEAR((x1 - x0) / t, expected, 1e-3 * expected);
+}
+
+TEST(Gerstner, ShallowWaterSpeedApproachesRootGh) {
+    // kh ≪ 1: c → √(g h); for λ = 200 m, h = 1 m the exact value is within 0.2 % of it.
+    const double h = 1.0, lambda = 200.0;
+    const GerstnerOcean o(OneWave(lambda, 0.05, 0.0, h));
+    const double t = 10.0;
+    const double c = std::sqrt(kGravity_mps2 * h);
+    const double x0 = CrestX(o, 0.0, 0.25 * lambda, 0.0);
+    const double x1 = CrestX(o, c * t, 0.25 * lambda, t);
+    EXPECT_NEAR((x1 - x0) / t, c, 2e-3 * c);
+    const double k = 2.0 * M_PI / lambda;
+    EXPECT_NEAR(GroupSpeed(k, h) / PhaseSpeed(k, h), 1.0, 2e-3);  // non-dispersive limit
+    EXPECT_NEAR(GroupSpeed(k, 1e4) / PhaseSpeed(k, 1e4), 0.5, 1e-12);  // deep water: c_g = c/2
+}
+
+TEST(Gerstner, TrochoidMeanLevelLiesHalfKA2BelowStillWater) {
+    // For a trochoid (Q = 1, deep water) the Eulerian mean of the surface over a wavelength is
+    // −k A² / 2 (Lamb, Hydrodynamics §251): the orbit centres sit above the mean level.
+    const double lambda = 20.0, A = 1.0;
+    const GerstnerOcean o(OneWave(lambda, A, 1.0, 1e4));
+    const int n = 4096;
+    double sum = 0.0;
+    for (int i = 0; i < n; ++i) sum += o.HeightAt(lambda * (i + 0.5) / n, 3.0, 1.7);
+    const double k = 2.0 * M_PI / lambda;
+    EXPECT_NEAR(sum / n, -0.5 * k * A * A, 1e-4);
+}
+
+TEST(Gerstner, SurfaceParticlesMoveOnCirclesOfRadiusAInDeepWater) {
+    const double A = 0.7;
+    const GerstnerOcean o(OneWave(30.0, A, 1.0, 1e4, 37.0));
+    for (int i = 0; i < 32; ++i) {
+        const SurfaceSample s = o.Evaluate(5.0, -2.0, 0.37 * i);
+        EXPECT_NEAR(glm::length(s.position - glm::dvec3(5.0, -2.0, 0.0)), A, 1e-9);
+    }
+}
+
+TEST(Gerstner, NormalIsPerpendicularToTheDrawnSurface) {
+    OceanSettings s = OneWave(25.0, 0.4, 0.9, 30.0, 10.0);
+    GerstnerWaveSettings w2;
+    w2.direction_rad = 1.2;
+    w2.wavelength_m = 9.0;
+    w2.amplitude_m = 0.1;
+    w2.steepness = 0.6;
+    s.waves.push_back(w2);
+    const GerstnerOcean o(s);
+    const double e = 1e-5;
+    for (int i = 0; i < 50; ++i) {
+        const double x = 1.3 * i, y = -0.7 * i, t = 0.11 * i;
+        const SurfaceSample c = o.Evaluate(x, y, t);
+        const glm::dvec3 tx = (o.Evaluate(x + e, y, t).position - o.Evaluate(x - e, y, t).position);
+        const glm::dvec3 ty = (o.Evaluate(x, y + e, t).position - o.Evaluate(x, y - e, t).position);
+        EXPECT_NEAR(glm::dot(c.normal, glm::normalize(tx)), 0.0, 1e-6);
+        EXPECT_NEAR(glm::dot(c.normal, glm::normalize(ty)), 0.0, 1e-6);
+        EXPECT_NEAR(glm::length(c.normal), 1.0, 1e-12);
+        EXPECT_GT(c.normal.z, 0.0);
+    }
+}
+
+TEST(Gerstner, HeightQueryAnswersWhatIsDrawn) {
+    OceanSettings s = OneWave(40.0, 0.6, 0.8, 50.0, 200.0);
+    GerstnerWaveSettings w2;
+    w2.direction_rad = 0.4;
+    w2.wavelength_m = 12.0;
+    w2.amplitude_m = 0.15;
+    w2.steepness = 0.7;
+    s.waves.push_back(w2);
+    const GerstnerOcean o(s);
+    for (int i = 0; i < 200; ++i) {
+        const double x0 = 0.77 * i - 50.0, y0 = 0.31 * i, t = 0.05 * i;
+        const SurfaceSample p = o.Evaluate(x0, y0, t);
+        EXPECT_NEAR(o.HeightAt(p.position.x, p.position.y, t), p.position.z, 1e-7);
+    }
+}
+
+TEST(OceanMesh, HorizonDistancesMatchEarthGeometry) {
+    // √(2 R h): 2 m → ≈ 5.05 km, 300 m → ≈ 61.8 km (issue 3 quotes ~5 km and ~62 km).
+    EXPECT_NEAR(HorizonDistance_m(2.0), 5048.0, 5.0);
+    EXPECT_NEAR(HorizonDistance_m(300.0), 61827.0, 30.0);
+    // Sag of a sphere at 10 km: r² / 2R = 7.85 m.
+    EXPECT_NEAR(CurvatureDrop_m(10000.0), 1e8 / (2.0 * kEarthRadius_m), 1e-4);
+}
+
+TEST(OceanMesh, CoversTheSectorOutPastTheHorizonWithUpwardFaces) {
+    const GerstnerOcean o(OneWave(30.0, 0.3, 0.8, 1e4));
+    OceanMeshRequest req;
+    req.eye_m = {10.0, 20.0, 5.0};
+    req.azimuthMin_rad = -0.5;
+    req.azimuthMax_rad = 0.7;
+    req.angularStep_rad = 0.01;
+    OceanMesh m;
+    BuildOceanMesh(o, req, m);
+    double farthest = 0.0;
+    for (const glm::vec3& p : m.positions)
+        farthest = std::max(farthest, std::hypot(p.x - 10.0, p.y - 20.0));
+    EXPECT_GT(farthest, HorizonDistance_m(5.0));
+    // Every non-degenerate triangle faces up (counter-clockwise seen from above).
+    size_t up = 0, total = 0;
+    for (size_t t = 0; t < m.indices.size(); t += 3) {
+        const glm::dvec3 a(m.positions[m.indices[t]]), b(m.positions[m.indices[t + 1]]),
+            c(m.positions[m.indices[t + 2]]);
+        const double nz = glm::cross(b - a, c - a).z;
+        if (std::abs(nz) < 1e-9) continue;
+        ++total;
+        up += nz > 0.0;
+    }
+    EXPECT_GT(total, 1000u);
+    EXPECT_EQ(up, total);
+}
+
+}  // namespace
+}  // namespace seasense::scene

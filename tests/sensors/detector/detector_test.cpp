@@ -1,0 +1,50 @@
+// Detector footprint integration against the discrete box-filter transfer function.
+#include "sensors/detector/detector.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+namespace seasense::sensors {
+namespace {
+
+TEST(Detector, BoxFootprintAttenuatesASineByTheDiscreteSinc) {
+    // The mean of n point samples at offsets (k + ½)/n of sin(2π f x + φ) is a sine of the
+    // same phase scaled by sin(π f) / (n sin(π f / n)) (sum of a geometric series); n → ∞
+    // gives the detector-footprint MTF |sinc(π a f)| of physics.md.
+    const int n = 8, width = 64;
+    for (double f : {0.05, 0.2, 0.37, 0.5}) {
+        Image s(width * n, 1, 1);
+        for (int i = 0; i < width * n; ++i)
+            s.At(i, 0)[0] = float(std::sin(2.0 * M_PI * f * (i + 0.5) / n + 0.3));
+        const Image p = IntegrateFootprint(s, n);
+        const double gain = std::sin(M_PI * f) / (n * std::sin(M_PI * f / n));
+        for (int x = 0; x < width; ++x)
+            EXPECT_NEAR(p.At(x, 0)[0], gain * std::sin(2.0 * M_PI * f * (x + 0.5) + 0.3), 2e-6);
+    }
+}
+
+TEST(Detector, IntegrationConservesTheImageMean) {
+    Image s(30, 18, 3);
+    for (size_t i = 0; i < s.pixels.size(); ++i) s.pixels[i] = float((i * 7919) % 101);
+    const Image p = IntegrateFootprint(s, 3);
+    ASSERT_EQ(p.width, 10);
+    ASSERT_EQ(p.height, 6);
+    double a = 0, b = 0;
+    for (float v : s.pixels) a += v;
+    for (float v : p.pixels) b += v;
+    EXPECT_NEAR(a / double(s.pixels.size()), b / double(p.pixels.size()), 1e-4);
+}
+
+TEST(Detector, AutoExposureMapsGeometricMeanLuminanceToKey) {
+    // Half the pixels at 10 cd/m², half at 1000: the geometric mean is 100 cd/m².
+    Image img(4, 2, 3);
+    for (int x = 0; x < 4; ++x)
+        for (int y = 0; y < 2; ++y)
+            for (int c = 0; c < 3; ++c) img.At(x, y)[c] = (x + y) % 2 ? 10.0f : 1000.0f;
+    EXPECT_NEAR(LogAverageLuminance(img), 100.0, 1e-3);
+    EXPECT_NEAR(AutoExposureEv(img, 0.18), std::log2(0.18 / 100.0), 1e-5);
+}
+
+}  // namespace
+}  // namespace seasense::sensors
