@@ -14,9 +14,10 @@ TEST(Detector, BoxFootprintAttenuatesASineByTheDiscreteSinc) {
     // gives the detector-footprint MTF |sinc(π a f)| of physics.md.
     const int n = 8, width = 64;
     for (double f : {0.05, 0.2, 0.37, 0.5}) {
-        Image s(width * n, 1, 1);
-        for (int i = 0; i < width * n; ++i)
-            s.At(i, 0)[0] = float(std::sin(2.0 * M_PI * f * (i + 0.5) / n + 0.3));
+        Image s(width * n, n, 1);  // one row of pixels, n sample rows of the same signal
+        for (int j = 0; j < n; ++j)
+            for (int i = 0; i < width * n; ++i)
+                s.At(i, j)[0] = float(std::sin(2.0 * M_PI * f * (i + 0.5) / n + 0.3));
         const Image p = IntegrateFootprint(s, n);
         const double gain = std::sin(M_PI * f) / (n * std::sin(M_PI * f / n));
         for (int x = 0; x < width; ++x)
