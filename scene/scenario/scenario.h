@@ -45,7 +45,7 @@ struct GerstnerWaveSettings {
     double direction_rad = 0.0;  // direction of travel, azimuth from north clockwise
     double wavelength_m = 10.0;
     double amplitude_m = 0.1;
-    double steepness = 0.5;      // Q in [0, 1]: 0 sine wave, 1 sharpest trochoid without loops
+    double steepness = 0.5;      // Q in [0, 1]: horizontal orbit / linear theory (1: trochoid)
     double phase_rad = 0.0;
 };
 
