@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include "radiometry/sky/analytic_sky.h"
@@ -28,6 +29,10 @@ double ExtinctionFromVisibility(double visibility_m) { return 3.912 / visibility
 // Gaussian isotropic slope density of Cox & Munk (1954), J. Opt. Soc. Am. 44(11), with the
 // mean-square slope σ² = 0.003 + 0.00512·W (W wind speed at 12.5 m, m/s); p(tan β) per unit
 // slope area.
+// Sea mesh vertex spacing on screen: waves are smooth at this scale and their normals are
+// interpolated per sample.
+constexpr double kOceanVertexSpacing_px = 6.0;
+
 float CoxMunkSlopeVariance(double windSpeed_mps) {
     return float(0.003 + 0.00512 * std::max(windSpeed_mps, 0.0));
 }
@@ -94,7 +99,7 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     scene::OceanMeshRequest req;
     req.eye_m = cam.worldFromCamera.position_m;
     req.time_s = state.time_s;
-    req.angularStep_rad = 4.0 * cam.hfov_rad / double(cam.width);
+    req.angularStep_rad = kOceanVertexSpacing_px * cam.hfov_rad / double(cam.width);
     FrustumAzimuthSector(cam, 20.0 * M_PI / 180.0, req.azimuthMin_rad, req.azimuthMax_rad);
     scene::BuildOceanMesh(world_.Ocean(), req, ocean_);
 
@@ -109,8 +114,13 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     stats_.oceanTriangles = ocean_.indices.size() / 3;
     for (const scene::TriangleMesh& m : worldMeshes_) stats_.modelTriangles += m.TriangleCount();
 
-    const radiometry::AnalyticSky sky(state.sun.direction, state.sun.illuminance_lux,
-                                      env.sky.turbidity);
+    if (!sky_ || skySun_ != state.sun.direction || skySunLux_ != state.sun.illuminance_lux) {
+        sky_ = std::make_unique<radiometry::AnalyticSky>(state.sun.direction,
+                                                         state.sun.illuminance_lux, env.sky.turbidity);
+        skySun_ = state.sun.direction;
+        skySunLux_ = state.sun.illuminance_lux;
+    }
+    const radiometry::AnalyticSky& sky = *sky_;
     const glm::vec3 sunDir(state.sun.direction);
     const glm::vec3 sunE(sky.SunIlluminance());
     const glm::vec3 sunL(sky.SunRadiance());
@@ -120,23 +130,46 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     const float cosSunRadius = float(std::cos(radiometry::kSunAngularRadius_rad));
     const float beta = float(ExtinctionFromVisibility(env.visibility_m));
     const float slopeVar = CoxMunkSlopeVariance(env.windSpeed_mps);
-    const float nWater = float(radiometry::kSeaWaterIndexVisible);
+    static const radiometry::FresnelTable fresnel(radiometry::kSeaWaterIndexVisible);
     const glm::vec3 eye(cam.worldFromCamera.position_m);
     const bool shadows = settings_.shadows && !occlusion_.Empty() && sunDir.z > 0.0f;
 
-    radiance = Image(sw, sh, 3);
+    if (radiance.width != sw || radiance.height != sh || radiance.channels != 3)
+        radiance = Image(sw, sh, 3);
     constexpr int kRowsPerBlock = 8;
     const int blocks = (sh + kRowsPerBlock - 1) / kRowsPerBlock;
     std::vector<uint64_t> blockRays(size_t(blocks), 0);
+    // View rays: direction = normalize(rowBase + x · colStep) (camera axes scaled by the
+    // pinhole geometry), so sky samples need no trigonometry.
+    const glm::dmat3& R = cam.worldFromCamera.worldFromBody;
+    const double tanH = cam.TanHalfH(), tanV = cam.TanHalfV();
+    const glm::vec3 colStep(R * glm::dvec3(2.0 * tanH / sw, 0.0, 0.0));
+    const glm::dvec3 forward = R * glm::dvec3(0.0, 1.0, 0.0);
+
+    struct Scratch {
+        std::vector<glm::vec3> position, normal, origins;
+        std::vector<int> meshOf;
+        std::vector<uint8_t> lit, vis;
+        std::vector<uint32_t> originOwner;
+    };
+    tbb::enumerable_thread_specific<Scratch> scratch;
 
     tbb::parallel_for(0, blocks, [&](int block) {
         const int y0 = block * kRowsPerBlock, y1 = std::min(sh, y0 + kRowsPerBlock);
         const size_t n = size_t(y1 - y0) * size_t(sw);
-        std::vector<glm::vec3> position(n), normal(n);
-        std::vector<int> meshOf(n, -1);
-        std::vector<uint8_t> lit(n, 1);
-        std::vector<glm::vec3> origins;
-        std::vector<uint32_t> originOwner;
+        Scratch& sc = scratch.local();
+        sc.position.resize(n);
+        sc.normal.resize(n);
+        sc.meshOf.assign(n, -1);
+        sc.lit.assign(n, 1);
+        sc.origins.clear();
+        sc.originOwner.clear();
+        std::vector<glm::vec3>& position = sc.position;
+        std::vector<glm::vec3>& normal = sc.normal;
+        std::vector<int>& meshOf = sc.meshOf;
+        std::vector<uint8_t>& lit = sc.lit;
+        std::vector<glm::vec3>& origins = sc.origins;
+        std::vector<uint32_t>& originOwner = sc.originOwner;
 
         // Pass 1: surface position and normal of each sample; gather shadow-ray origins.
         for (size_t k = 0; k < n; ++k) {
@@ -169,7 +202,8 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
             }
         }
         if (!origins.empty()) {
-            std::vector<uint8_t> vis(origins.size());
+            std::vector<uint8_t>& vis = sc.vis;
+            vis.resize(origins.size());
             occlusion_.DirectionalVisibility(origins, sunDir, 0.0f, vis);
             for (size_t r = 0; r < origins.size(); ++r) lit[originOwner[r]] = vis[r];
             blockRays[size_t(block)] = origins.size();
@@ -181,7 +215,9 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
             float* out = radiance.At(x, y);
             glm::vec3 L;
             if (meshOf[k] < 0) {
-                const glm::vec3 d(cam.SampleDirection(x, y));
+                const double ndcY = 1.0 - 2.0 * (y + 0.5) / sh;
+                const glm::vec3 rowBase(forward + R * glm::dvec3(-tanH, 0.0, ndcY * tanV));
+                const glm::vec3 d = glm::normalize(rowBase + (float(x) + 0.5f) * colStep);
                 L = sky.LookUp(d);
                 if (glm::dot(d, sunDir) >= cosSunRadius) L += sunL;
             } else {
@@ -194,18 +230,19 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
                     const float cosV = std::max(glm::dot(nrm, v), 1e-3f);
                     glm::vec3 r = 2.0f * glm::dot(nrm, v) * nrm - v;
                     if (r.z < 0.0f) r.z = -r.z;  // a ray reflected into the sea meets the next wave's sky
-                    const float F = float(radiometry::FresnelDielectric(cosV, nWater));
+                    const float F = fresnel(cosV);
                     L = F * sky.LookUp(r) + (1.0f - F) * kSeaRrs * downwelling;
                     // Cox–Munk glint: L = E_sun ρ(ω) p(β) / (4 cos θ_v cos⁴ β) (Cox & Munk
                     // 1954), β the tilt of the reflecting facet from the local normal.
                     const float cosS = glm::dot(nrm, sunDir);
-                    if (cosS > 0.0f && sunVis > 0.0f) {
-                        const glm::vec3 h = glm::normalize(v + sunDir);
-                        const float cosB = std::max(glm::dot(h, nrm), 1e-3f);
-                        const float cos2 = cosB * cosB;
-                        const float tan2 = (1.0f - cos2) / cos2;
+                    const glm::vec3 h = glm::normalize(v + sunDir);
+                    const float cosB = std::max(glm::dot(h, nrm), 1e-3f);
+                    const float cos2 = cosB * cosB;
+                    const float tan2 = (1.0f - cos2) / cos2;
+                    // Beyond e^-60 the glint is below float precision next to the sky term.
+                    if (cosS > 0.0f && sunVis > 0.0f && tan2 < 60.0f * slopeVar) {
                         const float p = std::exp(-tan2 / slopeVar) / (float(M_PI) * slopeVar);
-                        const float Fs = float(radiometry::FresnelDielectric(glm::dot(v, h), nWater));
+                        const float Fs = fresnel(glm::dot(v, h));
                         L += sunE * (Fs * p / (4.0f * cosV * cos2 * cos2)) * sunVis;
                     }
                 } else {
@@ -217,7 +254,7 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
                 }
                 // Koschmieder: the horizon sky is the airlight a long path converges to.
                 const float t = std::exp(-beta * range);
-                const glm::vec3 horizon = sky.LookUp(glm::vec3(-v.x, -v.y, 0.0f));
+                const glm::vec3 horizon = sky.HorizonLookUp(-v);
                 L = L * t + horizon * (1.0f - t);
             }
             out[0] = L.r;

@@ -8,6 +8,7 @@
 #include "channels/camera/channel_camera.h"
 #include "channels/occlusion/occlusion.h"
 #include "channels/raster/rasterizer.h"
+#include "radiometry/sky/analytic_sky.h"
 #include "scene/core/image.h"
 #include "scene/models/triangle_mesh.h"
 #include "scene/ocean/ocean_mesh.h"
@@ -45,6 +46,10 @@ private:
     std::vector<glm::dvec3> reflectance_;           // per entity
     scene::OceanMesh ocean_;
     VisibilityBuffer vis_;
+    // The sky depends only on the sun and turbidity: rebuilt when they change.
+    std::unique_ptr<radiometry::AnalyticSky> sky_;
+    glm::dvec3 skySun_{0.0};
+    double skySunLux_ = -1.0;
     OtwFrameStats stats_;
 };
 

@@ -10,8 +10,34 @@
 namespace seasense::radiometry {
 
 namespace {
-constexpr int kTableAz = 256;
-constexpr int kTableEl = 64;
+
+constexpr int kTableSize = 128;
+constexpr int kHorizonSize = 512;
+
+// Position around the horizon in [0, 4) from a horizontal direction without trigonometry:
+// the perimeter parameter of the octahedral diamond |u| + |v| = 1.
+float HorizonParameter(float x, float y) {
+    const float s = std::abs(x) + std::abs(y);
+    if (s <= 0.0f) return 0.0f;
+    const float u = x / s;
+    return y >= 0.0f ? 1.0f + u : 3.0f - u;
+}
+
+// Hemi-octahedral map (Engelhardt & Dachsbacher, "Octahedron Environment Maps", VMV 2008):
+// unit direction with z ≥ 0 ↔ square [-1, 1]²; area distortion stays within a factor ~2.
+glm::vec2 HemiOctFromDirection(glm::vec3 d) {
+    d.z = std::max(d.z, 0.0f);
+    const float s = std::abs(d.x) + std::abs(d.y) + d.z;
+    const float u = d.x / s, v = d.y / s;
+    return {u + v, u - v};
+}
+
+glm::dvec3 DirectionFromHemiOct(double a, double b) {
+    const double u = 0.5 * (a + b), v = 0.5 * (a - b);
+    const glm::dvec3 d{u, v, 1.0 - std::abs(u) - std::abs(v)};
+    return glm::normalize(d);
+}
+
 }  // namespace
 
 AnalyticSky::AnalyticSky(const glm::dvec3& sunDirection, double sunIlluminance_lux, double T)
@@ -53,15 +79,20 @@ AnalyticSky::AnalyticSky(const glm::dvec3& sunDirection, double sunIlluminance_l
     sunIlluminanceRgb_ = glm::dvec3(sunIlluminance_lux * sunUp);
     sunRadiance_ = sunIlluminanceRgb_ / sunSolidAngle;
 
-    table_.resize(size_t(kTableAz) * size_t(kTableEl + 1));
-    for (int j = 0; j <= kTableEl; ++j) {
-        const double el = 0.5 * M_PI * double(j) / kTableEl;
-        for (int i = 0; i < kTableAz; ++i) {
-            const double az = 2.0 * M_PI * double(i) / kTableAz;
-            const glm::dvec3 d{std::cos(el) * std::sin(az), std::cos(el) * std::cos(az),
-                               std::sin(el)};
-            table_[size_t(j) * kTableAz + size_t(i)] = glm::vec3(Radiance(d));
+    table_.resize(size_t(kTableSize) * size_t(kTableSize));
+    for (int j = 0; j < kTableSize; ++j) {
+        for (int i = 0; i < kTableSize; ++i) {
+            const double a = -1.0 + 2.0 * i / (kTableSize - 1), b = -1.0 + 2.0 * j / (kTableSize - 1);
+            table_[size_t(j) * kTableSize + size_t(i)] = glm::vec3(Radiance(DirectionFromHemiOct(a, b)));
         }
+    }
+
+    horizon_.resize(kHorizonSize + 1);
+    for (int i = 0; i <= kHorizonSize; ++i) {
+        const double t = 4.0 * i / kHorizonSize;  // invert HorizonParameter
+        const double u = t <= 2.0 ? t - 1.0 : 3.0 - t;
+        const double v = t <= 2.0 ? 1.0 - std::abs(u) : -(1.0 - std::abs(u));
+        horizon_[size_t(i)] = glm::vec3(Radiance(glm::normalize(glm::dvec3(u, v, 0.0))));
     }
 
     // E_h = ∫ L cosθ dω over the upper hemisphere, midpoint rule in (cosθ, φ): dω = dμ dφ.
@@ -100,22 +131,24 @@ glm::dvec3 AnalyticSky::Radiance(const glm::dvec3& dIn) const {
 }
 
 glm::vec3 AnalyticSky::LookUp(const glm::vec3& d) const {
-    const float horiz = std::sqrt(d.x * d.x + d.y * d.y);
-    float el = std::atan2(std::max(d.z, 0.0f), horiz);
-    float az = std::atan2(d.x, d.y);
-    if (az < 0.0f) az += float(2.0 * M_PI);
-    const float u = az * float(kTableAz / (2.0 * M_PI));
-    const float v = std::min(el * float(kTableEl / (0.5 * M_PI)), float(kTableEl));
-    int i0 = int(u), j0 = int(v);
+    const glm::vec2 st = HemiOctFromDirection(d);
+    const float scale = 0.5f * float(kTableSize - 1);
+    const float u = std::clamp((st.x + 1.0f) * scale, 0.0f, float(kTableSize - 1));
+    const float v = std::clamp((st.y + 1.0f) * scale, 0.0f, float(kTableSize - 1));
+    const int i0 = std::min(int(u), kTableSize - 2), j0 = std::min(int(v), kTableSize - 2);
     const float fu = u - float(i0), fv = v - float(j0);
-    i0 %= kTableAz;
-    const int i1 = (i0 + 1) % kTableAz;
-    const int j1 = std::min(j0 + 1, kTableEl);
-    const glm::vec3* row0 = &table_[size_t(j0) * kTableAz];
-    const glm::vec3* row1 = &table_[size_t(j1) * kTableAz];
-    const glm::vec3 a = row0[i0] + (row0[i1] - row0[i0]) * fu;
-    const glm::vec3 b = row1[i0] + (row1[i1] - row1[i0]) * fu;
+    const glm::vec3* row0 = &table_[size_t(j0) * kTableSize];
+    const glm::vec3* row1 = row0 + kTableSize;
+    const glm::vec3 a = row0[i0] + (row0[i0 + 1] - row0[i0]) * fu;
+    const glm::vec3 b = row1[i0] + (row1[i0 + 1] - row1[i0]) * fu;
     return a + (b - a) * fv;
+}
+
+glm::vec3 AnalyticSky::HorizonLookUp(const glm::vec3& d) const {
+    const float u = HorizonParameter(d.x, d.y) * (float(kHorizonSize) / 4.0f);
+    const int i = std::clamp(int(u), 0, kHorizonSize - 1);
+    const float f = std::clamp(u - float(i), 0.0f, 1.0f);
+    return horizon_[size_t(i)] + (horizon_[size_t(i) + 1] - horizon_[size_t(i)]) * f;
 }
 
 }  // namespace seasense::radiometry

@@ -24,8 +24,14 @@ public:
     // Sky radiance (cd/m², linear Rec.709) toward unit ENU direction d, without the sun disc.
     // Directions below the horizon see the horizon's radiance.
     glm::dvec3 Radiance(const glm::dvec3& d) const;
-    // As Radiance, bilinear from a precomputed 256×64 table (max relative error < 1 %).
+    // As Radiance, bilinear from a precomputed table over the upper hemisphere in the
+    // hemi-octahedral parameterisation (no trigonometry per lookup); within 1 % of Radiance
+    // more than 10° from the sun.
     glm::vec3 LookUp(const glm::vec3& d) const;
+
+    // Radiance at the horizon (elevation 0) in the azimuth of the horizontal part of d, from
+    // a 1-D table: the airlight colour of distant fog.
+    glm::vec3 HorizonLookUp(const glm::vec3& d) const;
 
     // Sun disc luminance (cd/m², Rec.709 RGB): illuminance / solid angle of the disc.
     glm::dvec3 SunRadiance() const { return sunRadiance_; }
@@ -47,7 +53,8 @@ private:
     double coefY_[5], coefX_[5], coefYc_[5];
     double normY_, normX_, normYc_;
     glm::dvec3 skyHorizontal_{0.0};
-    std::vector<glm::vec3> table_;  // kTableAz × (kTableEl + 1), elevation 0 … 90°
+    std::vector<glm::vec3> table_;    // kTableSize², hemi-octahedral map of the upper hemisphere
+    std::vector<glm::vec3> horizon_;  // kHorizonSize + 1 entries around the horizon
 };
 
 }  // namespace seasense::radiometry

@@ -74,6 +74,49 @@ SurfaceSample GerstnerOcean::Evaluate(double x0, double y0, double t) const {
     return out;
 }
 
+GerstnerOcean::LocalFrame GerstnerOcean::Local(double ox, double oy, double t) const {
+    LocalFrame f;
+    for (size_t i = 0; i < k_.size(); ++i) {
+        f.dirX_.push_back(float(dirX_[i]));
+        f.dirY_.push_back(float(dirY_[i]));
+        f.k_.push_back(float(k_[i]));
+        f.amplitude_.push_back(float(amplitude_[i]));
+        f.horizontal_.push_back(float(horizontal_[i]));
+        const double phase = k_[i] * (dirX_[i] * ox + dirY_[i] * oy) - omega_[i] * t + phase_[i];
+        f.phase0_.push_back(float(std::remainder(phase, 2.0 * M_PI)));
+    }
+    return f;
+}
+
+void GerstnerOcean::LocalFrame::Evaluate(float rx, float ry, glm::vec3& position,
+                                         glm::vec3& normal, float& jacobian) const {
+    // The same sums as GerstnerOcean::Evaluate, in float.
+    float dx = 0.0f, dy = 0.0f, z = 0.0f;
+    float dxdx = 1.0f, dxdy = 0.0f, dydy = 1.0f, dzdx = 0.0f, dzdy = 0.0f;
+    const size_t n = k_.size();
+    for (size_t i = 0; i < n; ++i) {
+        const float theta = k_[i] * (dirX_[i] * rx + dirY_[i] * ry) + phase0_[i];
+        const float s = std::sin(theta), c = std::cos(theta);
+        const float h = horizontal_[i];
+        dx -= dirX_[i] * h * s;
+        dy -= dirY_[i] * h * s;
+        z += amplitude_[i] * c;
+        const float hkc = h * k_[i] * c;
+        dxdx -= dirX_[i] * dirX_[i] * hkc;
+        dxdy -= dirX_[i] * dirY_[i] * hkc;
+        dydy -= dirY_[i] * dirY_[i] * hkc;
+        const float aks = amplitude_[i] * k_[i] * s;
+        dzdx -= dirX_[i] * aks;
+        dzdy -= dirY_[i] * aks;
+    }
+    position = {rx + dx, ry + dy, z};
+    glm::vec3 nrm = glm::cross(glm::vec3(dxdx, dxdy, dzdx), glm::vec3(dxdy, dydy, dzdy));
+    const float len = glm::length(nrm);
+    nrm = len > 0.0f ? nrm / len : glm::vec3(0.0f, 0.0f, 1.0f);
+    normal = nrm.z < 0.0f ? -nrm : nrm;
+    jacobian = dxdx * dydy - dxdy * dxdy;
+}
+
 SurfaceSample GerstnerOcean::SampleAt(double x, double y, double t) const {
     // Fixed-point iteration x0 ← x0 + (x − P_h(x0)); contracts while the horizontal map is
     // not folded (|∂D/∂x0| < 1), which holds for physical steepness (k A < 1).

@@ -44,6 +44,21 @@ public:
     double HeightAt(double x, double y, double t_s) const;
     SurfaceSample SampleAt(double x, double y, double t_s) const;
 
+    // Single-precision evaluation for mesh building, relative to a local origin: the
+    // per-wave phase of the origin and of time is reduced modulo 2π in double once, so float
+    // keeps ~1e-4 rad of phase anywhere within tens of km of the origin at any time.
+    class LocalFrame {
+    public:
+        // Position (relative to the origin, m), normal and Jacobian at rest offset (rx, ry).
+        void Evaluate(float rx, float ry, glm::vec3& position, glm::vec3& normal,
+                      float& jacobian) const;
+
+    private:
+        friend class GerstnerOcean;
+        std::vector<float> dirX_, dirY_, k_, amplitude_, horizontal_, phase0_;
+    };
+    LocalFrame Local(double originX, double originY, double t_s) const;
+
     size_t WaveCount() const { return k_.size(); }
     // Largest |elevation| the waves can reach: Σ A_i (m).
     double MaxAmplitude_m() const { return maxAmplitude_m_; }

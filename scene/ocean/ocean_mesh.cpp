@@ -56,18 +56,18 @@ void BuildOceanMesh(const GerstnerOcean& ocean, const OceanMeshRequest& req, Oce
     out.positions.resize(size_t(rings) * size_t(columns));
     out.normals.resize(out.positions.size());
     out.jacobian.resize(out.positions.size());
+    const GerstnerOcean::LocalFrame local = ocean.Local(req.eye_m.x, req.eye_m.y, req.time_s);
     tbb::parallel_for(0, rings, [&](int j) {
         const double radius = radii[size_t(j)];
         const double drop = CurvatureDrop_m(radius);
         for (int i = 0; i < columns; ++i) {
             const double az = req.azimuthMin_rad + span * double(i) / double(segments);
-            const double x0 = req.eye_m.x + radius * std::sin(az);
-            const double y0 = req.eye_m.y + radius * std::cos(az);
-            const SurfaceSample s = ocean.Evaluate(x0, y0, req.time_s);
+            const float rx = float(radius * std::sin(az)), ry = float(radius * std::cos(az));
             const size_t v = size_t(j) * size_t(columns) + size_t(i);
-            out.positions[v] = glm::vec3(s.position.x, s.position.y, s.position.z - drop);
-            out.normals[v] = glm::vec3(s.normal);
-            out.jacobian[v] = float(s.jacobian);
+            glm::vec3 p;
+            local.Evaluate(rx, ry, p, out.normals[v], out.jacobian[v]);
+            out.positions[v] = glm::vec3(float(req.eye_m.x + double(p.x)),
+                                         float(req.eye_m.y + double(p.y)), float(double(p.z) - drop));
         }
     });
 

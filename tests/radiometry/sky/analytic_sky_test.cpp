@@ -52,6 +52,8 @@ TEST(AnalyticSky, TableLookupMatchesDirectEvaluationAwayFromTheSun) {
         const glm::dvec3 a = sky.Radiance(d);
         const glm::vec3 b = sky.LookUp(glm::vec3(d));
         EXPECT_NEAR(b.g, a.g, 0.01 * a.g) << "az " << az << " el " << el;
+        const glm::dvec3 h = sky.Radiance({d.x, d.y, 0.0});
+        EXPECT_NEAR(sky.HorizonLookUp(glm::vec3(d)).g, h.g, 0.01 * h.g) << "az " << az;
     }
 }
 
@@ -65,6 +67,14 @@ TEST(Fresnel, WaterReflectanceAtNormalAndGrazingIncidence) {
     const double ct = std::sqrt(1.0 - std::pow(std::sin(thetaB) / n, 2));
     const double rs = (ci - n * ct) / (ci + n * ct);
     EXPECT_NEAR(FresnelDielectric(ci, n), 0.5 * rs * rs, 1e-12);
+}
+
+TEST(Fresnel, TableFollowsTheExactFormula) {
+    const FresnelTable table(kSeaWaterIndexVisible);
+    for (int i = 0; i <= 5000; ++i) {
+        const double c = i / 5000.0;
+        EXPECT_NEAR(table(float(c)), FresnelDielectric(c, kSeaWaterIndexVisible), 2e-4) << c;
+    }
 }
 
 }  // namespace
