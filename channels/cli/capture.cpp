@@ -1,11 +1,11 @@
 // Headless capture: one channel, N frames, images plus capture.json, all written atomically.
 #include "channels/cli/capture.h"
 
-#include <algorithm>
-#include <thread>
-
-#include <nlohmann/json.hpp>
 #include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <nlohmann/json.hpp>
+#include <thread>
 
 #include "channels/cli/progress.h"
 #include "channels/pipeline/channel_pipeline.h"
@@ -19,7 +19,8 @@ namespace {
 
 std::string ChannelNames(const scene::Scenario& sc) {
     std::string names;
-    for (const scene::ChannelSettings& c : sc.channels) names += (names.empty() ? "" : ", ") + c.name;
+    for (const scene::ChannelSettings& c : sc.channels)
+        names += (names.empty() ? "" : ", ") + c.name;
     return names;
 }
 
@@ -32,8 +33,9 @@ void RunCapture(const CaptureOptions& opt) {
     if (opt.start) {
         auto t = scene::ParseIso8601(*opt.start);
         if (!t)
-            throw InputError("--start: expected ISO-8601 UTC time (e.g. 2026-06-21T18:30:00Z), found '" +
-                             *opt.start + "'");
+            throw InputError(
+                "--start: expected ISO-8601 UTC time (e.g. 2026-06-21T18:30:00Z), found '" +
+                *opt.start + "'");
         scenario.world.start = *t;
     }
     const scene::ChannelSettings* ch = scenario.FindChannel(opt.channel);
@@ -42,18 +44,22 @@ void RunCapture(const CaptureOptions& opt) {
                          "' (channels: " + ChannelNames(scenario) + ")");
     std::vector<std::string> formats = opt.formats.empty() ? ch->formats : opt.formats;
     for (std::string& f : formats) {
-        std::transform(f.begin(), f.end(), f.begin(), [](unsigned char c) { return std::tolower(c); });
+        std::transform(f.begin(), f.end(), f.begin(),
+                       [](unsigned char c) { return std::tolower(c); });
         if (f == "tif") f = "tiff";
         if (f != "exr" && f != "png" && f != "tiff")
-            throw InputError("--format: expected a comma-separated subset of exr, png, tiff; found '" + f + "'");
+            throw InputError(
+                "--format: expected a comma-separated subset of exr, png, tiff; found '" + f + "'");
     }
 
-    const int threads = opt.threads > 0 ? opt.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+    const int threads =
+        opt.threads > 0 ? opt.threads : int(std::max(1u, std::thread::hardware_concurrency()));
     tbb::task_arena arena(threads);
     const scene::World world(scenario);
     std::unique_ptr<ChannelPipeline> pipeline;
     arena.execute([&] {
-        pipeline = std::make_unique<ChannelPipeline>(world, *ch, opt.out, formats, DefaultOcioConfig());
+        pipeline =
+            std::make_unique<ChannelPipeline>(world, *ch, opt.out, formats, DefaultOcioConfig());
     });
 
     nlohmann::json doc;

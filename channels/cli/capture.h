@@ -14,10 +14,10 @@ struct CaptureOptions {
     std::string channel;
     int64_t frames = 1;
     int64_t firstFrame = 0;
-    std::optional<std::string> start;     // ISO-8601 UTC; overrides world.start_utc
+    std::optional<std::string> start;  // ISO-8601 UTC; overrides world.start_utc
     std::filesystem::path out = "out";
-    std::vector<std::string> formats;     // overrides the channel's output formats if non-empty
-    int threads = 0;                      // 0: all cores
+    std::vector<std::string> formats;  // overrides the channel's output formats if non-empty
+    int threads = 0;                   // 0: all cores
 };
 
 // Writes DIR/<channel>/<channel>_<frame:06d>.<ext> and DIR/<channel>/capture.json.

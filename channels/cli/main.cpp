@@ -1,9 +1,8 @@
 // The seasense command line: subcommands, and the one place errors become exit statuses.
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
 #include <string>
-
-#include <CLI/CLI.hpp>
 
 #include "channels/cli/capture.h"
 #include "scene/core/check.h"
@@ -16,7 +15,8 @@ std::vector<std::string> SplitCommas(const std::string& s) {
     size_t start = 0;
     while (start <= s.size()) {
         const size_t comma = s.find(',', start);
-        const std::string item = s.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+        const std::string item =
+            s.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
         if (!item.empty()) out.push_back(item);
         if (comma == std::string::npos) break;
         start = comma + 1;
@@ -51,7 +51,8 @@ int main(int argc, char** argv) {
         ->check(CLI::NonNegativeNumber);
     capture->add_option("--start", cap.start,
                         "Simulation start, ISO-8601 UTC (overrides world.start_utc)");
-    capture->add_option("--out", cap.out, "Output folder (created if missing)")->capture_default_str();
+    capture->add_option("--out", cap.out, "Output folder (created if missing)")
+        ->capture_default_str();
     capture->add_option("--format", formats,
                         "Comma-separated output formats: exr (scene-linear float), png, tiff "
                         "(display 8-bit); default: the channel's output.formats");

@@ -8,7 +8,9 @@
 namespace seasense::channels {
 
 Progress::Progress(int64_t total, std::string label)
-    : total_(total), label_(std::move(label)), tty_(isatty(STDERR_FILENO) == 1),
+    : total_(total),
+      label_(std::move(label)),
+      tty_(isatty(STDERR_FILENO) == 1),
       start_(std::chrono::steady_clock::now()) {}
 
 Progress::~Progress() {

@@ -8,7 +8,7 @@
 namespace seasense::channels {
 
 class Progress {
-public:
+  public:
     // total: number of steps; label: what is counted ("frames").
     Progress(int64_t total, std::string label);
     ~Progress();
@@ -16,7 +16,7 @@ public:
     void Update(int64_t done);
     void Finish();
 
-private:
+  private:
     int64_t total_;
     std::string label_;
     bool tty_;

@@ -2,11 +2,11 @@
 // on the sea; Lambertian models lit by sun (shadowed) and sky; Koschmieder fog.
 #include "channels/otw/otw_channel.h"
 
-#include <algorithm>
-#include <cmath>
-
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
 
 #include "radiometry/sky/analytic_sky.h"
 #include "radiometry/surface/fresnel.h"
@@ -51,10 +51,18 @@ void FrustumAzimuthSector(const ChannelCamera& cam, double margin, double& lo, d
             const double s = double(i) / steps;
             double u = 0, v = 0;
             switch (e) {
-                case 0: u = s, v = 0; break;
-                case 1: u = 1, v = s; break;
-                case 2: u = 1 - s, v = 1; break;
-                default: u = 0, v = 1 - s; break;
+                case 0:
+                    u = s, v = 0;
+                    break;
+                case 1:
+                    u = 1, v = s;
+                    break;
+                case 2:
+                    u = 1 - s, v = 1;
+                    break;
+                default:
+                    u = 0, v = 1 - s;
+                    break;
             }
             const glm::dvec3 d =
                 cam.SampleDirection(u * cam.SampleWidth() - 0.5, v * cam.SampleHeight() - 0.5);
@@ -106,7 +114,8 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     std::vector<RasterMesh> meshes;
     // The sea is seen from both sides only when a camera dips below it; cull back faces.
     meshes.push_back({ocean_.positions, ocean_.indices, true});
-    for (const scene::TriangleMesh& m : worldMeshes_) meshes.push_back({m.positions, m.indices, true});
+    for (const scene::TriangleMesh& m : worldMeshes_)
+        meshes.push_back({m.positions, m.indices, true});
     rasterizer_.Render(meshes, cam.Raster(), vis_);
 
     stats_ = {};
@@ -115,8 +124,8 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     for (const scene::TriangleMesh& m : worldMeshes_) stats_.modelTriangles += m.TriangleCount();
 
     if (!sky_ || skySun_ != state.sun.direction || skySunLux_ != state.sun.illuminance_lux) {
-        sky_ = std::make_unique<radiometry::AnalyticSky>(state.sun.direction,
-                                                         state.sun.illuminance_lux, env.sky.turbidity);
+        sky_ = std::make_unique<radiometry::AnalyticSky>(
+            state.sun.direction, state.sun.illuminance_lux, env.sky.turbidity);
         skySun_ = state.sun.direction;
         skySunLux_ = state.sun.illuminance_lux;
     }
@@ -178,12 +187,16 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
             const uint32_t prim = vis_.primitive[idx];
             if (prim == kNoPrimitive) continue;
             int mesh = 0;
-            while (mesh + 1 < int(vis_.primitiveBase.size()) && prim >= vis_.primitiveBase[size_t(mesh) + 1])
+            while (mesh + 1 < int(vis_.primitiveBase.size()) &&
+                   prim >= vis_.primitiveBase[size_t(mesh) + 1])
                 ++mesh;
             const uint32_t tri = prim - vis_.primitiveBase[size_t(mesh)];
-            const std::vector<glm::vec3>& P = mesh == 0 ? ocean_.positions : worldMeshes_[size_t(mesh) - 1].positions;
-            const std::vector<glm::vec3>& N = mesh == 0 ? ocean_.normals : worldMeshes_[size_t(mesh) - 1].normals;
-            const std::vector<uint32_t>& I = mesh == 0 ? ocean_.indices : worldMeshes_[size_t(mesh) - 1].indices;
+            const std::vector<glm::vec3>& P =
+                mesh == 0 ? ocean_.positions : worldMeshes_[size_t(mesh) - 1].positions;
+            const std::vector<glm::vec3>& N =
+                mesh == 0 ? ocean_.normals : worldMeshes_[size_t(mesh) - 1].normals;
+            const std::vector<uint32_t>& I =
+                mesh == 0 ? ocean_.indices : worldMeshes_[size_t(mesh) - 1].indices;
             const uint32_t i0 = I[3 * tri], i1 = I[3 * tri + 1], i2 = I[3 * tri + 2];
             const float b1 = vis_.b1[idx], b2 = vis_.b2[idx], b0 = 1.0f - b1 - b2;
             position[k] = b0 * P[i0] + b1 * P[i1] + b2 * P[i2];
@@ -229,7 +242,8 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
                 if (meshOf[k] == 0) {
                     const float cosV = std::max(glm::dot(nrm, v), 1e-3f);
                     glm::vec3 r = 2.0f * glm::dot(nrm, v) * nrm - v;
-                    if (r.z < 0.0f) r.z = -r.z;  // a ray reflected into the sea meets the next wave's sky
+                    if (r.z < 0.0f)
+                        r.z = -r.z;  // a ray reflected into the sea meets the next wave's sky
                     const float F = fresnel(cosV);
                     L = F * sky.LookUp(r) + (1.0f - F) * kSeaRrs * downwelling;
                     // Cox–Munk glint: L = E_sun ρ(ω) p(β) / (4 cos θ_v cos⁴ β) (Cox & Munk

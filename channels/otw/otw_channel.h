@@ -24,7 +24,7 @@ struct OtwFrameStats {
 };
 
 class OtwChannel {
-public:
+  public:
     // Builds the occlusion scene from the world's models (committed once; static).
     OtwChannel(const scene::World& world, const scene::ChannelSettings& settings);
 
@@ -36,7 +36,7 @@ public:
     const OtwFrameStats& Stats() const { return stats_; }
     const ChannelCamera& Camera() const { return camera_; }
 
-private:
+  private:
     const scene::World& world_;
     scene::ChannelSettings settings_;
     ChannelCamera camera_;

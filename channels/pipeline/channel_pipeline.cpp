@@ -24,9 +24,12 @@ double MsSince(std::chrono::steady_clock::time_point t0) {
 
 const char* KindName(scene::ChannelKind k) {
     switch (k) {
-        case scene::ChannelKind::Otw: return "otw";
-        case scene::ChannelKind::Flir: return "flir";
-        case scene::ChannelKind::Nvg: return "nvg";
+        case scene::ChannelKind::Otw:
+            return "otw";
+        case scene::ChannelKind::Flir:
+            return "flir";
+        case scene::ChannelKind::Nvg:
+            return "nvg";
     }
     return "?";
 }
@@ -52,12 +55,15 @@ sensors::ImageMetadata FrameMetadata(const scene::World& world, const scene::Cha
     md.Set("seasense:scenario_hash", sc.hash);
     md.Set("seasense:seed", std::to_string(sc.world.seed));
     const glm::dvec3 eye = state.eyepoint.position_m;
-    md.Set("seasense:eyepoint_position_m", sensors::Vector3f{{float(eye.x), float(eye.y), float(eye.z)}});
+    md.Set("seasense:eyepoint_position_m",
+           sensors::Vector3f{{float(eye.x), float(eye.y), float(eye.z)}});
     const glm::dvec3 cp = cam.worldFromCamera.position_m;
-    md.Set("seasense:camera_position_m", sensors::Vector3f{{float(cp.x), float(cp.y), float(cp.z)}});
+    md.Set("seasense:camera_position_m",
+           sensors::Vector3f{{float(cp.x), float(cp.y), float(cp.z)}});
     sensors::Matrix33f rot;
     for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) rot.m[size_t(r * 3 + c)] = float(cam.worldFromCamera.worldFromBody[c][r]);
+        for (int c = 0; c < 3; ++c)
+            rot.m[size_t(r * 3 + c)] = float(cam.worldFromCamera.worldFromBody[c][r]);
     md.Set("seasense:world_from_camera_rotation", rot);
     md.Set("seasense:frame", std::string("world ENU (x east, y north, z up), origin lat ") +
                                  std::to_string(sc.world.latitude_deg) + " lon " +
@@ -89,7 +95,9 @@ std::filesystem::path DefaultOcioConfig() {
 ChannelPipeline::ChannelPipeline(const scene::World& world, const scene::ChannelSettings& channel,
                                  std::filesystem::path outDir, std::vector<std::string> formats,
                                  const std::filesystem::path& ocioConfig)
-    : world_(world), channel_(channel), channelDir_(std::move(outDir) / channel.name),
+    : world_(world),
+      channel_(channel),
+      channelDir_(std::move(outDir) / channel.name),
       formats_(std::move(formats)) {
     if (channel_.kind != scene::ChannelKind::Otw)
         throw InputError("channel '" + channel_.name + "': kind '" + KindName(channel_.kind) +

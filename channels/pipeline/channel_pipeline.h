@@ -25,7 +25,7 @@ struct FrameRecord {
 };
 
 class ChannelPipeline {
-public:
+  public:
     // outDir: files go to outDir/<channel>/. formats ⊂ {exr, png, tiff}. ocioConfig: path of
     // the OCIO config for visible channels. Throws InputError for an unsupported channel kind.
     ChannelPipeline(const scene::World& world, const scene::ChannelSettings& channel,
@@ -38,7 +38,7 @@ public:
     const std::filesystem::path& ChannelDir() const { return channelDir_; }
     const OtwChannel& Otw() const { return *otw_; }
 
-private:
+  private:
     const scene::World& world_;
     scene::ChannelSettings channel_;
     std::filesystem::path channelDir_;

@@ -3,14 +3,19 @@
 #pragma once
 
 #include <cstdint>
+#include <glm/glm.hpp>
+#include <memory>
 #include <span>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 namespace seasense::channels {
 
 inline constexpr uint32_t kNoPrimitive = 0xffffffffu;
+
+// Largest sample grid side the rasterizer accepts: it keeps fixed-point vertex coordinates,
+// after guard-band clipping, inside ±2^27 (8 sub-sample bits), so edge functions are exact
+// in 64-bit integers.
+inline constexpr int kMaxRasterSamplesPerAxis = 32768;
 
 // One triangle mesh to draw. Positions are in the frame that RasterCamera::clipFromWorld
 // maps from (world ENU metres, or any frame the caller chooses consistently).
@@ -26,18 +31,19 @@ struct RasterMesh {
 //   x_ndc = x/w ∈ [-1, 1] left→right; y_ndc = y/w ∈ [-1, 1] bottom→top.
 // Sample (i, j) of a width×height sample grid has its centre at NDC
 //   x = (2(i + 0.5) / width) - 1, y = 1 - (2(j + 0.5) / height)   (row 0 at the top).
-// Geometry with w < near_m is clipped away.
+// Geometry with w < near_m is clipped away. clip.z is not used.
 struct RasterCamera {
     glm::mat4 clipFromWorld{1.0f};
     float near_m = 0.25f;
-    int width = 0;   // samples (pixels × supersampling)
+    int width = 0;  // samples (pixels × supersampling), 1 … kMaxRasterSamplesPerAxis
     int height = 0;
 };
 
 // Per-sample visibility. depth = near_m / w (1 at the near plane, → 0 far away, 0 = empty).
 // primitive = global triangle id: mesh m's triangle t is primitiveBase[m] + t.
 // b1, b2 are the perspective-correct barycentric weights of the triangle's second and third
-// vertex (indices[3t+1], indices[3t+2]); the first vertex's weight is 1 - b1 - b2.
+// vertex (indices[3t+1], indices[3t+2]); the first vertex's weight is 1 - b1 - b2. They refer
+// to the original triangle also where it was clipped. Empty samples have b1 = b2 = 0.
 struct VisibilityBuffer {
     int width = 0;
     int height = 0;
@@ -51,28 +57,53 @@ struct VisibilityBuffer {
 };
 
 struct RasterStats {
-    uint64_t trianglesIn = 0;       // triangles submitted
-    uint64_t trianglesCulled = 0;   // back-facing, degenerate or outside the frustum
+    uint64_t trianglesIn = 0;  // triangles submitted
+    // Back-facing, degenerate, outside the frustum, or covering no sample centre's
+    // bounding box (nothing reached binning).
+    uint64_t trianglesCulled = 0;
     uint64_t trianglesClipped = 0;  // triangles that crossed the near plane or guard band
     uint64_t trianglesSetUp = 0;    // screen triangles after clipping that reached binning
 };
 
+// Coverage rule: a sample belongs to a triangle when its centre is inside the triangle with
+// vertices snapped to 1/256 sample; centres exactly on an edge belong to the triangle for
+// which that edge is a top edge (horizontal, triangle below it on screen) or a left edge
+// (triangle to its right), as in Direct3D's top-left rule. Meshes whose triangles share
+// edges (same vertex positions) therefore cover every sample exactly once, also across
+// near-plane and guard-band clipping.
+//
+// One Rasterizer keeps scratch memory between calls; call it from one thread at a time.
 class Rasterizer {
-public:
-    // tileSize in samples (square tiles).
+  public:
+    // tileSize in samples (square tiles): a power of two in [8, 1024], else InputError.
     explicit Rasterizer(int tileSize = 64);
+    ~Rasterizer();
+    Rasterizer(Rasterizer&&) noexcept;
+    Rasterizer& operator=(Rasterizer&&) noexcept;
 
     // Draws all meshes into out (resized and cleared to empty). Runs in the caller's
     // oneTBB task arena; the result does not depend on the number of threads: the depth
     // test keeps the nearer sample and, at equal depth, the lower primitive id.
+    // Throws InputError for a bad camera, non-finite positions or bad indices.
     void Render(std::span<const RasterMesh> meshes, const RasterCamera& camera,
                 VisibilityBuffer& out);
 
+    // Diagnostic for watertightness: the same clipping, set-up and coverage as Render, but
+    // hits[Index(x, y)] counts every screen triangle covering the sample (no depth test).
+    // hits is resized to width×height.
+    void RenderCoverageCount(std::span<const RasterMesh> meshes, const RasterCamera& camera,
+                             std::vector<uint32_t>& hits);
+
     const RasterStats& Stats() const { return stats_; }
 
-private:
+  private:
+    struct Scratch;
+    void Prepare(std::span<const RasterMesh> meshes, const RasterCamera& camera);
+
     int tileSize_;
+    int tileShift_;
     RasterStats stats_;
+    std::unique_ptr<Scratch> scratch_;
 };
 
 }  // namespace seasense::channels

@@ -82,8 +82,10 @@ AnalyticSky::AnalyticSky(const glm::dvec3& sunDirection, double sunIlluminance_l
     table_.resize(size_t(kTableSize) * size_t(kTableSize));
     for (int j = 0; j < kTableSize; ++j) {
         for (int i = 0; i < kTableSize; ++i) {
-            const double a = -1.0 + 2.0 * i / (kTableSize - 1), b = -1.0 + 2.0 * j / (kTableSize - 1);
-            table_[size_t(j) * kTableSize + size_t(i)] = glm::vec3(Radiance(DirectionFromHemiOct(a, b)));
+            const double a = -1.0 + 2.0 * i / (kTableSize - 1),
+                         b = -1.0 + 2.0 * j / (kTableSize - 1);
+            table_[size_t(j) * kTableSize + size_t(i)] =
+                glm::vec3(Radiance(DirectionFromHemiOct(a, b)));
         }
     }
 
@@ -113,7 +115,8 @@ double AnalyticSky::Perez(const double c[5], double cosTheta, double gamma) cons
     // F(θ, γ) = (1 + A e^{B / cos θ}) (1 + C e^{D γ} + E cos² γ) (Perez, Seals & Michalsky 1993).
     cosTheta = std::max(cosTheta, 0.01);
     const double cg = std::cos(gamma);
-    return (1.0 + c[0] * std::exp(c[1] / cosTheta)) * (1.0 + c[2] * std::exp(c[3] * gamma) + c[4] * cg * cg);
+    return (1.0 + c[0] * std::exp(c[1] / cosTheta)) *
+           (1.0 + c[2] * std::exp(c[3] * gamma) + c[4] * cg * cg);
 }
 
 glm::dvec3 AnalyticSky::Radiance(const glm::dvec3& dIn) const {

@@ -2,9 +2,8 @@
 // luminance units (cd/m²), with the sun disc and a direction table for per-sample lookups.
 #pragma once
 
-#include <vector>
-
 #include <glm/glm.hpp>
+#include <vector>
 
 namespace seasense::radiometry {
 
@@ -13,7 +12,7 @@ namespace seasense::radiometry {
 inline constexpr double kSunAngularRadius_rad = 4.6526e-3;
 
 class AnalyticSky {
-public:
+  public:
     // sunDirection: unit ENU vector toward the sun. sunIlluminance_lux: illuminance on a
     // plane normal to the sun. turbidity: Preetham's T (clear 2, hazy 6+). The sky's own
     // luminance comes from Preetham's zenith-luminance fit; it is valid for sun elevations
@@ -42,7 +41,7 @@ public:
     // numerical integration of L·cosθ over the hemisphere.
     glm::dvec3 HorizontalSkyIlluminance() const { return skyHorizontal_; }
 
-private:
+  private:
     double Perez(const double coeffs[5], double cosTheta, double gamma) const;
 
     glm::dvec3 sunDir_;

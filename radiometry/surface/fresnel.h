@@ -21,7 +21,7 @@ inline double FresnelDielectric(double cosI, double n) {
 // FresnelDielectric tabulated over cos θ ∈ [0, 1] for per-sample use: linear interpolation
 // on 1024 intervals, absolute error < 2e-4 (checked in tests against the exact formula).
 class FresnelTable {
-public:
+  public:
     explicit FresnelTable(double n) {
         for (int i = 0; i <= kSize; ++i) table_[i] = float(FresnelDielectric(double(i) / kSize, n));
     }
@@ -31,7 +31,7 @@ public:
         return table_[i] + (table_[i + 1] - table_[i]) * (u - float(i));
     }
 
-private:
+  private:
     static constexpr int kSize = 1024;
     float table_[kSize + 1];
 };

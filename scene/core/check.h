@@ -9,7 +9,7 @@ namespace seasense {
 
 // Thrown when an internal invariant fails. The CLI reports it and exits with status 1.
 class InternalError : public std::logic_error {
-public:
+  public:
     using std::logic_error::logic_error;
 };
 
@@ -26,15 +26,15 @@ namespace detail {
 }  // namespace seasense
 
 // CHECK(cond) and CHECK_MSG(cond, streamable) stay on in Release builds.
-#define CHECK(cond)                                                                        \
-    do {                                                                                   \
-        if (!(cond)) ::seasense::detail::CheckFailed(#cond, __FILE__, __LINE__, {});        \
+#define CHECK(cond)                                                                  \
+    do {                                                                             \
+        if (!(cond)) ::seasense::detail::CheckFailed(#cond, __FILE__, __LINE__, {}); \
     } while (0)
-#define CHECK_MSG(cond, msg)                                                              \
-    do {                                                                                  \
-        if (!(cond)) {                                                                    \
-            std::ostringstream checkStream_;                                              \
-            checkStream_ << msg;                                                          \
+#define CHECK_MSG(cond, msg)                                                                \
+    do {                                                                                    \
+        if (!(cond)) {                                                                      \
+            std::ostringstream checkStream_;                                                \
+            checkStream_ << msg;                                                            \
             ::seasense::detail::CheckFailed(#cond, __FILE__, __LINE__, checkStream_.str()); \
-        }                                                                                 \
+        }                                                                                   \
     } while (0)

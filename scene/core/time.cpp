@@ -118,7 +118,8 @@ std::optional<UtcTime> ParseIso8601(std::string_view s) {
 
 std::string FormatIso8601(UtcTime t) {
     int64_t ns = t.unixNs;
-    int64_t days = ns >= 0 ? ns / 86400000000000LL : -((-ns + 86400000000000LL - 1) / 86400000000000LL);
+    int64_t days =
+        ns >= 0 ? ns / 86400000000000LL : -((-ns + 86400000000000LL - 1) / 86400000000000LL);
     int64_t rem = ns - days * 86400000000000LL;
     int64_t y;
     unsigned m, d;

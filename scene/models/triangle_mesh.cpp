@@ -1,9 +1,10 @@
 // Model loading with assimp (OBJ, glTF 2.0 and whatever else assimp reads) into body frames.
 #include "scene/models/triangle_mesh.h"
 
-#include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+
+#include <assimp/Importer.hpp>
 
 #include "scene/core/error.h"
 
@@ -13,10 +14,10 @@ TriangleMesh LoadModel(const std::filesystem::path& file, double scale) {
     Assimp::Importer importer;
     // PreTransformVertices flattens the node hierarchy into mesh space; GenNormals adds flat
     // normals only where the file has none, so authored smoothing is kept.
-    const aiScene* s = importer.ReadFile(
-        file.string(), aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                           aiProcess_PreTransformVertices | aiProcess_GenNormals |
-                           aiProcess_SortByPType | aiProcess_FindInvalidData);
+    const aiScene* s =
+        importer.ReadFile(file.string(), aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                             aiProcess_PreTransformVertices | aiProcess_GenNormals |
+                                             aiProcess_SortByPType | aiProcess_FindInvalidData);
     if (!s || (s->mFlags & AI_SCENE_FLAGS_INCOMPLETE) || s->mNumMeshes == 0) {
         throw InputError(file.string() + ": cannot load model: " +
                          (s ? std::string("no meshes in file") : importer.GetErrorString()));

@@ -3,9 +3,8 @@
 
 #include <cstdint>
 #include <filesystem>
-#include <vector>
-
 #include <glm/glm.hpp>
+#include <vector>
 
 #include "scene/core/frames.h"
 

@@ -88,8 +88,8 @@ GerstnerOcean::LocalFrame GerstnerOcean::Local(double ox, double oy, double t) c
     return f;
 }
 
-void GerstnerOcean::LocalFrame::Evaluate(float rx, float ry, glm::vec3& position,
-                                         glm::vec3& normal, float& jacobian) const {
+void GerstnerOcean::LocalFrame::Evaluate(float rx, float ry, glm::vec3& position, glm::vec3& normal,
+                                         float& jacobian) const {
     // The same sums as GerstnerOcean::Evaluate, in float.
     float dx = 0.0f, dy = 0.0f, z = 0.0f;
     float dxdx = 1.0f, dxdy = 0.0f, dydy = 1.0f, dzdx = 0.0f, dzdy = 0.0f;

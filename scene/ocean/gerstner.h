@@ -2,9 +2,8 @@
 // height queries, with finite-depth dispersion ω² = g k tanh(k h).
 #pragma once
 
-#include <vector>
-
 #include <glm/glm.hpp>
+#include <vector>
 
 #include "scene/scenario/scenario.h"
 
@@ -31,7 +30,7 @@ struct SurfaceSample {
 
 // Precomputed per-wave constants, structure of arrays for the hot loops.
 class GerstnerOcean {
-public:
+  public:
     GerstnerOcean() = default;
     explicit GerstnerOcean(const OceanSettings& settings);
 
@@ -48,12 +47,12 @@ public:
     // per-wave phase of the origin and of time is reduced modulo 2π in double once, so float
     // keeps ~1e-4 rad of phase anywhere within tens of km of the origin at any time.
     class LocalFrame {
-    public:
+      public:
         // Position (relative to the origin, m), normal and Jacobian at rest offset (rx, ry).
         void Evaluate(float rx, float ry, glm::vec3& position, glm::vec3& normal,
                       float& jacobian) const;
 
-    private:
+      private:
         friend class GerstnerOcean;
         std::vector<float> dirX_, dirY_, k_, amplitude_, horizontal_, phase0_;
     };
@@ -65,7 +64,7 @@ public:
     // Shortest wavelength among the waves (m), for mesh resolution choices.
     double MinWavelength_m() const { return minWavelength_m_; }
 
-private:
+  private:
     std::vector<double> dirX_, dirY_;  // unit direction of travel (east, north)
     std::vector<double> k_;            // wavenumber, rad/m
     std::vector<double> omega_;        // angular frequency, rad/s

@@ -2,10 +2,10 @@
 // screen-uniform vertex density from the eye to the horizon with one crack-free mesh.
 #include "scene/ocean/ocean_mesh.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
-
-#include <tbb/parallel_for.h>
 
 #include "scene/core/check.h"
 
@@ -66,8 +66,9 @@ void BuildOceanMesh(const GerstnerOcean& ocean, const OceanMeshRequest& req, Oce
             const size_t v = size_t(j) * size_t(columns) + size_t(i);
             glm::vec3 p;
             local.Evaluate(rx, ry, p, out.normals[v], out.jacobian[v]);
-            out.positions[v] = glm::vec3(float(req.eye_m.x + double(p.x)),
-                                         float(req.eye_m.y + double(p.y)), float(double(p.z) - drop));
+            out.positions[v] =
+                glm::vec3(float(req.eye_m.x + double(p.x)), float(req.eye_m.y + double(p.y)),
+                          float(double(p.z) - drop));
         }
     });
 
@@ -77,7 +78,8 @@ void BuildOceanMesh(const GerstnerOcean& ocean, const OceanMeshRequest& req, Oce
         for (int i = 0; i < segments; ++i) {
             const int i1 = full ? (i + 1) % segments : i + 1;
             const uint32_t a = uint32_t(j * columns + i), b = uint32_t(j * columns + i1);
-            const uint32_t c = uint32_t((j + 1) * columns + i), d = uint32_t((j + 1) * columns + i1);
+            const uint32_t c = uint32_t((j + 1) * columns + i),
+                           d = uint32_t((j + 1) * columns + i1);
             // Azimuth increases clockwise seen from above and radius outward, so (a, b, c)
             // and (b, d, c) are counter-clockwise seen from above.
             out.indices.insert(out.indices.end(), {a, b, c, b, d, c});

@@ -3,11 +3,10 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <glm/glm.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 #include "scene/core/time.h"
 
@@ -22,7 +21,7 @@ struct Attitude {
 };
 
 struct WorldSettings {
-    double latitude_deg = 0.0;   // origin of the local ENU frame
+    double latitude_deg = 0.0;  // origin of the local ENU frame
     double longitude_deg = 0.0;
     UtcTime start;               // simulation time of frame 0
     double timeScale = 1.0;      // simulated seconds per real second
@@ -32,8 +31,8 @@ struct WorldSettings {
 
 // A directional sun set by the user (the ephemeris issue adds the real sun).
 struct SunSettings {
-    double azimuth_rad = 0.0;    // from true north, clockwise
-    double elevation_rad = 0.5;  // above the horizon
+    double azimuth_rad = 0.0;        // from true north, clockwise
+    double elevation_rad = 0.5;      // above the horizon
     double illuminance_lux = 1.0e5;  // on a surface normal to the sun, above the atmosphere path
 };
 
@@ -45,7 +44,7 @@ struct GerstnerWaveSettings {
     double direction_rad = 0.0;  // direction of travel, azimuth from north clockwise
     double wavelength_m = 10.0;
     double amplitude_m = 0.1;
-    double steepness = 0.5;      // Q in [0, 1]: horizontal orbit / linear theory (1: trochoid)
+    double steepness = 0.5;  // Q in [0, 1]: horizontal orbit / linear theory (1: trochoid)
     double phase_rad = 0.0;
 };
 
@@ -57,8 +56,8 @@ struct OceanSettings {
 struct EnvironmentSettings {
     SunSettings sun;
     SkySettings sky;
-    double visibility_m = 20000.0;  // meteorological optical range (Koschmieder, 2 % contrast)
-    double windSpeed_mps = 5.0;     // at 10 m
+    double visibility_m = 20000.0;   // meteorological optical range (Koschmieder, 2 % contrast)
+    double windSpeed_mps = 5.0;      // at 10 m
     double windDirection_rad = 0.0;  // direction the wind blows toward, from north clockwise
     OceanSettings ocean;
 };
@@ -96,9 +95,9 @@ struct ChannelSettings {
     int width = 640;
     int height = 480;
     double hfov_rad = 1.0471975511965976;  // 60°
-    glm::dvec3 offset_m{0.0};               // position relative to the eyepoint, eyepoint frame
-    Attitude attitude;                      // relative to the eyepoint
-    int supersampling = 2;                  // N: N×N samples per pixel
+    glm::dvec3 offset_m{0.0};              // position relative to the eyepoint, eyepoint frame
+    Attitude attitude;                     // relative to the eyepoint
+    int supersampling = 2;                 // N: N×N samples per pixel
     double near_m = 0.25;
     bool shadows = true;
     std::vector<std::string> formats{"exr", "png"};

@@ -93,10 +93,10 @@ GerstnerWaveSettings ReadWave(const ConfigValue& value) {
         // so A ≤ 0.071 λ; steeper input would also fold the Gerstner surface into loops.
         const double maxAmplitude = 0.071 * wave.wavelength_m;
         if (wave.amplitude_m > maxAmplitude)
-            w.Require("amplitude_m", "").Fail(
-                "a number (m) <= 0.071 × wavelength_m = " + FormatNumber(maxAmplitude) +
-                    " (Stokes limiting steepness H/λ = 0.142)",
-                FormatNumber(wave.amplitude_m));
+            w.Require("amplitude_m", "")
+                .Fail("a number (m) <= 0.071 × wavelength_m = " + FormatNumber(maxAmplitude) +
+                          " (Stokes limiting steepness H/λ = 0.142)",
+                      FormatNumber(wave.amplitude_m));
         wave.steepness = w.GetDouble("steepness", NumberRange::Closed(0, 1));
         wave.phase_rad = Degrees(w, "phase_deg", NumberRange::Any("deg"), 0.0);
     });

@@ -40,7 +40,7 @@ struct SceneState {
 };
 
 class World {
-public:
+  public:
     // Loads every model the scenario names (InputError on failure).
     explicit World(const Scenario& scenario);
 
@@ -50,7 +50,7 @@ public:
     const Scenario& GetScenario() const { return scenario_; }
     const GerstnerOcean& Ocean() const { return ocean_; }
 
-private:
+  private:
     Scenario scenario_;
     GerstnerOcean ocean_;
     std::vector<std::shared_ptr<const TriangleMesh>> models_;  // one per entity

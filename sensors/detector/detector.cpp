@@ -1,10 +1,10 @@
 // Box-footprint detector integration and log-average auto exposure.
 #include "sensors/detector/detector.h"
 
+#include <tbb/parallel_for.h>
+
 #include <cmath>
 #include <vector>
-
-#include <tbb/parallel_for.h>
 
 #include "radiometry/color/rec709.h"
 

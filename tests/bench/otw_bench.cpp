@@ -38,8 +38,8 @@ void BM_OtwFrame(benchmark::State& state) {
         });
     }
     const double samples = double(ch.width) * ch.height * ch.supersampling * ch.supersampling;
-    state.counters["Msamples/s"] =
-        benchmark::Counter(samples * 1e-6 * double(state.iterations()), benchmark::Counter::kIsRate);
+    state.counters["Msamples/s"] = benchmark::Counter(samples * 1e-6 * double(state.iterations()),
+                                                      benchmark::Counter::kIsRate);
     state.counters["triangles"] = double(otw->Stats().oceanTriangles + otw->Stats().modelTriangles);
     state.counters["shadow_rays"] = double(otw->Stats().shadowRays);
 }
@@ -68,7 +68,12 @@ void BM_OceanMesh(benchmark::State& state) {
     }
     state.counters["vertices"] = double(mesh.positions.size());
 }
-BENCHMARK(BM_OceanMesh)->ArgName("threads")->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_OceanMesh)
+    ->ArgName("threads")
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 }  // namespace seasense::channels

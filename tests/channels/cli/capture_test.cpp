@@ -1,18 +1,17 @@
 // End-to-end tests of `seasense capture`: outputs, metadata, OCIO agreement, determinism,
 // exit statuses and atomic output.
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
-
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 namespace fs = std::filesystem;
 
@@ -41,8 +40,8 @@ Result Shell(const std::string& command) {
 std::string Seasense() { return std::string(SEASENSE_BINARY); }
 
 fs::path TempDir(const std::string& name) {
-    fs::path d = fs::temp_directory_path() / ("seasense_capture_test_" + name + "_" +
-                                              std::to_string(::getpid()));
+    fs::path d = fs::temp_directory_path() /
+                 ("seasense_capture_test_" + name + "_" + std::to_string(::getpid()));
     fs::remove_all(d);
     fs::create_directories(d);
     return d;
@@ -56,8 +55,8 @@ std::string ReadBytes(const fs::path& p) {
 }
 
 Result Capture(const fs::path& out, const std::string& extra) {
-    return Shell(Seasense() + " capture --config " + kScenario.string() + " --channel small --out " +
-               out.string() + " " + extra);
+    return Shell(Seasense() + " capture --config " + kScenario.string() +
+                 " --channel small --out " + out.string() + " " + extra);
 }
 
 TEST(Capture, WritesImagesAndCaptureJson) {
@@ -86,10 +85,10 @@ TEST(Capture, MetadataIsVisibleToOiiotool) {
     ASSERT_EQ(Capture(out, "--frames 1 --format exr").status, 0);
     const Result info = Shell("oiiotool --info -v " + (out / "small/small_000000.exr").string());
     ASSERT_EQ(info.status, 0) << info.output;
-    for (const char* key : {"seasense:channel", "seasense:kind", "seasense:frame_index",
-                            "seasense:time_utc", "seasense:exposure_ev", "seasense:hfov_deg",
-                            "seasense:camera_position_m", "seasense:eyepoint_position_m",
-                            "seasense:units", "seasense:camera_from_world"})
+    for (const char* key :
+         {"seasense:channel", "seasense:kind", "seasense:frame_index", "seasense:time_utc",
+          "seasense:exposure_ev", "seasense:hfov_deg", "seasense:camera_position_m",
+          "seasense:eyepoint_position_m", "seasense:units", "seasense:camera_from_world"})
         EXPECT_NE(info.output.find(key), std::string::npos) << key << "\n" << info.output;
     EXPECT_NE(info.output.find("2026-06-21T20:00:00.000Z"), std::string::npos);
     EXPECT_NE(info.output.find("cd/m^2"), std::string::npos);
@@ -107,11 +106,12 @@ TEST(Capture, PngEqualsOcioconvertOfTheExposedExr) {
     const fs::path scaled = out / "scaled.exr", viaOcio = out / "ocioconvert.png";
     char mul[64];
     std::snprintf(mul, sizeof mul, "%.9g", std::exp2(double(ev)));
-    Result r = Shell("oiiotool " + exr.string() + " --mulc " + mul + " -d float -o " + scaled.string());
+    Result r =
+        Shell("oiiotool " + exr.string() + " --mulc " + mul + " -d float -o " + scaled.string());
     ASSERT_EQ(r.status, 0) << r.output;
     r = Shell("OCIO=" + (kSource / "configs/ocio/config.ocio").string() + " ocioconvert --view " +
-            scaled.string() + " 'Linear Rec.709 (sRGB)' " + viaOcio.string() +
-            " sRGB 'ACES 1.0 - SDR Video'");
+              scaled.string() + " 'Linear Rec.709 (sRGB)' " + viaOcio.string() +
+              " sRGB 'ACES 1.0 - SDR Video'");
     ASSERT_EQ(r.status, 0) << r.output;
     OIIO::ImageBuf ours((out / "small/small_000000.png").string()), theirs(viaOcio.string());
     ASSERT_TRUE(ours.read(0, 0, true, OIIO::TypeDesc::UINT8));
@@ -127,8 +127,8 @@ TEST(Capture, OutputIsBitIdenticalForOneAndTwoThreads) {
     const fs::path a = TempDir("t1"), b = TempDir("t2");
     ASSERT_EQ(Capture(a, "--frames 2 --threads 1").status, 0);
     ASSERT_EQ(Capture(b, "--frames 2 --threads 2").status, 0);
-    for (const char* f : {"small_000000.exr", "small_000000.png", "small_000001.exr",
-                          "small_000001.png"}) {
+    for (const char* f :
+         {"small_000000.exr", "small_000000.png", "small_000001.exr", "small_000001.png"}) {
         const std::string x = ReadBytes(a / "small" / f), y = ReadBytes(b / "small" / f);
         EXPECT_FALSE(x.empty());
         EXPECT_TRUE(x == y) << f << " differs between 1 and 2 threads";
@@ -140,8 +140,8 @@ TEST(Capture, OutputIsBitIdenticalForOneAndTwoThreads) {
 TEST(Capture, BadInputExitsWithStatusTwoAndAReadableMessage) {
     const fs::path out = TempDir("bad");
     Result r = Shell(Seasense() + " capture --config " +
-                   (kSource / "tests/data/configs/bad-nan.yaml").string() +
-                   " --channel x --out " + out.string());
+                     (kSource / "tests/data/configs/bad-nan.yaml").string() +
+                     " --channel x --out " + out.string());
     EXPECT_EQ(r.status, 2) << r.output;
     EXPECT_NE(r.output.find("bad-nan.yaml:"), std::string::npos) << r.output;
     EXPECT_EQ(r.output.find("terminate"), std::string::npos);
@@ -149,7 +149,7 @@ TEST(Capture, BadInputExitsWithStatusTwoAndAReadableMessage) {
     r = Capture(out, "--channel nonexistent");
     EXPECT_EQ(r.status, 2);
     r = Shell(Seasense() + " capture --config " + kScenario.string() + " --channel nope --out " +
-            out.string());
+              out.string());
     EXPECT_EQ(r.status, 2) << r.output;
     EXPECT_NE(r.output.find("small"), std::string::npos) << "lists the available channels";
     r = Capture(out, "--frames 0");

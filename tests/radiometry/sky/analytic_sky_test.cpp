@@ -1,9 +1,9 @@
 // Analytic sky against published daylight magnitudes and its own lookup table.
 #include "radiometry/sky/analytic_sky.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include "radiometry/color/rec709.h"
 #include "radiometry/surface/fresnel.h"
@@ -35,7 +35,8 @@ TEST(AnalyticSky, BrightestNearTheSunAndDimmerAwayFromIt) {
     const AnalyticSky sky(SunAt(30.0), 1e5, 3.0);
     const auto Y = [&](double az, double el) {
         const double a = az * M_PI / 180.0, e = el * M_PI / 180.0;
-        return LuminanceRec709(sky.Radiance({std::cos(e) * std::sin(a), std::cos(e) * std::cos(a), std::sin(e)}));
+        return LuminanceRec709(
+            sky.Radiance({std::cos(e) * std::sin(a), std::cos(e) * std::cos(a), std::sin(e)}));
     };
     EXPECT_GT(Y(0, 33), Y(0, 60));
     EXPECT_GT(Y(0, 33), Y(180, 33));

@@ -1,9 +1,9 @@
 // Gerstner waves against linear wave theory: dispersion, trochoid geometry, truthful queries.
 #include "scene/ocean/gerstner.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include "scene/ocean/ocean_mesh.h"
 
@@ -30,7 +30,10 @@ double CrestX(const GerstnerOcean& o, double xGuess, double halfWidth, double t)
     const double g = (std::sqrt(5.0) - 1.0) / 2.0;
     for (int i = 0; i < 200; ++i) {
         const double c = b - g * (b - a), d = a + g * (b - a);
-        if (o.HeightAt(c, 0.0, t) > o.HeightAt(d, 0.0, t)) b = d; else a = c;
+        if (o.HeightAt(c, 0.0, t) > o.HeightAt(d, 0.0, t))
+            b = d;
+        else
+            a = c;
     }
     return 0.5 * (a + b);
 }
@@ -56,7 +59,7 @@ TEST(Gerstner, ShallowWaterSpeedApproachesRootGh) {
     const double x1 = CrestX(o, c * t, 0.25 * lambda, t);
     EXPECT_NEAR((x1 - x0) / t, c, 2e-3 * c);
     const double k = 2.0 * M_PI / lambda;
-    EXPECT_NEAR(GroupSpeed(k, h) / PhaseSpeed(k, h), 1.0, 2e-3);  // non-dispersive limit
+    EXPECT_NEAR(GroupSpeed(k, h) / PhaseSpeed(k, h), 1.0, 2e-3);       // non-dispersive limit
     EXPECT_NEAR(GroupSpeed(k, 1e4) / PhaseSpeed(k, 1e4), 0.5, 1e-12);  // deep water: c_g = c/2
 }
 

@@ -1,9 +1,9 @@
 // Detector footprint integration against the discrete box-filter transfer function.
 #include "sensors/detector/detector.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 namespace seasense::sensors {
 namespace {
