@@ -1,0 +1,777 @@
+// Rasterizer pipeline: vertex transform, homogeneous clipping, fixed-point triangle set-up,
+// binning into tiles over triangle chunks, then per-tile half-space rasterization.
+#include "channels/raster/rasterizer.h"
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <sstream>
+
+#include "scene/core/check.h"
+#include "scene/core/error.h"
+
+namespace seasense::channels {
+namespace {
+
+// Fixed-point screen coordinates carry 8 sub-sample bits, as Direct3D 11 snaps vertices to
+// 16.8 fixed point (Microsoft, "Direct3D 11.3 Functional Specification", rasterization
+// rules).
+constexpr int kSubBits = 8;
+constexpr int64_t kSubScale = int64_t(1) << kSubBits;
+constexpr int64_t kHalfSample = kSubScale / 2;
+// Fixed-point coordinates stay within ±kGuardLimitSamples·256 = ±2^27 after guard-band
+// clipping, so edge-function products stay below 2^57 in int64.
+constexpr double kGuardLimitSamples = 524288.0;  // 2^19
+// Triangles per binning chunk: fixed, so chunk boundaries never depend on the thread count.
+constexpr uint32_t kTrianglesPerChunk = 8192;
+constexpr size_t kVerticesPerTask = 4096;
+
+// Per-vertex outcode bits. The frustum bits only drive trivial rejection; near and guard
+// bits send a triangle through the clipper.
+enum : uint32_t {
+    kOutRight = 1u << 0,   // x > w
+    kOutLeft = 1u << 1,    // x < -w
+    kOutTop = 1u << 2,     // y > w
+    kOutBottom = 1u << 3,  // y < -w
+    kOutNear = 1u << 4,    // w < near
+    kOutGuardXPos = 1u << 5,
+    kOutGuardXNeg = 1u << 6,
+    kOutGuardYPos = 1u << 7,
+    kOutGuardYNeg = 1u << 8,
+    kOutInvalid = 1u << 9,  // non-finite clip coordinates (overflow)
+};
+constexpr uint32_t kRejectMask = kOutRight | kOutLeft | kOutTop | kOutBottom | kOutNear;
+constexpr uint32_t kClipMask =
+    kOutNear | kOutGuardXPos | kOutGuardXNeg | kOutGuardYPos | kOutGuardYNeg;
+
+// Clip planes in the order the clipper applies them; the distance is >= 0 inside.
+enum ClipPlane { kPlaneNear, kPlaneGuardXPos, kPlaneGuardXNeg, kPlaneGuardYPos, kPlaneGuardYNeg };
+constexpr int kNumClipPlanes = 5;
+
+struct ScreenVertex {
+    int32_t x, y;  // fixed point, valid when outcode has no clip or invalid bits
+    uint32_t outcode;
+    double invW;  // 1 / clip w, valid with x, y
+};
+
+// One screen triangle ready for rasterization (64 bytes: one cache line).
+struct alignas(64) TriSetup {
+    int32_t x[3], y[3];  // fixed-point vertices (1/256 sample)
+    // near / (w_k · |2·area|): sum_k E_k c_k is the depth near/w at a sample, E_k the edge
+    // function opposite vertex k (screen-space barycentric × |2·area|). Double, so that the
+    // float barycentrics written out carry only their final rounding.
+    double c[3];
+    uint32_t prim;
+    int32_t attr;                 // -1: vertices are the original ones; else Chunk::attrs offset
+    uint16_t bx0, by0, bx1, by1;  // inclusive bounding box in samples, inside the grid
+};
+static_assert(sizeof(TriSetup) == 64);
+
+// Triangles [begin, end) of one mesh.
+struct ChunkRange {
+    uint32_t mesh;
+    uint32_t begin;
+    uint32_t end;
+};
+
+// Set-up output of one chunk. Cache-line aligned: chunks are written by different threads.
+struct alignas(64) Chunk {
+    // setups[0 .. numSetups); the vector only grows, so that frames reuse its memory.
+    std::vector<TriSetup> setups;
+    uint32_t numSetups = 0;
+    // For clipped triangles: c_k·β_k1 (3 values) then c_k·β_k2 (3 values), β_k the original
+    // triangle's barycentrics of screen vertex k.
+    std::vector<double> attrs;
+    // Tile range of each set-up, kept apart from the set-ups so that the binning scatter
+    // does not stream through them.
+    struct TileRange {
+        uint16_t tx0, ty0, tx1, ty1;
+    };
+    std::vector<TileRange> tileRanges;
+    std::vector<uint32_t> tileStart;  // tiles + 1: setups of tile t are binned[tileStart[t]..]
+    std::vector<uint32_t> cursor;
+    std::vector<uint32_t> binned;
+    RasterStats stats;
+    bool badIndex = false;
+    uint32_t badTriangle = 0;  // first triangle of the chunk with an out-of-range index
+    uint32_t badValue = 0;
+};
+
+struct Context {
+    int width = 0;
+    int height = 0;
+    double near = 0.0;
+    double halfWidth = 0.0;
+    double halfHeight = 0.0;
+    double guard = 0.0;  // guard band half-extent in NDC units
+    int tileShift = 6;
+    int tilesX = 0;
+    int tilesY = 0;
+};
+
+// Signed distance-like value of a clip-space point to a clip plane (>= 0 inside). The vertex
+// classification and the clipper both use this one function so they agree exactly.
+inline double PlaneDistance(int plane, double x, double y, double w, const Context& ctx) {
+    switch (plane) {
+        case kPlaneNear:
+            return w - ctx.near;
+        case kPlaneGuardXPos:
+            return ctx.guard * w - x;
+        case kPlaneGuardXNeg:
+            return ctx.guard * w + x;
+        case kPlaneGuardYPos:
+            return ctx.guard * w - y;
+        default:
+            return ctx.guard * w + y;
+    }
+}
+
+// Rounds v (|v| < 2^29) to the nearest integer, halves upward, without a libm call.
+inline int32_t RoundToInt32(double v) {
+    constexpr double kOffset = 1073741824.0;  // 2^30 makes the argument positive
+    return int32_t(int64_t(v + (0.5 + kOffset)) - int64_t(kOffset));
+}
+
+// Fixed-point screen position (1/256 sample, origin at the grid's top-left corner, y down)
+// of a clip-space point with w > 0. Every vertex, original or made by the clipper, goes
+// through this one function, so equal clip coordinates give equal fixed-point coordinates.
+// Returns 1 / w.
+inline double SnapToFixed(double x, double y, double w, const Context& ctx, int32_t& fx,
+                          int32_t& fy) {
+    const double invW = 1.0 / w;
+    const double sx = (x * invW + 1.0) * ctx.halfWidth;
+    const double sy = (1.0 - y * invW) * ctx.halfHeight;
+    fx = RoundToInt32(sx * double(kSubScale));
+    fy = RoundToInt32(sy * double(kSubScale));
+    return invW;
+}
+
+// First sample index whose centre i·256 + 128 is >= v, and last whose centre is <= v.
+inline int64_t FirstSampleAtOrAfter(int64_t v) {
+    return (v - kHalfSample + kSubScale - 1) >> kSubBits;
+}
+inline int64_t LastSampleAtOrBefore(int64_t v) { return (v - kHalfSample) >> kSubBits; }
+
+// Writes one set-up record. On x86 it uses non-temporal stores: the records are read by
+// whichever thread rasterizes the tile, so the next frame would otherwise have to take every
+// line back from that core's cache before overwriting it, which made two-thread binning
+// slower than one thread.
+inline void StoreSetup(const int32_t (&fx)[3], const int32_t (&fy)[3], const double (&c)[3],
+                       uint32_t prim, int32_t attr, uint16_t bx0, uint16_t by0, uint16_t bx1,
+                       uint16_t by1, TriSetup* dst) {
+#if defined(__SSE2__)
+    // Little-endian field layout of TriSetup, 16 bytes per store.
+    static_assert(offsetof(TriSetup, c) == 24 && offsetof(TriSetup, prim) == 48 &&
+                  offsetof(TriSetup, bx0) == 56 && offsetof(TriSetup, by1) == 62);
+    __m128i* q = reinterpret_cast<__m128i*>(dst);
+    _mm_stream_si128(q, _mm_setr_epi32(fx[0], fx[1], fx[2], fy[0]));
+    _mm_stream_si128(q + 1, _mm_set_epi64x(std::bit_cast<int64_t>(c[0]),
+                                           int64_t(uint64_t(uint32_t(fy[2])) << 32 |
+                                                   uint64_t(uint32_t(fy[1])))));
+    _mm_stream_si128(q + 2, _mm_castpd_si128(_mm_setr_pd(c[1], c[2])));
+    _mm_stream_si128(q + 3, _mm_setr_epi32(int32_t(prim), attr, int32_t(bx0 | uint32_t(by0) << 16),
+                                           int32_t(bx1 | uint32_t(by1) << 16)));
+#else
+    for (int k = 0; k < 3; ++k) {
+        dst->x[k] = fx[k];
+        dst->y[k] = fy[k];
+        dst->c[k] = c[k];
+    }
+    dst->prim = prim;
+    dst->attr = attr;
+    dst->bx0 = bx0;
+    dst->by0 = by0;
+    dst->bx1 = bx1;
+    dst->by1 = by1;
+#endif
+}
+
+// Sets up one screen triangle (fixed-point vertices, 1 / view depth w_k > 0, optional original
+// barycentrics β_k = (β_k1, β_k2)) and counts it into the chunk's tiles. Returns false when it
+// is culled (degenerate, back-facing or covering no sample centre's bounding box).
+[[gnu::always_inline]] inline bool EmitTriangle(const int32_t (&fx)[3], const int32_t (&fy)[3],
+                                                const double (&invW)[3], const double (*beta)[2],
+                                                uint32_t prim, bool cullBackFaces,
+                                                const Context& ctx, Chunk& chunk) {
+    const int64_t area2 = (int64_t(fx[1]) - fx[0]) * (int64_t(fy[2]) - fy[0]) -
+                          (int64_t(fy[1]) - fy[0]) * (int64_t(fx[2]) - fx[0]);
+    if (area2 == 0) return false;
+    // Counter-clockwise in NDC (y up) is clockwise on the y-down sample grid: 2·area < 0.
+    const bool front = area2 < 0;
+    if (cullBackFaces && !front) return false;
+
+    const int64_t minX = std::min({fx[0], fx[1], fx[2]}), maxX = std::max({fx[0], fx[1], fx[2]});
+    const int64_t minY = std::min({fy[0], fy[1], fy[2]}), maxY = std::max({fy[0], fy[1], fy[2]});
+    const int64_t sx0 = std::max<int64_t>(FirstSampleAtOrAfter(minX), 0);
+    const int64_t sx1 = std::min<int64_t>(LastSampleAtOrBefore(maxX), ctx.width - 1);
+    if (sx0 > sx1) return false;
+    const int64_t sy0 = std::max<int64_t>(FirstSampleAtOrAfter(minY), 0);
+    const int64_t sy1 = std::min<int64_t>(LastSampleAtOrBefore(maxY), ctx.height - 1);
+    if (sy0 > sy1) return false;
+
+    const int32_t attr = beta ? int32_t(chunk.attrs.size()) : -1;
+    const double nearPerArea = ctx.near / double(area2 < 0 ? -area2 : area2);
+    const double c[3] = {nearPerArea * invW[0], nearPerArea * invW[1], nearPerArea * invW[2]};
+    if (chunk.numSetups == chunk.setups.size())
+        chunk.setups.resize(std::max<size_t>(1024, 2 * chunk.setups.size()));
+    StoreSetup(fx, fy, c, prim, attr, uint16_t(sx0), uint16_t(sy0), uint16_t(sx1), uint16_t(sy1),
+               &chunk.setups[chunk.numSetups++]);
+    if (beta) {
+        for (int k = 0; k < 3; ++k) chunk.attrs.push_back(c[k] * beta[k][0]);
+        for (int k = 0; k < 3; ++k) chunk.attrs.push_back(c[k] * beta[k][1]);
+    }
+
+    const int tx0 = int(sx0) >> ctx.tileShift, tx1 = int(sx1) >> ctx.tileShift;
+    const int ty0 = int(sy0) >> ctx.tileShift, ty1 = int(sy1) >> ctx.tileShift;
+    chunk.tileRanges.push_back({uint16_t(tx0), uint16_t(ty0), uint16_t(tx1), uint16_t(ty1)});
+    for (int ty = ty0; ty <= ty1; ++ty)
+        for (int tx = tx0; tx <= tx1; ++tx) ++chunk.tileStart[size_t(ty * ctx.tilesX + tx) + 1];
+    ++chunk.stats.trianglesSetUp;
+    return true;
+}
+
+// A clip-space polygon vertex with the original triangle's barycentrics β1, β2.
+struct PolyVertex {
+    double x, y, w, b1, b2;
+};
+// Clipping a convex polygon adds at most one vertex per plane (Sutherland & Hodgman 1974),
+// so 8 suffice in exact arithmetic. Rounding can make a clipped polygon slightly non-convex;
+// one pass still emits at most two vertices per edge, so the near plane (3 → ≤ 4) and four
+// guard planes (×2 each) stay within 64 whatever the rounding.
+constexpr int kMaxPolyVertices = 64;
+
+// Sutherland–Hodgman ("Reentrant polygon clipping", CACM 17(1), 1974) against one plane.
+// Intersections are always computed from the inside endpoint toward the outside one, so
+// two triangles sharing an edge compute bit-identical new vertices.
+int ClipPolygon(const PolyVertex* in, int n, int plane, const Context& ctx, PolyVertex* out) {
+    int m = 0;
+    double dPrev = PlaneDistance(plane, in[n - 1].x, in[n - 1].y, in[n - 1].w, ctx);
+    const PolyVertex* prev = &in[n - 1];
+    for (int i = 0; i < n; ++i) {
+        const PolyVertex& cur = in[i];
+        const double dCur = PlaneDistance(plane, cur.x, cur.y, cur.w, ctx);
+        const bool prevIn = dPrev >= 0.0, curIn = dCur >= 0.0;
+        if (prevIn != curIn) {
+            const PolyVertex& a = prevIn ? *prev : cur;  // inside
+            const PolyVertex& b = prevIn ? cur : *prev;  // outside
+            const double da = prevIn ? dPrev : dCur, db = prevIn ? dCur : dPrev;
+            const double t = da / (da - db);
+            out[m++] = {a.x + t * (b.x - a.x), a.y + t * (b.y - a.y), a.w + t * (b.w - a.w),
+                        a.b1 + t * (b.b1 - a.b1), a.b2 + t * (b.b2 - a.b2)};
+        }
+        if (curIn) out[m++] = cur;
+        prev = &cur;
+        dPrev = dCur;
+    }
+    return m;
+}
+
+// Clips an original triangle (clip-space vertices) in homogeneous space against the near
+// plane and, where needed, the guard band, then emits its fan. Returns the count emitted.
+int ClipAndEmit(const glm::vec3 (&clip)[3], uint32_t prim, bool cullBackFaces, const Context& ctx,
+                Chunk& chunk) {
+    PolyVertex bufA[kMaxPolyVertices], bufB[kMaxPolyVertices];
+    PolyVertex* cur = bufA;
+    PolyVertex* next = bufB;
+    cur[0] = {clip[0].x, clip[0].y, clip[0].z, 0.0, 0.0};
+    cur[1] = {clip[1].x, clip[1].y, clip[1].z, 1.0, 0.0};
+    cur[2] = {clip[2].x, clip[2].y, clip[2].z, 0.0, 1.0};
+    int n = 3;
+    for (int plane = 0; plane < kNumClipPlanes && n >= 3; ++plane) {
+        // A plane is applied only when some vertex lies outside it; an edge that stays inside
+        // is copied unchanged, so neighbours that skip the plane still agree on it.
+        bool anyOut = false;
+        for (int i = 0; i < n; ++i)
+            anyOut |= PlaneDistance(plane, cur[i].x, cur[i].y, cur[i].w, ctx) < 0.0;
+        if (!anyOut) continue;
+        n = ClipPolygon(cur, n, plane, ctx, next);
+        std::swap(cur, next);
+    }
+    if (n < 3) return 0;
+    // Near-plane intersections have w = near up to rounding; only a near plane tiny against
+    // the coordinates could round to w <= 0, where the polygon is dropped.
+    for (int i = 0; i < n; ++i)
+        if (!(cur[i].w > 0.0)) return 0;
+
+    int32_t px[kMaxPolyVertices], py[kMaxPolyVertices];
+    double pInvW[kMaxPolyVertices];
+    for (int i = 0; i < n; ++i)
+        pInvW[i] = SnapToFixed(cur[i].x, cur[i].y, cur[i].w, ctx, px[i], py[i]);
+    int emitted = 0;
+    for (int i = 1; i + 1 < n; ++i) {
+        const int v[3] = {0, i, i + 1};
+        int32_t fx[3], fy[3];
+        double invW[3], beta[3][2];
+        for (int k = 0; k < 3; ++k) {
+            fx[k] = px[v[k]];
+            fy[k] = py[v[k]];
+            invW[k] = pInvW[v[k]];
+            beta[k][0] = cur[v[k]].b1;
+            beta[k][1] = cur[v[k]].b2;
+        }
+        emitted += EmitTriangle(fx, fy, invW, beta, prim, cullBackFaces, ctx, chunk);
+    }
+    return emitted;
+}
+
+// Output of the per-tile pass: a visibility buffer or a coverage count.
+struct Targets {
+    int width = 0;
+    float* depth = nullptr;
+    uint32_t* primitive = nullptr;
+    float* b1 = nullptr;
+    float* b2 = nullptr;
+    uint32_t* hits = nullptr;
+};
+
+struct TileRect {
+    int x0, y0, x1, y1;  // inclusive samples
+};
+
+// Half-space rasterization of one set-up triangle over its bounding box ∩ tile (Pineda, "A
+// parallel algorithm for polygon rasterization", SIGGRAPH 1988): exact int64 edge functions,
+// stepped incrementally from row to row and from sample to sample.
+template <bool kCount, bool kClipped>
+void RasterTriangle(const TriSetup& s, const double* attrs, const TileRect& r, const Targets& t) {
+    const int x0 = std::max<int>(s.bx0, r.x0), x1 = std::min<int>(s.bx1, r.x1);
+    const int y0 = std::max<int>(s.by0, r.y0), y1 = std::min<int>(s.by1, r.y1);
+    if (x0 > x1 || y0 > y1) return;
+
+    // Edge k runs between the two vertices other than k, oriented so that the inside is
+    // positive; E_k is then |2·area| times vertex k's screen-space barycentric.
+    const int64_t area2 = (int64_t(s.x[1]) - s.x[0]) * (int64_t(s.y[2]) - s.y[0]) -
+                          (int64_t(s.y[1]) - s.y[0]) * (int64_t(s.x[2]) - s.x[0]);
+    const bool positive = area2 > 0;
+    int64_t row[3], stepX[3], stepY[3], unbias[3];
+    const int64_t px = int64_t(x0) * kSubScale + kHalfSample;
+    const int64_t py = int64_t(y0) * kSubScale + kHalfSample;
+    for (int k = 0; k < 3; ++k) {
+        int i = k == 2 ? 0 : k + 1, j = k == 0 ? 2 : k - 1;
+        if (!positive) std::swap(i, j);
+        const int64_t ax = s.x[i], ay = s.y[i], bx = s.x[j], by = s.y[j];
+        const int64_t a = ay - by;  // ∂E/∂x
+        const int64_t b = bx - ax;  // ∂E/∂y
+        // Top-left rule (Direct3D 11.3 functional specification, rasterization rules) for a
+        // clockwise triangle on the y-down grid: a left edge runs upward (a > 0); a top edge
+        // is horizontal and runs toward +x. Other edges exclude samples with E = 0.
+        const bool topLeft = a > 0 || (a == 0 && b > 0);
+        unbias[k] = topLeft ? 0 : 1;
+        row[k] = a * (px - ax) + b * (py - ay) - unbias[k];
+        stepX[k] = a * kSubScale;
+        stepY[k] = b * kSubScale;
+    }
+    const uint32_t prim = s.prim;
+    const int64_t u1 = unbias[1], u2 = unbias[2];
+    // E_0 + E_1 + E_2 = |2·area| exactly, so depth = Σ E_k c_k = k0 + E_1 Δc_1 + E_2 Δc_2
+    // needs two conversions per sample instead of three.
+    const double absArea2 = double(positive ? area2 : -area2);
+    const double c1 = s.c[1], c2 = s.c[2];
+    const double k0 = absArea2 * s.c[0], dc1 = c1 - s.c[0], dc2 = c2 - s.c[0];
+    double g0 = 0.0, g1 = 0.0, g2 = 0.0, h0 = 0.0, h1 = 0.0, h2 = 0.0;
+    if constexpr (kClipped) {
+        const double* g = attrs + s.attr;
+        g0 = absArea2 * g[0];
+        g1 = g[1] - g[0];
+        g2 = g[2] - g[0];
+        h0 = absArea2 * g[3];
+        h1 = g[4] - g[3];
+        h2 = g[5] - g[3];
+    }
+
+    for (int y = y0; y <= y1; ++y) {
+        // The covered samples of a row form one span: each edge bounds it from one side,
+        // found by exact integer division rather than by testing every sample of the box.
+        int64_t lo = x0, hi = x1;
+        for (int k = 0; k < 3; ++k) {
+            const int64_t r = row[k], step = stepX[k];
+            if (step > 0) {
+                if (r < 0) lo = std::max(lo, x0 + (step - 1 - r) / step);
+            } else if (step < 0) {
+                hi = r < 0 ? -1 : std::min(hi, x0 + r / -step);
+            } else if (r < 0) {
+                hi = -1;
+            }
+        }
+        if (lo <= hi) {
+            const size_t rowBase = size_t(y) * size_t(t.width);
+            int64_t e1 = row[1] + (lo - x0) * stepX[1] + u1;
+            int64_t e2 = row[2] + (lo - x0) * stepX[2] + u2;
+            if constexpr (kCount) {
+                uint32_t* __restrict hitsRow = t.hits + rowBase;
+                for (int64_t x = lo; x <= hi; ++x) ++hitsRow[x];
+            } else {
+                float* __restrict depthRow = t.depth + rowBase;
+                uint32_t* __restrict primRow = t.primitive + rowBase;
+                float* __restrict b1Row = t.b1 + rowBase;
+                float* __restrict b2Row = t.b2 + rowBase;
+                for (int64_t x = lo; x <= hi; ++x) {
+                    const double f1 = double(e1), f2 = double(e2);
+                    e1 += stepX[1];
+                    e2 += stepX[2];
+                    const double d = k0 + f1 * dc1 + f2 * dc2;
+                    const float depth = float(d);
+                    const float old = depthRow[x];
+                    if (depth > 0.0f && (depth > old || (depth == old && prim < primRow[x]))) {
+                        depthRow[x] = depth;
+                        primRow[x] = prim;
+                        const double inv = 1.0 / d;
+                        if constexpr (kClipped) {
+                            b1Row[x] = float((g0 + f1 * g1 + f2 * g2) * inv);
+                            b2Row[x] = float((h0 + f1 * h1 + f2 * h2) * inv);
+                        } else {
+                            b1Row[x] = float(f1 * c1 * inv);
+                            b2Row[x] = float(f2 * c2 * inv);
+                        }
+                    }
+                }
+            }
+        }
+        row[0] += stepY[0];
+        row[1] += stepY[1];
+        row[2] += stepY[2];
+    }
+}
+
+// Clears one tile of the targets, then draws every triangle binned to it in global
+// triangle order (chunks in order, set-ups in order within a chunk).
+template <bool kCount>
+void RasterTile(int tile, const Context& ctx, const std::vector<Chunk>& chunks, size_t numChunks,
+                const Targets& t) {
+    const int tileSize = 1 << ctx.tileShift;
+    const int tx = tile % ctx.tilesX, ty = tile / ctx.tilesX;
+    const TileRect r{tx * tileSize, ty * tileSize, std::min(ctx.width, (tx + 1) * tileSize) - 1,
+                     std::min(ctx.height, (ty + 1) * tileSize) - 1};
+    for (int y = r.y0; y <= r.y1; ++y) {
+        const size_t b = size_t(y) * size_t(t.width) + size_t(r.x0);
+        const size_t n = size_t(r.x1 - r.x0 + 1);
+        if constexpr (kCount) {
+            std::fill_n(t.hits + b, n, 0u);
+        } else {
+            float* __restrict depth = t.depth + b;
+            uint32_t* __restrict primitive = t.primitive + b;
+            float* __restrict b1 = t.b1 + b;
+            float* __restrict b2 = t.b2 + b;
+            for (size_t i = 0; i < n; ++i) {
+                depth[i] = 0.0f;
+                primitive[i] = kNoPrimitive;
+                b1[i] = 0.0f;
+                b2[i] = 0.0f;
+            }
+        }
+    }
+    for (size_t c = 0; c < numChunks; ++c) {
+        const Chunk& chunk = chunks[c];
+        const uint32_t begin = chunk.tileStart[size_t(tile)],
+                       end = chunk.tileStart[size_t(tile) + 1];
+        const double* attrs = chunk.attrs.data();
+        for (uint32_t k = begin; k < end; ++k) {
+            const TriSetup& s = chunk.setups[chunk.binned[k]];
+            if (s.attr < 0)
+                RasterTriangle<kCount, false>(s, attrs, r, t);
+            else
+                RasterTriangle<kCount, true>(s, attrs, r, t);
+        }
+    }
+}
+
+// Sets up and bins the triangles of one chunk.
+void BinChunk(const ChunkRange& range, const RasterMesh& mesh, uint32_t vertexBase,
+              uint32_t primBase, const std::vector<ScreenVertex>& screen,
+              const std::vector<glm::vec3>& clip, const Context& ctx, Chunk& chunk) {
+    const size_t numTiles = size_t(ctx.tilesX) * size_t(ctx.tilesY);
+    chunk.numSetups = 0;
+    chunk.tileRanges.clear();
+    chunk.attrs.clear();
+    chunk.tileStart.assign(numTiles + 1, 0);
+    chunk.stats = {};
+    chunk.badIndex = false;
+
+    const size_t numVertices = mesh.positions.size();
+    const uint32_t* indices = mesh.indices.data();
+    const ScreenVertex* sv = screen.data() + vertexBase;
+    for (uint32_t t = range.begin; t < range.end; ++t) {
+        const uint32_t i0 = indices[3 * size_t(t)], i1 = indices[3 * size_t(t) + 1],
+                       i2 = indices[3 * size_t(t) + 2];
+        if (i0 >= numVertices || i1 >= numVertices || i2 >= numVertices) {
+            chunk.badIndex = true;
+            chunk.badTriangle = t;
+            chunk.badValue = std::max({i0, i1, i2});
+            return;
+        }
+        ++chunk.stats.trianglesIn;
+        const ScreenVertex& v0 = sv[i0];
+        const ScreenVertex& v1 = sv[i1];
+        const ScreenVertex& v2 = sv[i2];
+        const uint32_t ocAnd = v0.outcode & v1.outcode & v2.outcode;
+        const uint32_t ocOr = v0.outcode | v1.outcode | v2.outcode;
+        if ((ocAnd & kRejectMask) || (ocOr & kOutInvalid)) {
+            ++chunk.stats.trianglesCulled;
+            continue;
+        }
+        const uint32_t prim = primBase + t;
+        if (ocOr & kClipMask) {
+            ++chunk.stats.trianglesClipped;
+            const glm::vec3 c[3] = {clip[vertexBase + i0], clip[vertexBase + i1],
+                                    clip[vertexBase + i2]};
+            if (ClipAndEmit(c, prim, mesh.cullBackFaces, ctx, chunk) == 0)
+                ++chunk.stats.trianglesCulled;
+            continue;
+        }
+        const int32_t fx[3] = {v0.x, v1.x, v2.x};
+        const int32_t fy[3] = {v0.y, v1.y, v2.y};
+        const double invW[3] = {v0.invW, v1.invW, v2.invW};
+        if (!EmitTriangle(fx, fy, invW, nullptr, prim, mesh.cullBackFaces, ctx, chunk))
+            ++chunk.stats.trianglesCulled;
+    }
+
+#if defined(__SSE2__)
+    _mm_sfence();  // order the streamed set-ups before the tasks that read them
+#endif
+    // Counting sort of the set-ups into tiles, keeping triangle order within each tile.
+    for (size_t i = 0; i < numTiles; ++i) chunk.tileStart[i + 1] += chunk.tileStart[i];
+    chunk.binned.resize(chunk.tileStart[numTiles]);
+    chunk.cursor.assign(chunk.tileStart.begin(), chunk.tileStart.end() - 1);
+    for (uint32_t k = 0; k < uint32_t(chunk.tileRanges.size()); ++k) {
+        const Chunk::TileRange r = chunk.tileRanges[k];
+        for (int ty = r.ty0; ty <= r.ty1; ++ty)
+            for (int tx = r.tx0; tx <= r.tx1; ++tx)
+                chunk.binned[chunk.cursor[size_t(ty * ctx.tilesX + tx)]++] = k;
+    }
+}
+
+bool AllFinite(const glm::mat4& m) {
+    for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 4; ++r)
+            if (!std::isfinite(m[c][r])) return false;
+    return true;
+}
+
+}  // namespace
+
+struct Rasterizer::Scratch {
+    Context ctx;
+    std::vector<uint32_t> vertexBase;  // per mesh, into screen / clip
+    std::vector<ScreenVertex> screen;
+    std::vector<glm::vec3> clip;  // (x, y, w) in clip space
+    std::vector<ChunkRange> ranges;
+    std::vector<Chunk> chunks;  // grows, never shrinks: keeps capacity between frames
+};
+
+Rasterizer::Rasterizer(int tileSize) : tileSize_(tileSize), tileShift_(0) {
+    if (tileSize < 8 || tileSize > 1024 || (tileSize & (tileSize - 1)) != 0) {
+        std::ostringstream msg;
+        msg << "Rasterizer: tile size " << tileSize
+            << " samples: expected a power of two in [8, 1024]";
+        throw InputError(msg.str());
+    }
+    while ((1 << tileShift_) < tileSize) ++tileShift_;
+    scratch_ = std::make_unique<Scratch>();
+}
+
+Rasterizer::~Rasterizer() = default;
+Rasterizer::Rasterizer(Rasterizer&&) noexcept = default;
+Rasterizer& Rasterizer::operator=(Rasterizer&&) noexcept = default;
+
+void Rasterizer::Prepare(std::span<const RasterMesh> meshes, const RasterCamera& camera) {
+    CHECK(scratch_ != nullptr);
+    if (camera.width < 1 || camera.height < 1 || camera.width > kMaxRasterSamplesPerAxis ||
+        camera.height > kMaxRasterSamplesPerAxis) {
+        std::ostringstream msg;
+        msg << "Rasterizer: sample grid " << camera.width << "x" << camera.height
+            << ": expected each side in [1, " << kMaxRasterSamplesPerAxis << "]";
+        throw InputError(msg.str());
+    }
+    if (!std::isfinite(camera.near_m) || camera.near_m <= 0.0f) {
+        std::ostringstream msg;
+        msg << "Rasterizer: near plane " << camera.near_m << " m: expected a finite value > 0";
+        throw InputError(msg.str());
+    }
+    if (!AllFinite(camera.clipFromWorld))
+        throw InputError("Rasterizer: clipFromWorld has non-finite entries");
+
+    Scratch& sc = *scratch_;
+    Context& ctx = sc.ctx;
+    ctx.width = camera.width;
+    ctx.height = camera.height;
+    ctx.near = camera.near_m;
+    ctx.halfWidth = 0.5 * camera.width;
+    ctx.halfHeight = 0.5 * camera.height;
+    // |x_ndc| <= guard keeps the sample coordinate (x_ndc + 1)·width/2 within ±2^19.
+    ctx.guard = 2.0 * kGuardLimitSamples / double(std::max(camera.width, camera.height)) - 1.0;
+    ctx.tileShift = tileShift_;
+    ctx.tilesX = (camera.width + tileSize_ - 1) / tileSize_;
+    ctx.tilesY = (camera.height + tileSize_ - 1) / tileSize_;
+
+    stats_ = {};
+    sc.vertexBase.resize(meshes.size());
+    sc.ranges.clear();
+    uint64_t totalVertices = 0, totalTriangles = 0;
+    for (size_t m = 0; m < meshes.size(); ++m) {
+        const RasterMesh& mesh = meshes[m];
+        if (mesh.indices.size() % 3 != 0) {
+            std::ostringstream msg;
+            msg << "Rasterizer: mesh " << m << " has " << mesh.indices.size()
+                << " indices: expected a multiple of 3";
+            throw InputError(msg.str());
+        }
+        sc.vertexBase[m] = uint32_t(totalVertices);
+        totalVertices += mesh.positions.size();
+        const uint64_t tris = mesh.indices.size() / 3;
+        for (uint64_t b = 0; b < tris; b += kTrianglesPerChunk)
+            sc.ranges.push_back({uint32_t(m), uint32_t(b),
+                                 uint32_t(std::min<uint64_t>(tris, b + kTrianglesPerChunk))});
+        totalTriangles += tris;
+        if (totalVertices >= kNoPrimitive || totalTriangles >= kNoPrimitive) {
+            std::ostringstream msg;
+            msg << "Rasterizer: meshes 0.." << m
+                << " exceed 2^32 - 1 vertices or triangles in one frame";
+            throw InputError(msg.str());
+        }
+    }
+
+    // Vertex stage: clip coordinates (double arithmetic, stored as float), outcodes and
+    // fixed-point positions of vertices that need no clipping.
+    sc.screen.resize(totalVertices);
+    sc.clip.resize(totalVertices);
+    const glm::dmat4 m(camera.clipFromWorld);
+    const glm::dvec4 rowX(m[0][0], m[1][0], m[2][0], m[3][0]);
+    const glm::dvec4 rowY(m[0][1], m[1][1], m[2][1], m[3][1]);
+    const glm::dvec4 rowW(m[0][3], m[1][3], m[2][3], m[3][3]);
+    for (size_t mi = 0; mi < meshes.size(); ++mi) {
+        const std::span<const glm::vec3> positions = meshes[mi].positions;
+        const size_t base = sc.vertexBase[mi];
+        std::atomic<size_t> firstBad{std::numeric_limits<size_t>::max()};
+        tbb::parallel_for(
+            tbb::blocked_range<size_t>(0, positions.size(), kVerticesPerTask),
+            [&](const tbb::blocked_range<size_t>& r) {
+                for (size_t v = r.begin(); v < r.end(); ++v) {
+                    const glm::vec3 p = positions[v];
+                    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+                        size_t prev = firstBad.load();
+                        while (v < prev && !firstBad.compare_exchange_weak(prev, v)) {
+                        }
+                        continue;
+                    }
+                    const glm::dvec4 ph(p.x, p.y, p.z, 1.0);
+                    const float cx = float(glm::dot(rowX, ph));
+                    const float cy = float(glm::dot(rowY, ph));
+                    const float cw = float(glm::dot(rowW, ph));
+                    sc.clip[base + v] = glm::vec3(cx, cy, cw);
+                    ScreenVertex s{0, 0, 0, 0.0};
+                    if (!std::isfinite(cx) || !std::isfinite(cy) || !std::isfinite(cw)) {
+                        s.outcode = kOutInvalid;
+                    } else {
+                        uint32_t oc = 0;
+                        oc |= cx > cw ? kOutRight : 0u;
+                        oc |= cx < -cw ? kOutLeft : 0u;
+                        oc |= cy > cw ? kOutTop : 0u;
+                        oc |= cy < -cw ? kOutBottom : 0u;
+                        oc |= PlaneDistance(kPlaneNear, cx, cy, cw, ctx) < 0.0 ? kOutNear : 0u;
+                        oc |= PlaneDistance(kPlaneGuardXPos, cx, cy, cw, ctx) < 0.0 ? kOutGuardXPos
+                                                                                    : 0u;
+                        oc |= PlaneDistance(kPlaneGuardXNeg, cx, cy, cw, ctx) < 0.0 ? kOutGuardXNeg
+                                                                                    : 0u;
+                        oc |= PlaneDistance(kPlaneGuardYPos, cx, cy, cw, ctx) < 0.0 ? kOutGuardYPos
+                                                                                    : 0u;
+                        oc |= PlaneDistance(kPlaneGuardYNeg, cx, cy, cw, ctx) < 0.0 ? kOutGuardYNeg
+                                                                                    : 0u;
+                        s.outcode = oc;
+                        if (!(oc & kClipMask)) s.invW = SnapToFixed(cx, cy, cw, ctx, s.x, s.y);
+                    }
+                    sc.screen[base + v] = s;
+                }
+            });
+        if (firstBad.load() != std::numeric_limits<size_t>::max()) {
+            const size_t v = firstBad.load();
+            std::ostringstream msg;
+            msg << "Rasterizer: mesh " << mi << " vertex " << v << " position (" << positions[v].x
+                << ", " << positions[v].y << ", " << positions[v].z
+                << "): expected finite coordinates";
+            throw InputError(msg.str());
+        }
+    }
+
+    // Set-up and binning over fixed triangle chunks.
+    std::vector<uint32_t> primBase(meshes.size());
+    uint32_t nextPrim = 0;
+    for (size_t mi = 0; mi < meshes.size(); ++mi) {
+        primBase[mi] = nextPrim;
+        nextPrim += uint32_t(meshes[mi].indices.size() / 3);
+    }
+    if (sc.chunks.size() < sc.ranges.size()) sc.chunks.resize(sc.ranges.size());
+    tbb::parallel_for(size_t(0), sc.ranges.size(), [&](size_t c) {
+        const ChunkRange& r = sc.ranges[c];
+        BinChunk(r, meshes[r.mesh], sc.vertexBase[r.mesh], primBase[r.mesh], sc.screen, sc.clip,
+                 ctx, sc.chunks[c]);
+    });
+    for (size_t c = 0; c < sc.ranges.size(); ++c) {
+        const Chunk& chunk = sc.chunks[c];
+        if (chunk.badIndex) {
+            const RasterMesh& mesh = meshes[sc.ranges[c].mesh];
+            std::ostringstream msg;
+            msg << "Rasterizer: mesh " << sc.ranges[c].mesh << " triangle " << chunk.badTriangle
+                << " uses vertex index " << chunk.badValue << ": expected < "
+                << mesh.positions.size() << " (the mesh's vertex count)";
+            throw InputError(msg.str());
+        }
+        stats_.trianglesIn += chunk.stats.trianglesIn;
+        stats_.trianglesCulled += chunk.stats.trianglesCulled;
+        stats_.trianglesClipped += chunk.stats.trianglesClipped;
+        stats_.trianglesSetUp += chunk.stats.trianglesSetUp;
+    }
+}
+
+void Rasterizer::Render(std::span<const RasterMesh> meshes, const RasterCamera& camera,
+                        VisibilityBuffer& out) {
+    Prepare(meshes, camera);
+    const Scratch& sc = *scratch_;
+    const size_t n = size_t(camera.width) * size_t(camera.height);
+    out.width = camera.width;
+    out.height = camera.height;
+    out.depth.resize(n);
+    out.primitive.resize(n);
+    out.b1.resize(n);
+    out.b2.resize(n);
+    out.primitiveBase.resize(meshes.size());
+    uint32_t nextPrim = 0;
+    for (size_t mi = 0; mi < meshes.size(); ++mi) {
+        out.primitiveBase[mi] = nextPrim;
+        nextPrim += uint32_t(meshes[mi].indices.size() / 3);
+    }
+    Targets t;
+    t.width = camera.width;
+    t.depth = out.depth.data();
+    t.primitive = out.primitive.data();
+    t.b1 = out.b1.data();
+    t.b2 = out.b2.data();
+    const int numTiles = sc.ctx.tilesX * sc.ctx.tilesY;
+    tbb::parallel_for(0, numTiles, [&](int tile) {
+        RasterTile<false>(tile, sc.ctx, sc.chunks, sc.ranges.size(), t);
+    });
+}
+
+void Rasterizer::RenderCoverageCount(std::span<const RasterMesh> meshes, const RasterCamera& camera,
+                                     std::vector<uint32_t>& hits) {
+    Prepare(meshes, camera);
+    const Scratch& sc = *scratch_;
+    hits.resize(size_t(camera.width) * size_t(camera.height));
+    Targets t;
+    t.width = camera.width;
+    t.hits = hits.data();
+    const int numTiles = sc.ctx.tilesX * sc.ctx.tilesY;
+    tbb::parallel_for(0, numTiles, [&](int tile) {
+        RasterTile<true>(tile, sc.ctx, sc.chunks, sc.ranges.size(), t);
+    });
+}
+
+}  // namespace seasense::channels
