@@ -6,6 +6,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include "radiometry/sky/analytic_sky.h"
@@ -103,6 +104,11 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     const ChannelCamera& cam = camera_;
     const int sw = cam.SampleWidth(), sh = cam.SampleHeight();
 
+    using Clock = std::chrono::steady_clock;
+    const auto Ms = [](Clock::time_point a, Clock::time_point b) {
+        return std::chrono::duration<double, std::milli>(b - a).count();
+    };
+    const Clock::time_point t0 = Clock::now();
     // Sea mesh for this view: vertices about 4 pixels apart on screen.
     scene::OceanMeshRequest req;
     req.eye_m = cam.worldFromCamera.position_m;
@@ -116,10 +122,14 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     meshes.push_back({ocean_.positions, ocean_.indices, true});
     for (const scene::TriangleMesh& m : worldMeshes_)
         meshes.push_back({m.positions, m.indices, true});
+    const Clock::time_point t1 = Clock::now();
     rasterizer_.Render(meshes, cam.Raster(), vis_);
+    const Clock::time_point t2 = Clock::now();
 
     stats_ = {};
     stats_.raster = rasterizer_.Stats();
+    stats_.meshMs = Ms(t0, t1);
+    stats_.rasterMs = Ms(t1, t2);
     stats_.oceanTriangles = ocean_.indices.size() / 3;
     for (const scene::TriangleMesh& m : worldMeshes_) stats_.modelTriangles += m.TriangleCount();
 
@@ -222,15 +232,20 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
             blockRays[size_t(block)] = origins.size();
         }
 
+        glm::vec3 rowBase[kRowsPerBlock];
+        for (int y = y0; y < y1; ++y) {
+            const double ndcY = 1.0 - 2.0 * (y + 0.5) / sh;
+            rowBase[y - y0] = glm::vec3(forward + R * glm::dvec3(-tanH, 0.0, ndcY * tanV));
+        }
+
         // Pass 2: radiance.
         for (size_t k = 0; k < n; ++k) {
             const int x = int(k % size_t(sw)), y = y0 + int(k / size_t(sw));
             float* out = radiance.At(x, y);
             glm::vec3 L;
             if (meshOf[k] < 0) {
-                const double ndcY = 1.0 - 2.0 * (y + 0.5) / sh;
-                const glm::vec3 rowBase(forward + R * glm::dvec3(-tanH, 0.0, ndcY * tanV));
-                const glm::vec3 d = glm::normalize(rowBase + (float(x) + 0.5f) * colStep);
+                const glm::vec3 d =
+                    glm::normalize(rowBase[size_t(y - y0)] + (float(x) + 0.5f) * colStep);
                 L = sky.LookUp(d);
                 if (glm::dot(d, sunDir) >= cosSunRadius) L += sunL;
             } else {
@@ -277,6 +292,7 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
         }
     });
     for (uint64_t r : blockRays) stats_.shadowRays += r;
+    stats_.shadeMs = Ms(t2, Clock::now());
 }
 
 }  // namespace seasense::channels

@@ -20,6 +20,9 @@ struct OtwFrameStats {
     uint64_t oceanTriangles = 0;
     uint64_t modelTriangles = 0;
     uint64_t shadowRays = 0;  // rays actually traced (after the caster-bounds test)
+    double meshMs = 0.0;      // sea mesh for the view
+    double rasterMs = 0.0;    // visibility buffer
+    double shadeMs = 0.0;     // shadow rays and shading
     RasterStats raster;
 };
 

@@ -11,9 +11,17 @@
 namespace seasense::sensors {
 
 Image IntegrateFootprint(const Image& samples, int n) {
+    Image out;
+    IntegrateFootprint(samples, n, out);
+    return out;
+}
+
+void IntegrateFootprint(const Image& samples, int n, Image& out) {
     CHECK(n >= 1);
     CHECK(samples.width % n == 0 && samples.height % n == 0);
-    Image out(samples.width / n, samples.height / n, samples.channels);
+    if (out.width != samples.width / n || out.height != samples.height / n ||
+        out.channels != samples.channels)
+        out = Image(samples.width / n, samples.height / n, samples.channels);
     const int c = samples.channels;
     const float inv = 1.0f / float(n * n);
     tbb::parallel_for(0, out.height, [&](int y) {
@@ -28,7 +36,6 @@ Image IntegrateFootprint(const Image& samples, int n) {
         float* dst = out.At(0, y);
         for (size_t i = 0; i < acc.size(); ++i) dst[i] = acc[i] * inv;
     });
-    return out;
 }
 
 double LogAverageLuminance(const Image& rgb) {

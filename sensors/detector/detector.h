@@ -9,6 +9,8 @@ namespace seasense::sensors {
 // footprint: the mean of its n×n supersamples (a box of one pixel pitch; MTF |sinc(π a f)|).
 // samples: (width·n)×(height·n)×c; returns width×height×c. Parallel, deterministic.
 Image IntegrateFootprint(const Image& samples, int n);
+// As above into `out`, reusing its storage when the size already matches.
+void IntegrateFootprint(const Image& samples, int n, Image& out);
 
 // Log-average luminance of a linear Rec.709 image (cd/m²): exp(mean(ln(δ + Y))),
 // δ = 1e-4 cd/m² so black pixels do not send the mean to −∞ (Reinhard et al.,

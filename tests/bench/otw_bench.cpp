@@ -28,15 +28,23 @@ void BM_OtwFrame(benchmark::State& state) {
     const scene::World world(sc);
     std::unique_ptr<OtwChannel> otw;
     arena.execute([&] { otw = std::make_unique<OtwChannel>(world, ch); });
-    Image radiance;
+    Image radiance, pixels;
     int64_t frame = 0;
+    double meshMs = 0, rasterMs = 0, shadeMs = 0;
     for (auto _ : state) {
         arena.execute([&] {
             otw->Render(world.State(frame++), radiance);
-            const Image pixels = sensors::IntegrateFootprint(radiance, ch.supersampling);
+            sensors::IntegrateFootprint(radiance, ch.supersampling, pixels);
             benchmark::DoNotOptimize(pixels.pixels.data());
         });
+        meshMs += otw->Stats().meshMs;
+        rasterMs += otw->Stats().rasterMs;
+        shadeMs += otw->Stats().shadeMs;
     }
+    const double n = double(state.iterations());
+    state.counters["mesh_ms"] = meshMs / n;
+    state.counters["raster_ms"] = rasterMs / n;
+    state.counters["shade_ms"] = shadeMs / n;
     const double samples = double(ch.width) * ch.height * ch.supersampling * ch.supersampling;
     state.counters["Msamples/s"] = benchmark::Counter(samples * 1e-6 * double(state.iterations()),
                                                       benchmark::Counter::kIsRate);
