@@ -38,6 +38,9 @@ class OtwChannel {
 
     const OtwFrameStats& Stats() const { return stats_; }
     const ChannelCamera& Camera() const { return camera_; }
+    // The last frame's visibility buffer (supersampled grid): mesh 0 is the sea, mesh i ≥ 1
+    // the (i−1)-th entity.
+    const VisibilityBuffer& Visibility() const { return vis_; }
 
   private:
     const scene::World& world_;
@@ -47,6 +50,9 @@ class OtwChannel {
     OcclusionScene occlusion_;
     std::vector<scene::TriangleMesh> worldMeshes_;  // entity meshes in the world frame
     std::vector<glm::dvec3> reflectance_;           // per entity
+    // Bounding box of all shadow casters, widened well beyond OcclusionScene's own caster
+    // bounds: a cheap inline test that leaves only candidates for MayOcclude.
+    glm::vec3 casterMin_{0.0f}, casterMax_{0.0f};
     scene::OceanMesh ocean_;
     VisibilityBuffer vis_;
     // The sky depends only on the sun and turbidity: rebuilt when they change.

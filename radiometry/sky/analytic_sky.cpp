@@ -2,6 +2,8 @@
 // Appendix A.2: Perez distribution coefficients and zenith values for Y, x, y.
 #include "radiometry/sky/analytic_sky.h"
 
+#include <immintrin.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -30,6 +32,49 @@ glm::vec2 HemiOctFromDirection(glm::vec3 d) {
     const float s = std::abs(d.x) + std::abs(d.y) + d.z;
     const float u = d.x / s, v = d.y / s;
     return {u + v, u - v};
+}
+
+// Four-lane helpers for the batched lookups. They reproduce the scalar code's std::min,
+// std::max, std::clamp and std::abs exactly (including which operand a tie or −0 returns), so
+// the batched and scalar lookups agree bit for bit.
+using F4 = __m128;
+using I4 = __m128i;
+F4 Max4(F4 a, F4 b) { return _mm_max_ps(b, a); }  // std::max(a, b): b when a < b, else a
+F4 Min4(F4 a, F4 b) { return _mm_min_ps(b, a); }  // std::min(a, b): b when b < a, else a
+F4 Clamp4(F4 v, F4 lo, F4 hi) { return Min4(Max4(v, lo), hi); }
+F4 Abs4(F4 v) { return _mm_andnot_ps(_mm_set1_ps(-0.0f), v); }
+I4 MinI4(I4 a, I4 b) {  // SSE2 has no pminsd
+    const I4 bLess = _mm_cmplt_epi32(b, a);
+    return _mm_or_si128(_mm_and_si128(bLess, b), _mm_andnot_si128(bLess, a));
+}
+I4 MaxI4(I4 a, I4 b) {
+    const I4 aLess = _mm_cmplt_epi32(a, b);
+    return _mm_or_si128(_mm_and_si128(aLess, b), _mm_andnot_si128(aLess, a));
+}
+F4 Lerp4(F4 a, F4 b, F4 f) { return _mm_add_ps(a, _mm_mul_ps(_mm_sub_ps(b, a), f)); }
+
+// Loads four rgb(a) texels (one per lane) and transposes them into r, g, b lanes.
+void Gather4(const glm::vec4* t0, const glm::vec4* t1, const glm::vec4* t2, const glm::vec4* t3,
+             F4& r, F4& g, F4& b) {
+    F4 a0 = _mm_loadu_ps(&t0->x), a1 = _mm_loadu_ps(&t1->x), a2 = _mm_loadu_ps(&t2->x),
+       a3 = _mm_loadu_ps(&t3->x);
+    _MM_TRANSPOSE4_PS(a0, a1, a2, a3);
+    r = a0, g = a1, b = a2;
+}
+
+// Loads and stores of count ≤ 4 lanes: a partial last group is padded with a harmless value,
+// so every sample goes through the same four-wide code.
+F4 LoadLanes(const float* p, size_t count, float pad) {
+    if (count == 4) return _mm_loadu_ps(p);
+    alignas(16) float tmp[4] = {pad, pad, pad, pad};
+    for (size_t i = 0; i < count; ++i) tmp[i] = p[i];
+    return _mm_load_ps(tmp);
+}
+void StoreLanes(float* p, size_t count, F4 v) {
+    if (count == 4) return _mm_storeu_ps(p, v);
+    alignas(16) float tmp[4];
+    _mm_store_ps(tmp, v);
+    for (size_t i = 0; i < count; ++i) p[i] = tmp[i];
 }
 
 glm::dvec3 DirectionFromHemiOct(double a, double b) {
@@ -79,22 +124,23 @@ AnalyticSky::AnalyticSky(const glm::dvec3& sunDirection, double sunIlluminance_l
     sunIlluminanceRgb_ = glm::dvec3(sunIlluminance_lux * sunUp);
     sunRadiance_ = sunIlluminanceRgb_ / sunSolidAngle;
 
-    table_.resize(size_t(kTableSize) * size_t(kTableSize));
+    table_.resize(size_t(kTableSize) * size_t(kTableSize), glm::vec4(0.0f));
     for (int j = 0; j < kTableSize; ++j) {
         for (int i = 0; i < kTableSize; ++i) {
             const double a = -1.0 + 2.0 * i / (kTableSize - 1),
                          b = -1.0 + 2.0 * j / (kTableSize - 1);
             table_[size_t(j) * kTableSize + size_t(i)] =
-                glm::vec3(Radiance(DirectionFromHemiOct(a, b)));
+                glm::vec4(glm::vec3(Radiance(DirectionFromHemiOct(a, b))), 0.0f);
         }
     }
 
-    horizon_.resize(kHorizonSize + 1);
+    horizon_.resize(kHorizonSize + 1, glm::vec4(0.0f));
     for (int i = 0; i <= kHorizonSize; ++i) {
         const double t = 4.0 * i / kHorizonSize;  // invert HorizonParameter
         const double u = t <= 2.0 ? t - 1.0 : 3.0 - t;
         const double v = t <= 2.0 ? 1.0 - std::abs(u) : -(1.0 - std::abs(u));
-        horizon_[size_t(i)] = glm::vec3(Radiance(glm::normalize(glm::dvec3(u, v, 0.0))));
+        horizon_[size_t(i)] =
+            glm::vec4(glm::vec3(Radiance(glm::normalize(glm::dvec3(u, v, 0.0)))), 0.0f);
     }
 
     // E_h = ∫ L cosθ dω over the upper hemisphere, midpoint rule in (cosθ, φ): dω = dμ dφ.
@@ -140,18 +186,89 @@ glm::vec3 AnalyticSky::LookUp(const glm::vec3& d) const {
     const float v = std::clamp((st.y + 1.0f) * scale, 0.0f, float(kTableSize - 1));
     const int i0 = std::min(int(u), kTableSize - 2), j0 = std::min(int(v), kTableSize - 2);
     const float fu = u - float(i0), fv = v - float(j0);
-    const glm::vec3* row0 = &table_[size_t(j0) * kTableSize];
-    const glm::vec3* row1 = row0 + kTableSize;
-    const glm::vec3 a = row0[i0] + (row0[i0 + 1] - row0[i0]) * fu;
-    const glm::vec3 b = row1[i0] + (row1[i0 + 1] - row1[i0]) * fu;
+    const glm::vec4* row0 = &table_[size_t(j0) * kTableSize];
+    const glm::vec4* row1 = row0 + kTableSize;
+    const glm::vec3 a00(row0[i0]), a01(row0[i0 + 1]), a10(row1[i0]), a11(row1[i0 + 1]);
+    const glm::vec3 a = a00 + (a01 - a00) * fu;
+    const glm::vec3 b = a10 + (a11 - a10) * fu;
     return a + (b - a) * fv;
+}
+
+void AnalyticSky::LookUp(size_t n, const float* x, const float* y, const float* z, float* r,
+                         float* g, float* b) const {
+    const F4 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
+    const F4 scale = _mm_set1_ps(0.5f * float(kTableSize - 1));
+    const F4 hi = _mm_set1_ps(float(kTableSize - 1));
+    const I4 hiIndex = _mm_set1_epi32(kTableSize - 2);
+    for (size_t k = 0; k < n; k += 4) {
+        const size_t count = std::min<size_t>(4, n - k);
+        // HemiOctFromDirection and the clamped texel coordinates, as in the scalar LookUp.
+        const F4 dx = LoadLanes(x + k, count, 0.0f), dy = LoadLanes(y + k, count, 0.0f);
+        const F4 dz = Max4(LoadLanes(z + k, count, 1.0f), zero);
+        const F4 s = _mm_add_ps(_mm_add_ps(Abs4(dx), Abs4(dy)), dz);
+        const F4 u = _mm_div_ps(dx, s), v = _mm_div_ps(dy, s);
+        const F4 tu = Clamp4(_mm_mul_ps(_mm_add_ps(_mm_add_ps(u, v), one), scale), zero, hi);
+        const F4 tv = Clamp4(_mm_mul_ps(_mm_add_ps(_mm_sub_ps(u, v), one), scale), zero, hi);
+        // tu, tv ≥ 0: truncation is the scalar int() conversion.
+        const I4 i0 = MinI4(_mm_cvttps_epi32(tu), hiIndex);
+        const I4 j0 = MinI4(_mm_cvttps_epi32(tv), hiIndex);
+        const F4 fu = _mm_sub_ps(tu, _mm_cvtepi32_ps(i0));
+        const F4 fv = _mm_sub_ps(tv, _mm_cvtepi32_ps(j0));
+        alignas(16) int32_t offset[4];
+        _mm_store_si128(reinterpret_cast<I4*>(offset),
+                        _mm_add_epi32(i0, _mm_slli_epi32(j0, 7)));  // j0·kTableSize + i0
+        static_assert(kTableSize == 128);
+        const glm::vec4* t = table_.data();
+        const glm::vec4 *p0 = t + offset[0], *p1 = t + offset[1], *p2 = t + offset[2],
+                        *p3 = t + offset[3];
+        F4 r00, g00, b00, r01, g01, b01, r10, g10, b10, r11, g11, b11;
+        Gather4(p0, p1, p2, p3, r00, g00, b00);
+        Gather4(p0 + 1, p1 + 1, p2 + 1, p3 + 1, r01, g01, b01);
+        Gather4(p0 + kTableSize, p1 + kTableSize, p2 + kTableSize, p3 + kTableSize, r10, g10, b10);
+        Gather4(p0 + kTableSize + 1, p1 + kTableSize + 1, p2 + kTableSize + 1, p3 + kTableSize + 1,
+                r11, g11, b11);
+        StoreLanes(r + k, count, Lerp4(Lerp4(r00, r01, fu), Lerp4(r10, r11, fu), fv));
+        StoreLanes(g + k, count, Lerp4(Lerp4(g00, g01, fu), Lerp4(g10, g11, fu), fv));
+        StoreLanes(b + k, count, Lerp4(Lerp4(b00, b01, fu), Lerp4(b10, b11, fu), fv));
+    }
 }
 
 glm::vec3 AnalyticSky::HorizonLookUp(const glm::vec3& d) const {
     const float u = HorizonParameter(d.x, d.y) * (float(kHorizonSize) / 4.0f);
     const int i = std::clamp(int(u), 0, kHorizonSize - 1);
     const float f = std::clamp(u - float(i), 0.0f, 1.0f);
-    return horizon_[size_t(i)] + (horizon_[size_t(i) + 1] - horizon_[size_t(i)]) * f;
+    const glm::vec3 a(horizon_[size_t(i)]), b(horizon_[size_t(i) + 1]);
+    return a + (b - a) * f;
+}
+
+void AnalyticSky::HorizonLookUp(size_t n, const float* x, const float* y, float* r, float* g,
+                                float* b) const {
+    const F4 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), three = _mm_set1_ps(3.0f);
+    const F4 scale = _mm_set1_ps(float(kHorizonSize) / 4.0f);
+    const I4 zeroIndex = _mm_setzero_si128(), hiIndex = _mm_set1_epi32(kHorizonSize - 1);
+    for (size_t k = 0; k < n; k += 4) {
+        const size_t count = std::min<size_t>(4, n - k);
+        const F4 dx = LoadLanes(x + k, count, 1.0f), dy = LoadLanes(y + k, count, 0.0f);
+        // HorizonParameter: lanes with s ≤ 0 divide by zero and are then replaced by 0.
+        const F4 s = _mm_add_ps(Abs4(dx), Abs4(dy));
+        const F4 u = _mm_div_ps(dx, s);
+        const F4 up = _mm_cmpge_ps(dy, zero);
+        F4 t =
+            _mm_or_ps(_mm_and_ps(up, _mm_add_ps(one, u)), _mm_andnot_ps(up, _mm_sub_ps(three, u)));
+        t = _mm_and_ps(_mm_cmpgt_ps(s, zero), t);
+        const F4 tu = _mm_mul_ps(t, scale);
+        const I4 i = MaxI4(MinI4(_mm_cvttps_epi32(tu), hiIndex), zeroIndex);
+        const F4 f = Clamp4(_mm_sub_ps(tu, _mm_cvtepi32_ps(i)), zero, one);
+        alignas(16) int32_t index[4];
+        _mm_store_si128(reinterpret_cast<I4*>(index), i);
+        const glm::vec4* h = horizon_.data();
+        F4 r0, g0, b0, r1, g1, b1;
+        Gather4(h + index[0], h + index[1], h + index[2], h + index[3], r0, g0, b0);
+        Gather4(h + index[0] + 1, h + index[1] + 1, h + index[2] + 1, h + index[3] + 1, r1, g1, b1);
+        StoreLanes(r + k, count, Lerp4(r0, r1, f));
+        StoreLanes(g + k, count, Lerp4(g0, g1, f));
+        StoreLanes(b + k, count, Lerp4(b0, b1, f));
+    }
 }
 
 }  // namespace seasense::radiometry

@@ -2,6 +2,7 @@
 // luminance units (cd/m²), with the sun disc and a direction table for per-sample lookups.
 #pragma once
 
+#include <cstddef>
 #include <glm/glm.hpp>
 #include <vector>
 
@@ -32,6 +33,15 @@ class AnalyticSky {
     // a 1-D table: the airlight colour of distant fog.
     glm::vec3 HorizonLookUp(const glm::vec3& d) const;
 
+    // Batched LookUp / HorizonLookUp over n directions in structure-of-arrays form (x[i],
+    // y[i], z[i]), writing rgb to r[i], g[i], b[i]. Four lanes at a time with SSE2; every
+    // lane does exactly the scalar arithmetic, so results equal the one-at-a-time calls bit
+    // for bit whatever the batch size or a sample's position in it.
+    void LookUp(size_t n, const float* x, const float* y, const float* z, float* r, float* g,
+                float* b) const;
+    void HorizonLookUp(size_t n, const float* x, const float* y, float* r, float* g,
+                       float* b) const;
+
     // Sun disc luminance (cd/m², Rec.709 RGB): illuminance / solid angle of the disc.
     glm::dvec3 SunRadiance() const { return sunRadiance_; }
     glm::dvec3 SunIlluminance() const { return sunIlluminanceRgb_; }
@@ -52,8 +62,10 @@ class AnalyticSky {
     double coefY_[5], coefX_[5], coefYc_[5];
     double normY_, normX_, normYc_;
     glm::dvec3 skyHorizontal_{0.0};
-    std::vector<glm::vec3> table_;    // kTableSize², hemi-octahedral map of the upper hemisphere
-    std::vector<glm::vec3> horizon_;  // kHorizonSize + 1 entries around the horizon
+    // kTableSize², hemi-octahedral map of the upper hemisphere; rgb padded to 16 bytes so a
+    // batched lookup loads one texel per instruction and transposes four of them.
+    std::vector<glm::vec4> table_;
+    std::vector<glm::vec4> horizon_;  // kHorizonSize + 1 entries around the horizon
 };
 
 }  // namespace seasense::radiometry

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 
 namespace seasense::radiometry {
 
@@ -29,6 +30,10 @@ class FresnelTable {
         const float u = std::clamp(cosI, 0.0f, 1.0f) * float(kSize);
         const int i = std::min(int(u), kSize - 1);
         return table_[i] + (table_[i + 1] - table_[i]) * (u - float(i));
+    }
+    // F[k] = (*this)(cosI[k]) for k < n: a tight loop the caller's batches can inline.
+    void operator()(size_t n, const float* cosI, float* F) const {
+        for (size_t k = 0; k < n; ++k) F[k] = (*this)(cosI[k]);
     }
 
   private:

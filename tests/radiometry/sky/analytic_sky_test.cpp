@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "radiometry/color/rec709.h"
 #include "radiometry/surface/fresnel.h"
@@ -55,6 +56,30 @@ TEST(AnalyticSky, TableLookupMatchesDirectEvaluationAwayFromTheSun) {
         EXPECT_NEAR(b.g, a.g, 0.01 * a.g) << "az " << az << " el " << el;
         const glm::dvec3 h = sky.Radiance({d.x, d.y, 0.0});
         EXPECT_NEAR(sky.HorizonLookUp(glm::vec3(d)).g, h.g, 0.01 * h.g) << "az " << az;
+    }
+}
+
+TEST(AnalyticSky, BatchedLookupsEqualSingleLookupsBitForBit) {
+    const AnalyticSky sky(SunAt(40.0), 8e4, 4.0);
+    const size_t n = 103;  // not a multiple of the batch width
+    std::vector<float> x(n), y(n), z(n), r(n), g(n), b(n), hr(n), hg(n), hb(n);
+    for (size_t i = 0; i < n; ++i) {
+        const double az = 0.37 * double(i), el = -0.2 + 1.7 * double(i) / n;
+        x[i] = float(std::cos(el) * std::sin(az));
+        y[i] = float(std::cos(el) * std::cos(az));
+        z[i] = float(std::sin(el));
+    }
+    sky.LookUp(n, x.data(), y.data(), z.data(), r.data(), g.data(), b.data());
+    sky.HorizonLookUp(n, x.data(), y.data(), hr.data(), hg.data(), hb.data());
+    for (size_t i = 0; i < n; ++i) {
+        const glm::vec3 one = sky.LookUp(glm::vec3(x[i], y[i], z[i]));
+        EXPECT_EQ(one.r, r[i]);
+        EXPECT_EQ(one.g, g[i]);
+        EXPECT_EQ(one.b, b[i]);
+        const glm::vec3 h = sky.HorizonLookUp(glm::vec3(x[i], y[i], z[i]));
+        EXPECT_EQ(h.r, hr[i]);
+        EXPECT_EQ(h.g, hg[i]);
+        EXPECT_EQ(h.b, hb[i]);
     }
 }
 
