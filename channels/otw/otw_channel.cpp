@@ -258,43 +258,51 @@ struct SeaShading {
 
 }  // namespace
 
+namespace {
+
+// Calls fn(d) for unit world directions along the boundary of the camera's frustum (33 per
+// edge); fn returns false to stop early.
+template <class Fn>
+void ForEachFrustumBoundaryDirection(const ChannelCamera& cam, Fn&& fn) {
+    constexpr int kSteps = 32;
+    for (int e = 0; e < 4; ++e) {
+        for (int i = 0; i <= kSteps; ++i) {
+            const double s = double(i) / kSteps;
+            const double u = e == 0 ? s : e == 1 ? 1.0 : e == 2 ? 1.0 - s : 0.0;
+            const double v = e == 0 ? 0.0 : e == 1 ? s : e == 2 ? 1.0 : 1.0 - s;
+            if (!fn(cam.SampleDirection(u * cam.SampleWidth() - 0.5, v * cam.SampleHeight() - 0.5)))
+                return;
+        }
+    }
+}
+
+// Whether the straight-down direction lies inside the frustum (its boundary winds around it).
+bool FrustumContainsNadir(const ChannelCamera& cam) {
+    const glm::dvec3 down =
+        glm::transpose(cam.worldFromCamera.worldFromBody) * glm::dvec3(0, 0, -1);
+    if (down.y <= 0.0) return false;  // behind the camera
+    return std::abs(down.x / down.y) <= cam.TanHalfH() &&
+           std::abs(down.z / down.y) <= cam.TanHalfV();
+}
+
+}  // namespace
+
 void FrustumAzimuthSector(const ChannelCamera& cam, double margin, double& lo, double& hi) {
     const glm::dvec3 axis = cam.worldFromCamera.worldFromBody * glm::dvec3(0, 1, 0);
     const double centre = std::atan2(axis.x, axis.y);
     double minRel = 0.0, maxRel = 0.0;
     bool full = false;
-    // Walk the frustum boundary: its azimuth extremes lie on the boundary.
-    const int steps = 32;
-    for (int e = 0; e < 4 && !full; ++e) {
-        for (int i = 0; i <= steps; ++i) {
-            const double s = double(i) / steps;
-            double u = 0, v = 0;
-            switch (e) {
-                case 0:
-                    u = s, v = 0;
-                    break;
-                case 1:
-                    u = 1, v = s;
-                    break;
-                case 2:
-                    u = 1 - s, v = 1;
-                    break;
-                default:
-                    u = 0, v = 1 - s;
-                    break;
-            }
-            const glm::dvec3 d =
-                cam.SampleDirection(u * cam.SampleWidth() - 0.5, v * cam.SampleHeight() - 0.5);
-            if (std::hypot(d.x, d.y) < 0.05) {
-                full = true;  // within ~3° of the zenith or nadir: all azimuths are near
-                break;
-            }
-            double rel = std::atan2(d.x, d.y) - centre;
-            rel = std::remainder(rel, 2.0 * M_PI);
-            minRel = std::min(minRel, rel);
-            maxRel = std::max(maxRel, rel);
+    // The azimuth extremes of a convex cone of directions lie on its boundary.
+    ForEachFrustumBoundaryDirection(cam, [&](const glm::dvec3& d) {
+        if (std::hypot(d.x, d.y) < 0.05) {
+            full = true;  // within ~3° of the zenith or nadir: all azimuths are near
+            return false;
         }
-    }
+        const double rel = std::remainder(std::atan2(d.x, d.y) - centre, 2.0 * M_PI);
+        minRel = std::min(minRel, rel);
+        maxRel = std::max(maxRel, rel);
+        return true;
+    });
     if (full || maxRel - minRel + 2.0 * margin >= 2.0 * M_PI) {
         lo = 0.0;
         hi = 2.0 * M_PI;
@@ -302,6 +310,22 @@ void FrustumAzimuthSector(const ChannelCamera& cam, double margin, double& lo, d
     }
     lo = centre + minRel - margin;
     hi = centre + maxRel + margin;
+}
+
+double NearestVisibleSeaRange_m(const ChannelCamera& cam, double crestHeight_m,
+                                double horizontalReach_m) {
+    const double h = cam.worldFromCamera.position_m.z - crestHeight_m;
+    if (h <= 0.0 || FrustumContainsNadir(cam)) return 0.0;
+    // The steepest downward view ray meets the crest plane nearest: range = h / slope.
+    double slope = 0.0;
+    ForEachFrustumBoundaryDirection(cam, [&](const glm::dvec3& d) {
+        slope = std::max(slope, -d.z / std::max(std::hypot(d.x, d.y), 1e-9));
+        return true;
+    });
+    if (slope <= 0.0) return std::numeric_limits<double>::infinity();  // no ray looks down
+    // Sampled boundary and straight-line rays: keep a 20 % margin, then allow for vertices
+    // that the waves carry horizontally toward the eye.
+    return std::max(0.0, 0.8 * h / slope - horizontalReach_m);
 }
 
 OtwChannel::OtwChannel(const scene::World& world, const scene::ChannelSettings& settings)
@@ -343,7 +367,9 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     req.time_s = state.time_s;
     req.angularStep_rad = kOceanVertexSpacing_px * cam.hfov_rad / double(cam.width);
     FrustumAzimuthSector(cam, 20.0 * M_PI / 180.0, req.azimuthMin_rad, req.azimuthMax_rad);
-    scene::BuildOceanMesh(world_.Ocean(), req, ocean_);
+    const scene::GerstnerOcean& sea = world_.Ocean();
+    req.minRange_m = NearestVisibleSeaRange_m(cam, sea.MaxAmplitude_m(), sea.MaxHorizontal_m());
+    scene::BuildOceanMesh(sea, req, ocean_);
 
     std::vector<RasterMesh> meshes;
     // The sea is seen from both sides only when a camera dips below it; cull back faces.

@@ -67,4 +67,11 @@ class OtwChannel {
 void FrustumAzimuthSector(const ChannelCamera& camera, double margin_rad, double& min_rad,
                           double& max_rad);
 
+// Horizontal distance (m) inside which no sea can be seen by the camera: the steepest
+// downward view ray meets the plane of the highest crest, less a 20 % margin and the waves'
+// horizontal reach. 0 when the eye is below the crests or looks straight down; +∞ when no
+// view ray points down.
+double NearestVisibleSeaRange_m(const ChannelCamera& camera, double crestHeight_m,
+                                double horizontalReach_m);
+
 }  // namespace seasense::channels

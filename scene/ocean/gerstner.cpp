@@ -38,6 +38,7 @@ GerstnerOcean::GerstnerOcean(const OceanSettings& settings) {
         horizontal_.push_back(w.steepness * w.amplitude_m / std::tanh(k * settings.depth_m));
         phase_.push_back(w.phase_rad);
         maxAmplitude_m_ += w.amplitude_m;
+        maxHorizontal_m_ += horizontal_.back();
         minWavelength_m_ = std::min(minWavelength_m_, w.wavelength_m);
     }
 }

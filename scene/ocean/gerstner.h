@@ -61,6 +61,8 @@ class GerstnerOcean {
     size_t WaveCount() const { return k_.size(); }
     // Largest |elevation| the waves can reach: Σ A_i (m).
     double MaxAmplitude_m() const { return maxAmplitude_m_; }
+    // Largest horizontal displacement the waves can cause: Σ Q A / tanh(kh) (m).
+    double MaxHorizontal_m() const { return maxHorizontal_m_; }
     // Shortest wavelength among the waves (m), for mesh resolution choices.
     double MinWavelength_m() const { return minWavelength_m_; }
 
@@ -72,6 +74,7 @@ class GerstnerOcean {
     std::vector<double> horizontal_;   // horizontal orbit semi-axis Q·A / tanh(kh), m
     std::vector<double> phase_;        // rad
     double maxAmplitude_m_ = 0.0;
+    double maxHorizontal_m_ = 0.0;
     double minWavelength_m_ = 1e30;
 };
 

@@ -34,9 +34,22 @@ void BuildOceanMesh(const GerstnerOcean& ocean, const OceanMeshRequest& req, Oce
     const double dphi = req.angularStep_rad;
 
     std::vector<double> radii;
-    // Start well inside the nearest visible water: horizontal orbits can pull crests inward.
-    double r = std::max(0.05, 0.25 * hEff);
-    radii.push_back(0.0);
+    if (!(req.minRange_m < maxRange)) {  // nothing visible (also catches NaN)
+        out.positions.clear();
+        out.normals.clear();
+        out.jacobian.clear();
+        out.indices.clear();
+        out.rings = out.segments = 0;
+        return;
+    }
+    double r;
+    if (req.minRange_m > 0.0) {
+        r = req.minRange_m;
+    } else {
+        // A centre vertex under the eye, then rings from well inside the nearest water.
+        radii.push_back(0.0);
+        r = std::max(0.05, 0.25 * hEff);
+    }
     while (r < maxRange) {
         radii.push_back(r);
         const double step = std::min(r * dphi * std::max(1.0, r / hEff), 8.0 * r * dphi);

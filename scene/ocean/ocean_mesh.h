@@ -27,6 +27,9 @@ struct OceanMeshRequest {
     double azimuthMax_rad = 0.0;    // max − min ≥ 2π means the full circle
     double angularStep_rad = 0.01;  // target angle between neighbouring vertices seen from the eye
     double time_s = 0.0;
+    // No sea nearer than this can be seen (e.g. below the view): the grid starts here rather
+    // than under the eye. +∞ means no sea is visible at all (an empty mesh).
+    double minRange_m = 0.0;
 };
 
 struct OceanMesh {

@@ -24,17 +24,23 @@ void IntegrateFootprint(const Image& samples, int n, Image& out) {
         out = Image(samples.width / n, samples.height / n, samples.channels);
     const int c = samples.channels;
     const float inv = 1.0f / float(n * n);
+    const size_t rowValues = size_t(c) * size_t(out.width);
     tbb::parallel_for(0, out.height, [&](int y) {
-        std::vector<float> acc(size_t(c) * size_t(out.width));
+        float* dst = out.At(0, y);
+        // Rows of samples are summed in order sy = 0 … n−1, then each pixel's sx in order:
+        // the same sums for any thread count.
         for (int sy = 0; sy < n; ++sy) {
             const float* row = samples.At(0, y * n + sy);
-            for (int x = 0; x < out.width; ++x)
-                for (int sx = 0; sx < n; ++sx)
-                    for (int k = 0; k < c; ++k)
-                        acc[size_t(x * c + k)] += row[size_t((x * n + sx) * c + k)];
+            for (int x = 0; x < out.width; ++x) {
+                for (int k = 0; k < c; ++k) {
+                    float sum = row[size_t((x * n) * c + k)];
+                    for (int sx = 1; sx < n; ++sx) sum += row[size_t((x * n + sx) * c + k)];
+                    float& d = dst[size_t(x * c + k)];
+                    d = sy == 0 ? sum : d + sum;
+                }
+            }
         }
-        float* dst = out.At(0, y);
-        for (size_t i = 0; i < acc.size(); ++i) dst[i] = acc[i] * inv;
+        for (size_t i = 0; i < rowValues; ++i) dst[i] *= inv;
     });
 }
 

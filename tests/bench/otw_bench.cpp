@@ -67,8 +67,10 @@ void BM_OceanMesh(benchmark::State& state) {
     const ChannelCamera cam = MakeChannelCamera(world.State(0).eyepoint, ch);
     scene::OceanMeshRequest req;
     req.eye_m = cam.worldFromCamera.position_m;
-    req.angularStep_rad = 4.0 * cam.hfov_rad / double(cam.width);
+    req.angularStep_rad = 6.0 * cam.hfov_rad / double(cam.width);
     FrustumAzimuthSector(cam, 20.0 * M_PI / 180.0, req.azimuthMin_rad, req.azimuthMax_rad);
+    req.minRange_m = NearestVisibleSeaRange_m(cam, world.Ocean().MaxAmplitude_m(),
+                                              world.Ocean().MaxHorizontal_m());
     scene::OceanMesh mesh;
     for (auto _ : state) {
         arena.execute([&] { scene::BuildOceanMesh(world.Ocean(), req, mesh); });
