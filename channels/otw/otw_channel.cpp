@@ -142,11 +142,15 @@ int MayHit4(const RayBoxTest& box, F4 ox, F4 oy, F4 oz) {
     return _mm_movemask_ps(_mm_and_ps(inside, _mm_cmple_ps(t0, t1)));
 }
 
-// Shadow-ray origin for surface point p with unit normal n seen from eye: offset along the
-// normal by a range-proportional amount against self-shadowing.
-glm::vec3 ShadowRayOrigin(const glm::vec3& p, const glm::vec3& n, const glm::vec3& eye) {
-    const float range = glm::length(eye - p);
-    return p + n * (1e-3f * range + 1e-3f);
+// Shadow-ray origin for surface point p with unit normal n: offset along the normal against
+// self-shadowing by 1 mm plus 32 float ulps of the largest coordinate (4e-6 relative), which
+// covers the rounding of positions rebuilt from float vertices and barycentrics. A larger
+// offset would shorten shadows by offset / tan(sun elevation).
+float ShadowOffset_m(const glm::vec3& p) {
+    return 4e-6f * std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)}) + 1e-3f;
+}
+glm::vec3 ShadowRayOrigin(const glm::vec3& p, const glm::vec3& n) {
+    return p + n * ShadowOffset_m(p);
 }
 
 // Tag of shadow-ray owners that are sea samples (indices into the sea arrays).
@@ -188,8 +192,10 @@ struct SeaShading {
             const F4 ty = _mm_sub_ps(Set4(eye.y), LoadLanes(py + i, lanes, 0.0f));
             const F4 tz = _mm_sub_ps(Set4(eye.z), LoadLanes(pz + i, lanes, 0.0f));
             const F4 range = _mm_sqrt_ps(Dot4(tx, ty, tz, tx, ty, tz));
-            const F4 vx = _mm_div_ps(tx, range), vy = _mm_div_ps(ty, range),
-                     vz = _mm_div_ps(tz, range);
+            // One division for the three components (differs from t / range by rounding).
+            const F4 invRange = _mm_div_ps(Set4(1.0f), range);
+            const F4 vx = _mm_mul_ps(tx, invRange), vy = _mm_mul_ps(ty, invRange),
+                     vz = _mm_mul_ps(tz, invRange);
             const F4 ndv = Dot4(Nx, Ny, Nz, vx, vy, vz);
             const F4 twoNdv = _mm_mul_ps(Set4(2.0f), ndv);
             const F4 rz = _mm_sub_ps(_mm_mul_ps(twoNdv, Nz), vz);
@@ -221,7 +227,9 @@ struct SeaShading {
 
         const F4 zero = _mm_setzero_ps(), one = Set4(1.0f);
         const F4 glintLimit = Set4(60.0f * slopeVar);
-        const F4 glintNorm = Set4(float(M_PI) * slopeVar);
+        // Reciprocals of the frame's constants: multiplications in the loop, not divisions.
+        const F4 minusInvSlopeVar = Set4(-1.0f / slopeVar);
+        const F4 invGlintNorm = Set4(1.0f / (float(M_PI) * slopeVar));
         for (size_t i = 0; i < count; i += 4) {
             const F4 F = _mm_load_ps(ch.F + i), oneMinusF = _mm_sub_ps(one, F);
             const F4 cosV = _mm_load_ps(ch.cosV + i), cos2 = _mm_load_ps(ch.cos2 + i);
@@ -232,8 +240,8 @@ struct SeaShading {
             const F4 glint = _mm_and_ps(_mm_and_ps(_mm_cmpgt_ps(_mm_load_ps(ch.cosS + i), zero),
                                                    _mm_cmpgt_ps(sunVis, zero)),
                                         _mm_cmplt_ps(tan2, glintLimit));
-            const F4 p = _mm_div_ps(
-                ExpNonPositive4(_mm_div_ps(_mm_sub_ps(zero, tan2), Set4(slopeVar))), glintNorm);
+            const F4 p =
+                _mm_mul_ps(ExpNonPositive4(_mm_mul_ps(tan2, minusInvSlopeVar)), invGlintNorm);
             const F4 g =
                 _mm_div_ps(_mm_mul_ps(_mm_load_ps(ch.Fs + i), p),
                            _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(Set4(4.0f), cosV), cos2), cos2));
@@ -255,6 +263,49 @@ struct SeaShading {
         }
     }
 };
+
+// Per-thread scratch of the shading pass. Samples of a row block are sorted into sky, sea and
+// model lists so that each kind is shaded in a tight loop: sky and sea four lanes at a time in
+// structure-of-arrays chunks (the bulk of the frame), the few model samples one by one. The
+// sky and sea lists only grow (their used length is counted separately), so that a block
+// never zero-fills them.
+struct BlockScratch {
+    std::vector<uint32_t> skyK, seaK, modelK;                     // sample index within the block
+    std::vector<float> skyX, skyY, skyZ;                          // view directions of sky samples
+    std::vector<float> seaPx, seaPy, seaPz, seaNx, seaNy, seaNz;  // unit normals
+    std::vector<glm::vec3> modelPosition, modelNormal;
+    std::vector<int> modelMesh;
+    std::vector<glm::vec3> origins;
+    std::vector<uint8_t> lit, vis;  // lit: sun visibility of model samples, by k
+    std::vector<float> seaLit;      // sun visibility of sea samples
+    // originOwner: sample index k of a model sample, or kSeaOwner | sea index.
+    std::vector<uint32_t> originOwner;
+    SeaChunk chunk{};  // zeroed: lanes past a chunk's end are computed, then dropped
+
+    // Makes the sky and sea lists hold at least n samples.
+    void Reserve(size_t n) {
+        if (skyK.size() >= n) return;
+        for (std::vector<float>* v :
+             {&skyX, &skyY, &skyZ, &seaPx, &seaPy, &seaPz, &seaNx, &seaNy, &seaNz})
+            v->resize(n);
+        skyK.resize(n), seaK.resize(n);
+    }
+};
+
+// Vertex positions and normals of the triangle last met in a sample row, as SSE (x, y, z, 0):
+// neighbouring samples mostly see the same triangle, so its six vertices are gathered once.
+struct CachedTriangle {
+    uint32_t prim = kNoPrimitive;
+    int mesh = 0;
+    F4 p0 = _mm_setzero_ps(), p1 = p0, p2 = p0, n0 = p0, n1 = p0, n2 = p0;
+};
+
+F4 Load3(const glm::vec3& v) { return _mm_setr_ps(v.x, v.y, v.z, 0.0f); }
+
+// b0·a0 + b1·a1 + b2·a2 per component, in glm's order ((b0 a0 + b1 a1) + b2 a2).
+F4 Interpolate3(F4 b0, F4 b1, F4 b2, F4 a0, F4 a1, F4 a2) {
+    return _mm_add_ps(_mm_add_ps(_mm_mul_ps(b0, a0), _mm_mul_ps(b1, a1)), _mm_mul_ps(b2, a2));
+}
 
 }  // namespace
 
@@ -349,6 +400,12 @@ OtwChannel::OtwChannel(const scene::World& world, const scene::ChannelSettings& 
     casterMax_ = hi + margin_m;
 }
 
+struct OtwChannel::ShadeScratch {
+    tbb::enumerable_thread_specific<BlockScratch> perThread;
+};
+
+OtwChannel::~OtwChannel() = default;
+
 void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     const scene::Scenario& sc = world_.GetScenario();
     const scene::EnvironmentSettings& env = sc.environment;
@@ -419,23 +476,9 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     const glm::vec3 colStep(R * glm::dvec3(2.0 * tanH / sw, 0.0, 0.0));
     const glm::dvec3 forward = R * glm::dvec3(0.0, 1.0, 0.0);
 
-    // Per-thread scratch. Samples of a row block are sorted into sky, sea and model lists so
-    // that each kind is shaded in a tight loop: sky and sea four lanes at a time in
-    // structure-of-arrays chunks (the bulk of the frame), the few model samples one by one.
-    struct Scratch {
-        std::vector<uint32_t> skyK, seaK, modelK;  // sample index within the block
-        std::vector<float> skyX, skyY, skyZ;       // view directions of sky samples
-        std::vector<float> seaPx, seaPy, seaPz, seaNx, seaNy, seaNz;  // unit normals
-        std::vector<glm::vec3> modelPosition, modelNormal;
-        std::vector<int> modelMesh;
-        std::vector<glm::vec3> origins;
-        std::vector<uint8_t> lit, vis;  // lit: sun visibility of model samples, by k
-        std::vector<float> seaLit;      // sun visibility of sea samples
-        // originOwner: sample index k of a model sample, or kSeaOwner | sea index.
-        std::vector<uint32_t> originOwner;
-        SeaChunk chunk{};  // zeroed: lanes past a chunk's end are computed, then dropped
-    };
-    tbb::enumerable_thread_specific<Scratch> scratch;
+    // Per-thread scratch (see BlockScratch), created on the first frame.
+    if (!scratch_) scratch_ = std::make_unique<ShadeScratch>();
+    tbb::enumerable_thread_specific<BlockScratch>& scratch = scratch_->perThread;
 
     // Mesh m's primitives are [primitiveBase[m], primitiveBase[m + 1]); mesh 0 is the sea.
     struct MeshRef {
@@ -457,10 +500,8 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     tbb::parallel_for(0, blocks, [&](int block) {
         const int y0 = block * kRowsPerBlock, y1 = std::min(sh, y0 + kRowsPerBlock);
         const size_t n = size_t(y1 - y0) * size_t(sw);
-        Scratch& sc = scratch.local();
-        sc.skyK.clear(), sc.skyX.clear(), sc.skyY.clear(), sc.skyZ.clear();
-        sc.seaK.clear(), sc.seaPx.clear(), sc.seaPy.clear(), sc.seaPz.clear();
-        sc.seaNx.clear(), sc.seaNy.clear(), sc.seaNz.clear();
+        BlockScratch& sc = scratch.local();
+        sc.Reserve(n);
         sc.modelK.clear(), sc.modelPosition.clear(), sc.modelNormal.clear(), sc.modelMesh.clear();
         sc.lit.assign(n, 1);
         sc.origins.clear();
@@ -473,15 +514,17 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
         }
 
         // Pass 1: sort samples by kind; surface position and normal.
-        sc.skyX.resize(n), sc.skyY.resize(n), sc.skyZ.resize(n), sc.skyK.resize(n);
-        sc.seaPx.resize(n), sc.seaPy.resize(n), sc.seaPz.resize(n), sc.seaK.resize(n);
-        sc.seaNx.resize(n), sc.seaNy.resize(n), sc.seaNz.resize(n);
         size_t skyCount = 0, seaCount = 0;
+        CachedTriangle tri;
         for (int y = y0; y < y1; ++y) {
+            const size_t rowIdx = vis_.Index(0, y);
+            const uint32_t* primRow = vis_.primitive.data() + rowIdx;
+            const float* b1Row = vis_.b1.data() + rowIdx;
+            const float* b2Row = vis_.b2.data() + rowIdx;
+            const uint32_t kRow = uint32_t(size_t(y - y0) * size_t(sw));
             for (int x = 0; x < sw; ++x) {
-                const uint32_t k = uint32_t(size_t(y - y0) * size_t(sw) + size_t(x));
-                const size_t idx = vis_.Index(x, y);
-                const uint32_t prim = vis_.primitive[idx];
+                const uint32_t k = kRow + uint32_t(x);
+                const uint32_t prim = primRow[x];
                 if (prim == kNoPrimitive) {
                     // View direction, normalized in the sky pass.
                     const glm::vec3 d = rowBase[y - y0] + (float(x) + 0.5f) * colStep;
@@ -490,36 +533,44 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
                     ++skyCount;
                     continue;
                 }
-                int mesh = 0;
-                if (prim >= firstModelPrimitive) {
-                    mesh = 1;
-                    while (mesh + 1 < int(vis_.primitiveBase.size()) &&
-                           prim >= vis_.primitiveBase[size_t(mesh) + 1])
-                        ++mesh;
+                if (prim != tri.prim) {
+                    int mesh = 0;
+                    if (prim >= firstModelPrimitive) {
+                        mesh = 1;
+                        while (mesh + 1 < int(vis_.primitiveBase.size()) &&
+                               prim >= vis_.primitiveBase[size_t(mesh) + 1])
+                            ++mesh;
+                    }
+                    const MeshRef& m = meshRefs[size_t(mesh)];
+                    const uint32_t t = prim - vis_.primitiveBase[size_t(mesh)];
+                    const uint32_t i0 = m.I[3 * t], i1 = m.I[3 * t + 1], i2 = m.I[3 * t + 2];
+                    tri.prim = prim, tri.mesh = mesh;
+                    tri.p0 = Load3(m.P[i0]), tri.p1 = Load3(m.P[i1]), tri.p2 = Load3(m.P[i2]);
+                    tri.n0 = Load3(m.N[i0]), tri.n1 = Load3(m.N[i1]), tri.n2 = Load3(m.N[i2]);
                 }
-                const MeshRef& m = meshRefs[size_t(mesh)];
-                const uint32_t tri = prim - vis_.primitiveBase[size_t(mesh)];
-                const uint32_t i0 = m.I[3 * tri], i1 = m.I[3 * tri + 1], i2 = m.I[3 * tri + 2];
-                const float b1 = vis_.b1[idx], b2 = vis_.b2[idx], b0 = 1.0f - b1 - b2;
-                const glm::vec3 p = b0 * m.P[i0] + b1 * m.P[i1] + b2 * m.P[i2];
-                const glm::vec3 nSum = b0 * m.N[i0] + b1 * m.N[i1] + b2 * m.N[i2];
-                if (mesh == 0) {
+                const float b1 = b1Row[x], b2 = b2Row[x], b0 = 1.0f - b1 - b2;
+                const F4 w0 = Set4(b0), w1 = Set4(b1), w2 = Set4(b2);
+                alignas(16) float p[4], nSum[4];
+                _mm_store_ps(p, Interpolate3(w0, w1, w2, tri.p0, tri.p1, tri.p2));
+                _mm_store_ps(nSum, Interpolate3(w0, w1, w2, tri.n0, tri.n1, tri.n2));
+                if (tri.mesh == 0) {
                     // Normalized, and shadow origins found, four lanes at a time below.
                     sc.seaK[seaCount] = k;
-                    sc.seaPx[seaCount] = p.x, sc.seaPy[seaCount] = p.y, sc.seaPz[seaCount] = p.z;
-                    sc.seaNx[seaCount] = nSum.x, sc.seaNy[seaCount] = nSum.y;
-                    sc.seaNz[seaCount] = nSum.z;
+                    sc.seaPx[seaCount] = p[0], sc.seaPy[seaCount] = p[1], sc.seaPz[seaCount] = p[2];
+                    sc.seaNx[seaCount] = nSum[0], sc.seaNy[seaCount] = nSum[1];
+                    sc.seaNz[seaCount] = nSum[2];
                     ++seaCount;
                     continue;
                 }
-                glm::vec3 nrm = glm::normalize(nSum);
-                if (glm::dot(nrm, eye - p) < 0.0f) nrm = -nrm;
+                const glm::vec3 position(p[0], p[1], p[2]);
+                glm::vec3 nrm = glm::normalize(glm::vec3(nSum[0], nSum[1], nSum[2]));
+                if (glm::dot(nrm, eye - position) < 0.0f) nrm = -nrm;
                 sc.modelK.push_back(k);
-                sc.modelPosition.push_back(p);
+                sc.modelPosition.push_back(position);
                 sc.modelNormal.push_back(nrm);
-                sc.modelMesh.push_back(mesh);
+                sc.modelMesh.push_back(tri.mesh);
                 if (shadows) {
-                    const glm::vec3 o = ShadowRayOrigin(p, nrm, eye);
+                    const glm::vec3 o = ShadowRayOrigin(position, nrm);
                     if (casters.MayHit(o) && occlusion_.MayOcclude(o, sunDir, 1e30f)) {
                         sc.origins.push_back(o);
                         sc.originOwner.push_back(k);
@@ -527,7 +578,6 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
                 }
             }
         }
-        sc.skyK.resize(skyCount), sc.seaK.resize(seaCount);
         sc.seaLit.assign(seaCount, 1.0f);
         Normalize(seaCount, sc.seaNx.data(), sc.seaNy.data(), sc.seaNz.data());
         if (shadows) {
@@ -538,10 +588,12 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
                 const F4 px = LoadLanes(&sc.seaPx[i], lanes, eye.x);
                 const F4 py = LoadLanes(&sc.seaPy[i], lanes, eye.y);
                 const F4 pz = LoadLanes(&sc.seaPz[i], lanes, eye.z);
-                const F4 tx = _mm_sub_ps(Set4(eye.x), px), ty = _mm_sub_ps(Set4(eye.y), py),
-                         tz = _mm_sub_ps(Set4(eye.z), pz);
-                const F4 range = _mm_sqrt_ps(Dot4(tx, ty, tz, tx, ty, tz));
-                const F4 offset = _mm_add_ps(_mm_mul_ps(Set4(1e-3f), range), Set4(1e-3f));
+                // ShadowOffset_m, four lanes: |v| by clearing the sign bit.
+                const F4 absMask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+                const F4 maxAbs =
+                    _mm_max_ps(_mm_max_ps(_mm_and_ps(px, absMask), _mm_and_ps(py, absMask)),
+                               _mm_and_ps(pz, absMask));
+                const F4 offset = _mm_add_ps(_mm_mul_ps(Set4(4e-6f), maxAbs), Set4(1e-3f));
                 alignas(16) float o[3][4];
                 _mm_store_ps(
                     o[0], _mm_add_ps(px, _mm_mul_ps(LoadLanes(&sc.seaNx[i], lanes, 0.0f), offset)));
@@ -578,8 +630,8 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
         float* out = radiance.At(0, y0);
 
         // Pass 2a: sky samples.
-        for (size_t c = 0; c < sc.skyK.size(); c += kChunk) {
-            const size_t count = std::min(kChunk, sc.skyK.size() - c);
+        for (size_t c = 0; c < skyCount; c += kChunk) {
+            const size_t count = std::min(kChunk, skyCount - c);
             float *dx = &sc.skyX[c], *dy = &sc.skyY[c], *dz = &sc.skyZ[c];
             Normalize(count, dx, dy, dz);
             SeaChunk& ch = sc.chunk;
@@ -593,8 +645,8 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
         }
 
         // Pass 2b: sea samples.
-        for (size_t c = 0; c < sc.seaK.size(); c += kChunk) {
-            const size_t count = std::min(kChunk, sc.seaK.size() - c);
+        for (size_t c = 0; c < seaCount; c += kChunk) {
+            const size_t count = std::min(kChunk, seaCount - c);
             SeaChunk& ch = sc.chunk;
             std::copy_n(&sc.seaLit[c], count, ch.sunVis);
             seaShading.Shade(count, &sc.seaPx[c], &sc.seaPy[c], &sc.seaPz[c], &sc.seaNx[c],

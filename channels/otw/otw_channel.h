@@ -30,6 +30,7 @@ class OtwChannel {
   public:
     // Builds the occlusion scene from the world's models (committed once; static).
     OtwChannel(const scene::World& world, const scene::ChannelSettings& settings);
+    ~OtwChannel();
 
     // Renders the supersampled at-aperture radiance of frame `state` into radiance:
     // (width·N)×(height·N)×3, linear Rec.709, cd/m² (Y = luminance). Runs in the caller's
@@ -43,6 +44,10 @@ class OtwChannel {
     const VisibilityBuffer& Visibility() const { return vis_; }
 
   private:
+    // Per-thread shading scratch, kept between frames so that a frame neither allocates nor
+    // zero-fills its sample lists (fresh pages cost page faults on every frame).
+    struct ShadeScratch;
+
     const scene::World& world_;
     scene::ChannelSettings settings_;
     ChannelCamera camera_;
@@ -59,6 +64,7 @@ class OtwChannel {
     std::unique_ptr<radiometry::AnalyticSky> sky_;
     glm::dvec3 skySun_{0.0};
     double skySunLux_ = -1.0;
+    std::unique_ptr<ShadeScratch> scratch_;
     OtwFrameStats stats_;
 };
 

@@ -5,6 +5,8 @@
 #include <tbb/task_arena.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 
 #include "scene/ocean/ocean_mesh.h"
 
@@ -62,6 +64,73 @@ TEST(OtwChannel, SeaHorizonDipsByTheGeometricDipAngle) {
         for (int y = 0; y < vis.height; ++y)
             EXPECT_EQ(vis.primitive[vis.Index(x, y)] != kNoPrimitive, y >= firstSea) << y;
     }
+}
+
+// Writes an OBJ (glTF axes: +X left, +Y up, +Z forward) of an axis-aligned box with the given
+// body-frame extents (x right, y forward, z up), faces counter-clockwise from outside.
+void WriteBoxObj(const std::filesystem::path& file, glm::vec3 lo, glm::vec3 hi) {
+    std::ofstream out(file);
+    for (int i = 0; i < 8; ++i) {
+        const glm::vec3 p((i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z);
+        out << "v " << -p.x << " " << p.z << " " << p.y << "\n";  // body → glTF axes
+    }
+    // Body-frame quads, counter-clockwise seen from outside (1-based OBJ indices).
+    const int quads[6][4] = {{1, 3, 4, 2}, {5, 6, 8, 7}, {1, 2, 6, 5},
+                             {3, 7, 8, 4}, {1, 5, 7, 3}, {2, 4, 8, 6}};
+    // The body → glTF map is a proper rotation, so windings carry over unchanged.
+    for (const auto& q : quads)
+        out << "f " << q[0] << " " << q[1] << " " << q[2] << "\nf " << q[0] << " " << q[2] << " "
+            << q[3] << "\n";
+}
+
+TEST(OtwChannel, BoxShadowOnAPlateHasLengthHeightOverTanElevation) {
+    // A 2 × 2 × 4 m box on a large plate, seen straight down from 100 m: the plate plane is
+    // parallel to the image plane, so ground distance is linear in pixels. The shadow of a
+    // box of height h under a sun at elevation e reaches h / tan(e) beyond its base.
+    const std::filesystem::path dir =
+        std::filesystem::temp_directory_path() / ("seasense_shadow_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    const double h = 4.0, plateTop = 0.2;
+    WriteBoxObj(dir / "plate.obj", {-30, -30, 0}, {30, 30, float(plateTop)});
+    WriteBoxObj(dir / "box.obj", {-1, -1, float(plateTop)}, {1, 1, float(plateTop + h)});
+    for (double elevation_deg : {30.0, 50.0}) {
+        scene::Scenario sc = CalmSeaScenario(100.0, 12.0);
+        sc.materials = {{"grey", glm::dvec3(0.5)}};
+        sc.entities.push_back({"plate", dir / "plate.obj", {0, 0, 0}, {}, 1.0, "grey"});
+        sc.entities.push_back({"box", dir / "box.obj", {0, 0, 0}, {}, 1.0, "grey"});
+        // Sun in the west: the shadow falls toward +x (east).
+        sc.environment.sun.azimuth_rad = 1.5 * M_PI;
+        sc.environment.sun.elevation_rad = elevation_deg * M_PI / 180.0;
+        sc.eyepoint.attitude.pitch_rad = -0.5 * M_PI;  // looking straight down, image up = north
+        scene::ChannelSettings& ch = sc.channels[0];
+        ch.width = 640;
+        ch.height = 480;
+        ch.supersampling = 1;
+        ch.shadows = true;
+        const scene::World world(sc);
+        OtwChannel otw(world, ch);
+        Image radiance;
+        tbb::task_arena arena(2);
+        arena.execute([&] { otw.Render(world.State(0), radiance); });
+        const ChannelCamera& cam = otw.Camera();
+        // Ground sample distance on the plate: 2 · d · tan(hfov / 2) / width.
+        const double distance = 100.0 - plateTop;
+        const double gsd = 2.0 * distance * cam.TanHalfH() / cam.width;
+        const int row = cam.height / 2;
+        const auto groundX = [&](int px) { return (px + 0.5 - cam.width / 2.0) * gsd; };
+        // Lit plate luminance far from the box; shadow = below half of it.
+        const float lit = radiance.At(cam.width - 20, row)[1];
+        int lastShadow = -1;
+        for (int px = cam.width / 2; px < cam.width; ++px) {
+            if (groundX(px) < 1.2) continue;  // the box top covers the base in the image
+            if (radiance.At(px, row)[1] < 0.5f * lit) lastShadow = px;
+        }
+        ASSERT_GE(lastShadow, 0) << "no shadow found";
+        const double expectedEnd = 1.0 + h / std::tan(elevation_deg * M_PI / 180.0);
+        // The last shadowed pixel's far edge lies within one pixel of the shadow's end.
+        EXPECT_NEAR(groundX(lastShadow) + 0.5 * gsd, expectedEnd, gsd) << elevation_deg << "°";
+    }
+    std::filesystem::remove_all(dir);
 }
 
 }  // namespace
