@@ -40,6 +40,7 @@ void BuildOceanMesh(const GerstnerOcean& ocean, const OceanMeshRequest& req, Oce
         out.jacobian.clear();
         out.indices.clear();
         out.rings = out.segments = 0;
+        out.fullCircle = false;
         return;
     }
     double r;
@@ -64,8 +65,18 @@ void BuildOceanMesh(const GerstnerOcean& ocean, const OceanMeshRequest& req, Oce
     const int columns = full ? segments : segments + 1;  // the full circle wraps its last column
     const int rings = int(radii.size());
 
+    // The index buffer depends only on the grid's shape: rebuilt when that changes.
+    const bool sameShape = out.rings == rings && out.segments == segments &&
+                           out.fullCircle == full && !out.indices.empty();
     out.rings = rings;
     out.segments = segments;
+    out.fullCircle = full;
+    std::vector<double> sinAz(static_cast<size_t>(columns)), cosAz(static_cast<size_t>(columns));
+    for (int i = 0; i < columns; ++i) {
+        const double az = req.azimuthMin_rad + span * double(i) / double(segments);
+        sinAz[size_t(i)] = std::sin(az);
+        cosAz[size_t(i)] = std::cos(az);
+    }
     out.positions.resize(size_t(rings) * size_t(columns));
     out.normals.resize(out.positions.size());
     out.jacobian.resize(out.positions.size());
@@ -74,8 +85,8 @@ void BuildOceanMesh(const GerstnerOcean& ocean, const OceanMeshRequest& req, Oce
         const double radius = radii[size_t(j)];
         const double drop = CurvatureDrop_m(radius);
         for (int i = 0; i < columns; ++i) {
-            const double az = req.azimuthMin_rad + span * double(i) / double(segments);
-            const float rx = float(radius * std::sin(az)), ry = float(radius * std::cos(az));
+            const float rx = float(radius * sinAz[size_t(i)]);
+            const float ry = float(radius * cosAz[size_t(i)]);
             const size_t v = size_t(j) * size_t(columns) + size_t(i);
             glm::vec3 p;
             local.Evaluate(rx, ry, p, out.normals[v], out.jacobian[v]);
@@ -85,6 +96,7 @@ void BuildOceanMesh(const GerstnerOcean& ocean, const OceanMeshRequest& req, Oce
         }
     });
 
+    if (sameShape) return;
     out.indices.clear();
     out.indices.reserve(size_t(rings - 1) * size_t(segments) * 6);
     for (int j = 0; j + 1 < rings; ++j) {

@@ -39,6 +39,7 @@ struct OceanMesh {
     std::vector<uint32_t> indices;     // counter-clockwise seen from above
     int rings = 0;
     int segments = 0;
+    bool fullCircle = false;
 };
 
 // Builds the mesh for one view. Rings are spaced so that each step subtends about

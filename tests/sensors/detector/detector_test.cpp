@@ -25,16 +25,28 @@ TEST(Detector, BoxFootprintAttenuatesASineByTheDiscreteSinc) {
     }
 }
 
-TEST(Detector, IntegrationConservesTheImageMean) {
-    Image s(30, 18, 3);
-    for (size_t i = 0; i < s.pixels.size(); ++i) s.pixels[i] = float((i * 7919) % 101);
-    const Image p = IntegrateFootprint(s, 3);
-    ASSERT_EQ(p.width, 10);
-    ASSERT_EQ(p.height, 6);
-    double a = 0, b = 0;
-    for (float v : s.pixels) a += v;
-    for (float v : p.pixels) b += v;
-    EXPECT_NEAR(a / double(s.pixels.size()), b / double(p.pixels.size()), 1e-4);
+TEST(Detector, EachPixelIsTheMeanOfItsSamplesAndTheImageMeanIsConserved) {
+    for (int n : {2, 3}) {
+        for (int c : {1, 3}) {
+            Image s(12 * n, 6 * n, c);
+            for (size_t i = 0; i < s.pixels.size(); ++i) s.pixels[i] = float((i * 7919) % 101);
+            const Image p = IntegrateFootprint(s, n);
+            ASSERT_EQ(p.width, 12);
+            ASSERT_EQ(p.height, 6);
+            double a = 0, b = 0;
+            for (float v : s.pixels) a += v;
+            for (float v : p.pixels) b += v;
+            EXPECT_NEAR(a / double(s.pixels.size()), b / double(p.pixels.size()), 1e-4);
+            for (int y = 0; y < 6; ++y)
+                for (int x = 0; x < 12; ++x)
+                    for (int k = 0; k < c; ++k) {
+                        double mean = 0;
+                        for (int sy = 0; sy < n; ++sy)
+                            for (int sx = 0; sx < n; ++sx) mean += s.At(x * n + sx, y * n + sy)[k];
+                        EXPECT_NEAR(p.At(x, y)[k], mean / (n * n), 1e-4);
+                    }
+        }
+    }
 }
 
 TEST(Detector, AutoExposureMapsGeometricMeanLuminanceToKey) {
