@@ -2,7 +2,6 @@
 // on the sea; Lambertian models lit by sun (shadowed) and sky; Koschmieder fog.
 #include "channels/otw/otw_channel.h"
 
-#include <immintrin.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
@@ -13,10 +12,13 @@
 
 #include "radiometry/sky/analytic_sky.h"
 #include "radiometry/surface/fresnel.h"
+#include "scene/core/simd4.h"
 
 namespace seasense::channels {
 
 namespace {
+
+using namespace simd4;
 
 // Remote-sensing reflectance R_rs = L_w / E_d of clear oceanic (Case 1) water, sr⁻¹, at the
 // Rec.709 primaries' dominant wavelengths (≈ 610, 550, 465 nm); order of magnitude from
@@ -68,28 +70,6 @@ float CoxMunkSlopeVariance(double windSpeed_mps) {
 // Four-lane (SSE2, the x86-64 baseline) arithmetic for the sky and sea passes. Each lane does
 // the scalar code's operations in the scalar code's order, so a sample's result does not
 // depend on its neighbours, the batch size or the thread count.
-using F4 = __m128;
-using I4 = __m128i;
-F4 Set4(float v) { return _mm_set1_ps(v); }
-F4 Max4(F4 a, F4 b) { return _mm_max_ps(b, a); }  // std::max(a, b): b when a < b, else a
-F4 Select4(F4 mask, F4 a, F4 b) { return _mm_or_ps(_mm_and_ps(mask, a), _mm_andnot_ps(mask, b)); }
-F4 Dot4(F4 ax, F4 ay, F4 az, F4 bx, F4 by, F4 bz) {  // (x + y) + z, as glm::dot
-    return _mm_add_ps(_mm_add_ps(_mm_mul_ps(ax, bx), _mm_mul_ps(ay, by)), _mm_mul_ps(az, bz));
-}
-
-// Loads count ≤ 4 lanes from p, padding the rest with a harmless value.
-F4 LoadLanes(const float* p, size_t count, float pad) {
-    if (count == 4) return _mm_loadu_ps(p);
-    alignas(16) float tmp[4] = {pad, pad, pad, pad};
-    for (size_t i = 0; i < count; ++i) tmp[i] = p[i];
-    return _mm_load_ps(tmp);
-}
-void StoreLanes(float* p, size_t count, F4 v) {
-    if (count == 4) return _mm_storeu_ps(p, v);
-    alignas(16) float tmp[4];
-    _mm_store_ps(tmp, v);
-    for (size_t i = 0; i < count; ++i) p[i] = tmp[i];
-}
 
 // e^x for x ≤ 0 (0 below −87, where e^x leaves float's normal range). Cody & Waite range
 // reduction ("Software Manual for the Elementary Functions", 1980): x = k ln 2 + r with
@@ -588,11 +568,8 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
                 const F4 px = LoadLanes(&sc.seaPx[i], lanes, eye.x);
                 const F4 py = LoadLanes(&sc.seaPy[i], lanes, eye.y);
                 const F4 pz = LoadLanes(&sc.seaPz[i], lanes, eye.z);
-                // ShadowOffset_m, four lanes: |v| by clearing the sign bit.
-                const F4 absMask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
-                const F4 maxAbs =
-                    _mm_max_ps(_mm_max_ps(_mm_and_ps(px, absMask), _mm_and_ps(py, absMask)),
-                               _mm_and_ps(pz, absMask));
+                // ShadowOffset_m, four lanes.
+                const F4 maxAbs = _mm_max_ps(_mm_max_ps(Abs4(px), Abs4(py)), Abs4(pz));
                 const F4 offset = _mm_add_ps(_mm_mul_ps(Set4(4e-6f), maxAbs), Set4(1e-3f));
                 alignas(16) float o[3][4];
                 _mm_store_ps(

@@ -2,16 +2,17 @@
 // Appendix A.2: Perez distribution coefficients and zenith values for Y, x, y.
 #include "radiometry/sky/analytic_sky.h"
 
-#include <immintrin.h>
-
 #include <algorithm>
 #include <cmath>
 
 #include "radiometry/color/rec709.h"
+#include "scene/core/simd4.h"
 
 namespace seasense::radiometry {
 
 namespace {
+
+using namespace simd4;
 
 constexpr int kTableSize = 128;
 constexpr int kHorizonSize = 512;
@@ -37,12 +38,8 @@ glm::vec2 HemiOctFromDirection(glm::vec3 d) {
 // Four-lane helpers for the batched lookups. They reproduce the scalar code's std::min,
 // std::max, std::clamp and std::abs exactly (including which operand a tie or −0 returns), so
 // the batched and scalar lookups agree bit for bit.
-using F4 = __m128;
-using I4 = __m128i;
-F4 Max4(F4 a, F4 b) { return _mm_max_ps(b, a); }  // std::max(a, b): b when a < b, else a
 F4 Min4(F4 a, F4 b) { return _mm_min_ps(b, a); }  // std::min(a, b): b when b < a, else a
 F4 Clamp4(F4 v, F4 lo, F4 hi) { return Min4(Max4(v, lo), hi); }
-F4 Abs4(F4 v) { return _mm_andnot_ps(_mm_set1_ps(-0.0f), v); }
 I4 MinI4(I4 a, I4 b) {  // SSE2 has no pminsd
     const I4 bLess = _mm_cmplt_epi32(b, a);
     return _mm_or_si128(_mm_and_si128(bLess, b), _mm_andnot_si128(bLess, a));
@@ -60,21 +57,6 @@ void Gather4(const glm::vec4* t0, const glm::vec4* t1, const glm::vec4* t2, cons
        a3 = _mm_loadu_ps(&t3->x);
     _MM_TRANSPOSE4_PS(a0, a1, a2, a3);
     r = a0, g = a1, b = a2;
-}
-
-// Loads and stores of count ≤ 4 lanes: a partial last group is padded with a harmless value,
-// so every sample goes through the same four-wide code.
-F4 LoadLanes(const float* p, size_t count, float pad) {
-    if (count == 4) return _mm_loadu_ps(p);
-    alignas(16) float tmp[4] = {pad, pad, pad, pad};
-    for (size_t i = 0; i < count; ++i) tmp[i] = p[i];
-    return _mm_load_ps(tmp);
-}
-void StoreLanes(float* p, size_t count, F4 v) {
-    if (count == 4) return _mm_storeu_ps(p, v);
-    alignas(16) float tmp[4];
-    _mm_store_ps(tmp, v);
-    for (size_t i = 0; i < count; ++i) p[i] = tmp[i];
 }
 
 glm::dvec3 DirectionFromHemiOct(double a, double b) {

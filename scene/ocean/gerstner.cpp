@@ -23,6 +23,7 @@ double GroupSpeed(double k, double depth_m) {
 
 GerstnerOcean::GerstnerOcean(const OceanSettings& settings) {
     CHECK(settings.depth_m > 0.0);
+    CHECK(settings.waves.size() <= kMaxWaves);
     for (const GerstnerWaveSettings& w : settings.waves) {
         CHECK(w.wavelength_m > 0.0);
         const double k = 2.0 * M_PI / w.wavelength_m;
@@ -43,35 +44,62 @@ GerstnerOcean::GerstnerOcean(const OceanSettings& settings) {
     }
 }
 
-SurfaceSample GerstnerOcean::Evaluate(double x0, double y0, double t) const {
-    double dx = 0.0, dy = 0.0, z = 0.0;
-    // Partial derivatives of the displaced position with respect to (x0, y0).
-    double dxdx = 1.0, dxdy = 0.0, dydy = 1.0, dzdx = 0.0, dzdy = 0.0;
-    const size_t n = k_.size();
+namespace {
+
+// Displacement of the surface and its derivatives with respect to the rest position.
+template <class Real>
+struct WaveSum {
+    Real dx = 0, dy = 0, z = 0;
+    Real dxdx = 1, dxdy = 0, dydy = 1, dzdx = 0, dzdy = 0;
+};
+
+// Σ over waves of the Gerstner displacement at rest offset (x, y), where wave i has phase
+// k_i (d_i · (x, y)) + phase_i; shared by the double query path and the float mesh path.
+template <class Real>
+WaveSum<Real> SumWaves(size_t n, const Real* dirX, const Real* dirY, const Real* k,
+                       const Real* amplitude, const Real* horizontal, const Real* phase, Real x,
+                       Real y) {
+    WaveSum<Real> w;
     for (size_t i = 0; i < n; ++i) {
-        const double theta = k_[i] * (dirX_[i] * x0 + dirY_[i] * y0) - omega_[i] * t + phase_[i];
-        const double s = std::sin(theta), c = std::cos(theta);
-        const double h = horizontal_[i];
-        dx -= dirX_[i] * h * s;
-        dy -= dirY_[i] * h * s;
-        z += amplitude_[i] * c;
-        const double hkc = h * k_[i] * c;
-        dxdx -= dirX_[i] * dirX_[i] * hkc;
-        dxdy -= dirX_[i] * dirY_[i] * hkc;
-        dydy -= dirY_[i] * dirY_[i] * hkc;
-        const double aks = amplitude_[i] * k_[i] * s;
-        dzdx -= dirX_[i] * aks;
-        dzdy -= dirY_[i] * aks;
+        const Real theta = k[i] * (dirX[i] * x + dirY[i] * y) + phase[i];
+        const Real s = std::sin(theta), c = std::cos(theta);
+        const Real h = horizontal[i];
+        w.dx -= dirX[i] * h * s;
+        w.dy -= dirY[i] * h * s;
+        w.z += amplitude[i] * c;
+        const Real hkc = h * k[i] * c;
+        w.dxdx -= dirX[i] * dirX[i] * hkc;
+        w.dxdy -= dirX[i] * dirY[i] * hkc;
+        w.dydy -= dirY[i] * dirY[i] * hkc;
+        const Real aks = amplitude[i] * k[i] * s;
+        w.dzdx -= dirX[i] * aks;
+        w.dzdy -= dirY[i] * aks;
     }
+    return w;
+}
+
+// Upward unit normal from the tangents ∂P/∂x0 = (dxdx, dxdy, dzdx), ∂P/∂y0 = (dxdy, dydy, dzdy).
+template <class Real>
+glm::vec<3, Real> UpwardNormal(const WaveSum<Real>& w) {
+    using V = glm::vec<3, Real>;
+    V nrm = glm::cross(V(w.dxdx, w.dxdy, w.dzdx), V(w.dxdy, w.dydy, w.dzdy));
+    const Real len = glm::length(nrm);
+    nrm = len > Real(0) ? nrm / len : V(0, 0, 1);
+    return nrm.z < Real(0) ? -nrm : nrm;  // folded surface: keep the normal upward
+}
+
+}  // namespace
+
+SurfaceSample GerstnerOcean::Evaluate(double x0, double y0, double t) const {
+    const size_t n = k_.size();
+    double phase[kMaxWaves];
+    for (size_t i = 0; i < n; ++i) phase[i] = phase_[i] - omega_[i] * t;
+    const WaveSum<double> w = SumWaves(n, dirX_.data(), dirY_.data(), k_.data(), amplitude_.data(),
+                                       horizontal_.data(), phase, x0, y0);
     SurfaceSample out;
-    out.position = {x0 + dx, y0 + dy, z};
-    // Tangents ∂P/∂x0 = (dxdx, dxdy, dzdx), ∂P/∂y0 = (dxdy, dydy, dzdy); normal = their cross.
-    const glm::dvec3 tx{dxdx, dxdy, dzdx}, ty{dxdy, dydy, dzdy};
-    glm::dvec3 nrm = glm::cross(tx, ty);
-    const double len = glm::length(nrm);
-    out.normal = len > 0.0 ? nrm / len : glm::dvec3(0.0, 0.0, 1.0);
-    if (out.normal.z < 0.0) out.normal = -out.normal;  // folded surface: keep the normal upward
-    out.jacobian = dxdx * dydy - dxdy * dxdy;
+    out.position = {x0 + w.dx, y0 + w.dy, w.z};
+    out.normal = UpwardNormal(w);
+    out.jacobian = w.dxdx * w.dydy - w.dxdy * w.dxdy;
     return out;
 }
 
@@ -91,31 +119,12 @@ GerstnerOcean::LocalFrame GerstnerOcean::Local(double ox, double oy, double t) c
 
 void GerstnerOcean::LocalFrame::Evaluate(float rx, float ry, glm::vec3& position, glm::vec3& normal,
                                          float& jacobian) const {
-    // The same sums as GerstnerOcean::Evaluate, in float.
-    float dx = 0.0f, dy = 0.0f, z = 0.0f;
-    float dxdx = 1.0f, dxdy = 0.0f, dydy = 1.0f, dzdx = 0.0f, dzdy = 0.0f;
-    const size_t n = k_.size();
-    for (size_t i = 0; i < n; ++i) {
-        const float theta = k_[i] * (dirX_[i] * rx + dirY_[i] * ry) + phase0_[i];
-        const float s = std::sin(theta), c = std::cos(theta);
-        const float h = horizontal_[i];
-        dx -= dirX_[i] * h * s;
-        dy -= dirY_[i] * h * s;
-        z += amplitude_[i] * c;
-        const float hkc = h * k_[i] * c;
-        dxdx -= dirX_[i] * dirX_[i] * hkc;
-        dxdy -= dirX_[i] * dirY_[i] * hkc;
-        dydy -= dirY_[i] * dirY_[i] * hkc;
-        const float aks = amplitude_[i] * k_[i] * s;
-        dzdx -= dirX_[i] * aks;
-        dzdy -= dirY_[i] * aks;
-    }
-    position = {rx + dx, ry + dy, z};
-    glm::vec3 nrm = glm::cross(glm::vec3(dxdx, dxdy, dzdx), glm::vec3(dxdy, dydy, dzdy));
-    const float len = glm::length(nrm);
-    nrm = len > 0.0f ? nrm / len : glm::vec3(0.0f, 0.0f, 1.0f);
-    normal = nrm.z < 0.0f ? -nrm : nrm;
-    jacobian = dxdx * dydy - dxdy * dxdy;
+    const WaveSum<float> w =
+        SumWaves(k_.size(), dirX_.data(), dirY_.data(), k_.data(), amplitude_.data(),
+                 horizontal_.data(), phase0_.data(), rx, ry);
+    position = {rx + w.dx, ry + w.dy, w.z};
+    normal = UpwardNormal(w);
+    jacobian = w.dxdx * w.dydy - w.dxdy * w.dxdy;
 }
 
 SurfaceSample GerstnerOcean::SampleAt(double x, double y, double t) const {

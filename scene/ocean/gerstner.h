@@ -12,6 +12,9 @@ namespace seasense::scene {
 // Standard gravity, m/s² (CGPM 1901; BIPM SI Brochure, 9th ed.).
 inline constexpr double kGravity_mps2 = 9.80665;
 
+// Most wave components a GerstnerOcean holds (the scenario schema's limit).
+inline constexpr size_t kMaxWaves = 64;
+
 // Angular frequency of a linear surface gravity wave of wavenumber k (rad/m) in water of
 // depth h (m): ω² = g k tanh(k h) (Airy theory; physics.md).
 double DispersionOmega(double k_radpm, double depth_m);

@@ -1,5 +1,5 @@
-// Polar-grid sea mesh: chosen over a clipmap for now because a grid centred on the eye gives a
-// screen-uniform vertex density from the eye to the horizon with one crack-free mesh.
+// Polar-grid sea mesh: a grid centred on the eye gives a screen-uniform vertex density from the
+// eye to the horizon as one mesh, so there are no level-of-detail seams to stitch.
 #include "scene/ocean/ocean_mesh.h"
 
 #include <tbb/parallel_for.h>

@@ -11,6 +11,7 @@
 #include "scene/config/config.h"
 #include "scene/config/digest.h"
 #include "scene/config/suggest.h"
+#include "scene/ocean/gerstner.h"
 
 namespace seasense::scene {
 
@@ -20,7 +21,6 @@ constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 // Largest image side in pixels, before and after supersampling (issue 2).
 constexpr int64_t kMaxImageSide = 16384;
 constexpr int64_t kMaxSupersampling = 8;
-constexpr size_t kMaxWaves = 64;
 constexpr size_t kMaxChannels = 64;
 constexpr size_t kMaxEntities = 100000;
 
