@@ -5,6 +5,7 @@
 #include <string>
 
 #include "channels/cli/capture.h"
+#include "channels/cli/query_sky.h"
 #include "scene/core/check.h"
 #include "scene/core/error.h"
 
@@ -59,6 +60,26 @@ int main(int argc, char** argv) {
     capture->add_option("--threads", cap.threads, "Worker threads (0 = all cores)")
         ->capture_default_str();
 
+    seasense::channels::QuerySkyOptions sky;
+    CLI::App* query = app.add_subcommand("query", "Ask the scene core a question");
+    query->require_subcommand(1);
+    CLI::App* querySky = query->add_subcommand(
+        "sky",
+        "Sun and moon apparent altitude/azimuth (deg, azimuth from north through east), moon\n"
+        "illuminated fraction and phase angle, natural illuminance in lux (USNO Circular 171),\n"
+        "twilight state (day|civil|nautical|astronomical|night) and the next rise and set of\n"
+        "sun and moon.");
+    querySky->add_option("--lat", sky.latitude_deg, "Latitude, degrees north")->required();
+    querySky->add_option("--lon", sky.longitude_deg, "Longitude, degrees east")->required();
+    querySky->add_option("--time", sky.time, "Instant, ISO-8601 UTC")->required();
+    querySky->add_option("--height-m", sky.height_m, "Observer height above the ellipsoid, m")
+        ->capture_default_str();
+    querySky
+        ->add_option("--sky-divisor", sky.skyDivisor,
+                     "Sky condition divisor of illuminance: 1 clear ... 10 dark stratus")
+        ->capture_default_str();
+    querySky->add_flag("--json", sky.json, "Print JSON instead of text");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -70,6 +91,8 @@ int main(int argc, char** argv) {
         if (capture->parsed()) {
             cap.formats = SplitCommas(formats);
             seasense::channels::RunCapture(cap);
+        } else if (querySky->parsed()) {
+            seasense::channels::RunQuerySky(sky);
         }
         return 0;
     } catch (const seasense::InputError& e) {
