@@ -131,12 +131,13 @@ FrameRecord ChannelPipeline::RenderAndWrite(int64_t frame) {
     char stem[64];
     std::snprintf(stem, sizeof stem, "_%06lld", (long long)frame);
     const std::string base = channel_.name + stem;
+    std::vector<uint8_t> display;  // the display transform runs once, for any 8-bit formats
     for (const std::string& fmt : formats_) {
         const std::filesystem::path path = channelDir_ / (base + "." + fmt);
         if (fmt == "exr") {
             sensors::WriteExr(path, pixels, md);
         } else {
-            const std::vector<uint8_t> display = display_->ToDisplay8(pixels, scale);
+            if (display.empty()) display = display_->ToDisplay8(pixels, scale);
             sensors::WriteDisplayImage8(path, display, pixels.width, pixels.height, 3, md);
         }
         rec.files.push_back(path);

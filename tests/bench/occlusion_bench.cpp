@@ -7,14 +7,13 @@
 #include <vector>
 
 #include "channels/occlusion/occlusion.h"
+#include "tests/support/meshes.h"
 
 namespace seasense::channels {
 namespace {
 
-struct BenchMesh {
-    std::vector<glm::vec3> positions;
-    std::vector<uint32_t> indices;
-};
+using BenchMesh = seasense::testing::SimpleMesh;
+using seasense::testing::MakeBox;
 
 // Latitude-longitude sphere: 2·stacks·slices triangles (poles keep their degenerate ones,
 // which Embree skips, so the count stays simple).
@@ -37,18 +36,6 @@ BenchMesh MakeSphere(const glm::vec3& centre, float radius_m, int stacks, int sl
             mesh.indices.insert(mesh.indices.end(), {a, c, b, b, c, d});
         }
     }
-    return mesh;
-}
-
-BenchMesh MakeBox(const glm::vec3& lo, const glm::vec3& hi) {
-    BenchMesh mesh;
-    for (int corner = 0; corner < 8; ++corner)
-        mesh.positions.emplace_back(corner & 1 ? hi.x : lo.x, corner & 2 ? hi.y : lo.y,
-                                    corner & 4 ? hi.z : lo.z);
-    const uint32_t faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
-                                  {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-    for (const auto& f : faces)
-        mesh.indices.insert(mesh.indices.end(), {f[0], f[1], f[2], f[0], f[2], f[3]});
     return mesh;
 }
 

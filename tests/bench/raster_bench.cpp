@@ -7,16 +7,14 @@
 #include <vector>
 
 #include "channels/raster/rasterizer.h"
+#include "tests/support/meshes.h"
 
 namespace seasense::channels {
 namespace {
 
 constexpr int kGridCells = 256;
 
-struct BenchGrid {
-    std::vector<glm::vec3> positions;
-    std::vector<uint32_t> indices;
-};
+using BenchGrid = seasense::testing::SimpleMesh;
 
 // A 32 m × 26 m plane tilted 45° away from a camera at the origin looking down −z: view
 // depths from ~6 m to ~24 m, so triangle sizes on screen vary by ~4× across the frame.

@@ -3,7 +3,6 @@
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <cmath>
 #include <cstdio>
@@ -13,6 +12,8 @@
 #include <sstream>
 #include <string>
 
+#include "tests/support/shell.h"
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -20,22 +21,8 @@ namespace {
 const fs::path kSource = SEASENSE_SOURCE_DIR;
 const fs::path kScenario = kSource / "tests/data/scenarios/capture-small.yaml";
 
-struct Result {
-    int status = -1;
-    std::string output;  // stdout + stderr
-};
-
-Result Shell(const std::string& command) {
-    Result r;
-    FILE* p = popen((command + " 2>&1").c_str(), "r");
-    if (!p) return r;
-    char buf[4096];
-    size_t n;
-    while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
-    const int s = pclose(p);
-    r.status = WIFEXITED(s) ? WEXITSTATUS(s) : 128 + WTERMSIG(s);
-    return r;
-}
+using Result = seasense::testing::ShellResult;
+using seasense::testing::Shell;
 
 std::string Seasense() { return std::string(SEASENSE_BINARY); }
 

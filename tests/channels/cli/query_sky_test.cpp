@@ -1,30 +1,18 @@
 // `seasense query sky` end to end: JSON keys, published solstice and full-moon facts, errors.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
-#include <cstdio>
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "tests/support/shell.h"
+
 namespace {
 
-struct Result {
-    int status = -1;
-    std::string output;
-};
+using Result = seasense::testing::ShellResult;
 
-Result Shell(const std::string& args, bool mergeStderr = true) {
-    Result r;
-    const std::string command =
-        std::string(SEASENSE_BINARY) + " " + args + (mergeStderr ? " 2>&1" : " 2>/dev/null");
-    FILE* p = popen(command.c_str(), "r");
-    if (!p) return r;
-    char buf[4096];
-    size_t n;
-    while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
-    const int s = pclose(p);
-    r.status = WIFEXITED(s) ? WEXITSTATUS(s) : 128 + WTERMSIG(s);
-    return r;
+// Runs the seasense binary under test with args.
+Result Seasense(const std::string& args, bool mergeStderr = true) {
+    return seasense::testing::Shell(std::string(SEASENSE_BINARY) + " " + args, mergeStderr);
 }
 
 TEST(QuerySky, SolsticeNoonSunStandsOverTheTropicOfCancer) {
@@ -32,7 +20,7 @@ TEST(QuerySky, SolsticeNoonSunStandsOverTheTropicOfCancer) {
     // noon on the Tropic of Cancer it stands in the zenith. 2026-06-21, longitude 0: apparent
     // noon ≈ 12:02 UTC (equation of time ≈ −1.6 min).
     const Result r =
-        Shell("query sky --lat 23.4367 --lon 0 --time 2026-06-21T12:02:00Z --json", false);
+        Seasense("query sky --lat 23.4367 --lon 0 --time 2026-06-21T12:02:00Z --json", false);
     ASSERT_EQ(r.status, 0) << r.output;
     const auto j = nlohmann::json::parse(r.output);
     EXPECT_GT(j["sun"]["altitude_deg"].get<double>(), 89.5);
@@ -52,7 +40,7 @@ TEST(QuerySky, SolsticeNoonSunStandsOverTheTropicOfCancer) {
 TEST(QuerySky, FullMoonIsFullyIlluminated) {
     // USNO lists the full moon of 2024-01-25 at 17:54 UTC.
     const Result r =
-        Shell("query sky --lat 38.89 --lon -77.03 --time 2024-01-25T17:54:00Z --json", false);
+        Seasense("query sky --lat 38.89 --lon -77.03 --time 2024-01-25T17:54:00Z --json", false);
     ASSERT_EQ(r.status, 0) << r.output;
     const auto j = nlohmann::json::parse(r.output);
     EXPECT_GT(j["moon"]["illuminated_fraction"].get<double>(), 0.99);
@@ -60,17 +48,18 @@ TEST(QuerySky, FullMoonIsFullyIlluminated) {
 }
 
 TEST(QuerySky, TextOutputAndBadInput) {
-    Result r = Shell("query sky --lat 10 --lon 20 --time 2026-03-20T00:00:00Z");
+    Result r = Seasense("query sky --lat 10 --lon 20 --time 2026-03-20T00:00:00Z");
     ASSERT_EQ(r.status, 0) << r.output;
     EXPECT_NE(r.output.find("twilight"), std::string::npos);
-    EXPECT_EQ(Shell("query sky --lat 91 --lon 0 --time 2026-03-20T00:00:00Z").status, 2);
-    EXPECT_EQ(Shell("query sky --lat 0 --lon 200 --time 2026-03-20T00:00:00Z").status, 2);
-    r = Shell("query sky --lat 0 --lon 0 --time yesterday");
+    EXPECT_EQ(Seasense("query sky --lat 91 --lon 0 --time 2026-03-20T00:00:00Z").status, 2);
+    EXPECT_EQ(Seasense("query sky --lat 0 --lon 200 --time 2026-03-20T00:00:00Z").status, 2);
+    r = Seasense("query sky --lat 0 --lon 0 --time yesterday");
     EXPECT_EQ(r.status, 2);
     EXPECT_NE(r.output.find("ISO-8601"), std::string::npos) << r.output;
     EXPECT_EQ(
-        Shell("query sky --lat 0 --lon 0 --time 2026-03-20T00:00:00Z --sky-divisor 20").status, 2);
-    EXPECT_EQ(Shell("query sky --lon 0 --time 2026-03-20T00:00:00Z").status, 2);
+        Seasense("query sky --lat 0 --lon 0 --time 2026-03-20T00:00:00Z --sky-divisor 20").status,
+        2);
+    EXPECT_EQ(Seasense("query sky --lon 0 --time 2026-03-20T00:00:00Z").status, 2);
 }
 
 }  // namespace

@@ -12,28 +12,13 @@
 #include "scene/core/check.h"
 #include "scene/core/error.h"
 #include "scene/core/rng.h"
+#include "tests/support/meshes.h"
 
 namespace seasense::channels {
 namespace {
 
-struct TestMesh {
-    std::vector<glm::vec3> positions;
-    std::vector<uint32_t> indices;
-};
-
-// Axis-aligned box as 8 corners and 12 triangles (two per face).
-TestMesh MakeBox(const glm::vec3& lo, const glm::vec3& hi) {
-    TestMesh mesh;
-    for (int corner = 0; corner < 8; ++corner)
-        mesh.positions.emplace_back(corner & 1 ? hi.x : lo.x, corner & 2 ? hi.y : lo.y,
-                                    corner & 4 ? hi.z : lo.z);
-    // Each face as a quad of corner indices, split along one diagonal.
-    const uint32_t faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
-                                  {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-    for (const auto& f : faces)
-        mesh.indices.insert(mesh.indices.end(), {f[0], f[1], f[2], f[0], f[2], f[3]});
-    return mesh;
-}
+using TestMesh = seasense::testing::SimpleMesh;
+using seasense::testing::MakeBox;
 
 // Square ground plane z = 0 of half-size halfSize_m around the origin (2 triangles).
 TestMesh MakeGround(float halfSize_m) {

@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "scene/ocean/ocean_mesh.h"
+#include "tests/support/meshes.h"
 
 namespace seasense::channels {
 namespace {
@@ -66,21 +67,17 @@ TEST(OtwChannel, SeaHorizonDipsByTheGeometricDipAngle) {
     }
 }
 
-// Writes an OBJ (glTF axes: +X left, +Y up, +Z forward) of an axis-aligned box with the given
-// body-frame extents (x right, y forward, z up), faces counter-clockwise from outside.
+// Writes testing::MakeBox(lo, hi), given in body axes (x right, y forward, z up), as an OBJ in
+// glTF axes (+X left, +Y up, +Z forward). The axis map is a proper rotation, so the box's
+// outward winding carries over.
 void WriteBoxObj(const std::filesystem::path& file, glm::vec3 lo, glm::vec3 hi) {
+    const seasense::testing::SimpleMesh box = seasense::testing::MakeBox(lo, hi);
     std::ofstream out(file);
-    for (int i = 0; i < 8; ++i) {
-        const glm::vec3 p((i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z);
-        out << "v " << -p.x << " " << p.z << " " << p.y << "\n";  // body → glTF axes
-    }
-    // Body-frame quads, counter-clockwise seen from outside (1-based OBJ indices).
-    const int quads[6][4] = {{1, 3, 4, 2}, {5, 6, 8, 7}, {1, 2, 6, 5},
-                             {3, 7, 8, 4}, {1, 5, 7, 3}, {2, 4, 8, 6}};
-    // The body → glTF map is a proper rotation, so windings carry over unchanged.
-    for (const auto& q : quads)
-        out << "f " << q[0] << " " << q[1] << " " << q[2] << "\nf " << q[0] << " " << q[2] << " "
-            << q[3] << "\n";
+    for (const glm::vec3& p : box.positions)
+        out << "v " << -p.x << " " << p.z << " " << p.y << "\n";
+    for (size_t t = 0; t < box.indices.size(); t += 3)
+        out << "f " << box.indices[t] + 1 << " " << box.indices[t + 1] + 1 << " "
+            << box.indices[t + 2] + 1 << "\n";
 }
 
 TEST(OtwChannel, BoxShadowOnAPlateHasLengthHeightOverTanElevation) {
