@@ -6,6 +6,7 @@
 
 #include "channels/cli/capture.h"
 #include "channels/cli/query_sky.h"
+#include "channels/cli/run.h"
 #include "scene/core/check.h"
 #include "scene/core/error.h"
 
@@ -60,6 +61,55 @@ int main(int argc, char** argv) {
     capture->add_option("--threads", cap.threads, "Worker threads (0 = all cores)")
         ->capture_default_str();
 
+    seasense::channels::RunOptions run;
+    bool noVideo = false, noImages = false;
+    CLI::App* runCmd = app.add_subcommand(
+        "run",
+        "Frame-locked multi-channel run: a host process advances the scene and publishes each\n"
+        "frame's state in shared memory; one renderer process per channel renders it. Writes\n"
+        "DIR/<channel>/ images, DIR/sync.csv, DIR/mosaic.mp4 and DIR/summary.json.");
+    runCmd->add_option("--config", run.config, "Scenario YAML file")
+        ->capture_default_str()
+        ->default_val(seasense::channels::DefaultRunConfig().string());
+    runCmd->add_option("--frames", run.frames, "Number of frames (>= 1)")->capture_default_str();
+    runCmd->add_option("--out", run.out, "Output folder (created if missing)")
+        ->capture_default_str();
+    runCmd
+        ->add_option("--rate", run.rate_hz,
+                     "Real-time pacing: publish frames on a fixed clock of HZ frames per second "
+                     "and count overruns (0 = as fast as possible)")
+        ->capture_default_str();
+    runCmd->add_flag("--no-video", noVideo, "Do not write the mosaic video");
+    runCmd->add_flag("--no-images", noImages, "Do not write per-channel image files");
+    runCmd->add_option("--run-id", run.runId,
+                       "Run id in the shared-memory name /dev/shm/seasense-<uid>-<id> "
+                       "(default: the host's pid)");
+    runCmd->add_option("--external", run.external,
+                       "Channel whose renderer is started by hand with `seasense channel` "
+                       "(repeatable)");
+    runCmd
+        ->add_option("--threads", run.threadsPerChannel,
+                     "Worker threads per renderer process (0 = all cores)")
+        ->capture_default_str();
+    runCmd
+        ->add_option("--attach-timeout", run.attachTimeout_s,
+                     "Seconds to wait for every renderer to attach")
+        ->capture_default_str();
+    runCmd
+        ->add_option("--frame-timeout", run.frameTimeout_s,
+                     "Seconds to wait for one frame from every channel")
+        ->capture_default_str();
+
+    seasense::channels::ChannelOptions chan;
+    CLI::App* channelCmd = app.add_subcommand(
+        "channel",
+        "One channel renderer attached to a running `seasense run` (as a separate image\n"
+        "generator would be); it reads the scenario and output folder from the run.");
+    channelCmd->add_option("--attach", chan.runId, "Run id printed by `seasense run`")->required();
+    channelCmd->add_option("--channel", chan.channel, "Channel name")->required();
+    channelCmd->add_option("--threads", chan.threads,
+                           "Worker threads (default: the run's --threads; 0 = all cores)");
+
     seasense::channels::QuerySkyOptions sky;
     CLI::App* query = app.add_subcommand("query", "Ask the scene core a question");
     query->require_subcommand(1);
@@ -91,6 +141,12 @@ int main(int argc, char** argv) {
         if (capture->parsed()) {
             cap.formats = SplitCommas(formats);
             seasense::channels::RunCapture(cap);
+        } else if (runCmd->parsed()) {
+            run.video = !noVideo;
+            run.images = !noImages;
+            return seasense::channels::RunHost(run);
+        } else if (channelCmd->parsed()) {
+            return seasense::channels::RunChannelRenderer(chan);
         } else if (querySky->parsed()) {
             seasense::channels::RunQuerySky(sky);
         }

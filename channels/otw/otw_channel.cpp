@@ -364,10 +364,34 @@ OtwChannel::OtwChannel(const scene::World& world, const scene::ChannelSettings& 
     const scene::SceneState s0 = world.State(0);
     for (const scene::EntityState& e : s0.entities) {
         worldMeshes_.push_back(scene::TransformMesh(*e.bodyMesh, e.pose));
+        entityPoses_.push_back(e.pose);
         reflectance_.push_back(e.reflectanceRgb);
-        occlusion_.AddMesh(worldMeshes_.back().positions, worldMeshes_.back().indices);
+        occlusionIds_.push_back(
+            occlusion_.AddMesh(worldMeshes_.back().positions, worldMeshes_.back().indices));
     }
     occlusion_.Commit();
+    UpdateCasterBounds();
+}
+
+void OtwChannel::UpdateEntities(const scene::SceneState& state) {
+    CHECK(state.entities.size() == worldMeshes_.size());
+    bool moved = false;
+    for (size_t i = 0; i < state.entities.size(); ++i) {
+        const scene::Pose& pose = state.entities[i].pose;
+        if (pose.position_m == entityPoses_[i].position_m &&
+            pose.worldFromBody == entityPoses_[i].worldFromBody)
+            continue;
+        worldMeshes_[i] = scene::TransformMesh(*state.entities[i].bodyMesh, pose);
+        entityPoses_[i] = pose;
+        occlusion_.UpdateMesh(occlusionIds_[i], worldMeshes_[i].positions);
+        moved = true;
+    }
+    if (!moved) return;
+    occlusion_.Commit();
+    UpdateCasterBounds();
+}
+
+void OtwChannel::UpdateCasterBounds() {
     glm::vec3 lo(std::numeric_limits<float>::infinity()), hi(-lo);
     for (const scene::TriangleMesh& m : worldMeshes_)
         for (const glm::vec3& p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
@@ -391,6 +415,7 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     const scene::EnvironmentSettings& env = sc.environment;
     camera_ = MakeChannelCamera(state.eyepoint, settings_);
     const ChannelCamera& cam = camera_;
+    UpdateEntities(state);
     const int sw = cam.SampleWidth(), sh = cam.SampleHeight();
 
     using Clock = std::chrono::steady_clock;

@@ -47,6 +47,9 @@ class OtwChannel {
     // Per-thread shading scratch, kept between frames so that a frame neither allocates nor
     // zero-fills its sample lists (fresh pages cost page faults on every frame).
     struct ShadeScratch;
+    // Moves entity meshes to the frame's poses (transform, Embree refit) when they changed.
+    void UpdateEntities(const scene::SceneState& state);
+    void UpdateCasterBounds();
 
     const scene::World& world_;
     scene::ChannelSettings settings_;
@@ -54,6 +57,8 @@ class OtwChannel {
     Rasterizer rasterizer_;
     OcclusionScene occlusion_;
     std::vector<scene::TriangleMesh> worldMeshes_;  // entity meshes in the world frame
+    std::vector<scene::Pose> entityPoses_;          // the poses worldMeshes_ were built at
+    std::vector<uint32_t> occlusionIds_;            // Embree geometry of each entity
     std::vector<glm::dvec3> reflectance_;           // per entity
     // Bounding box of all shadow casters, widened well beyond OcclusionScene's own caster
     // bounds: a cheap inline test that leaves only candidates for MayOcclude.

@@ -107,43 +107,56 @@ ChannelPipeline::ChannelPipeline(const scene::World& world, const scene::Channel
 }
 
 FrameRecord ChannelPipeline::RenderAndWrite(int64_t frame) {
+    FrameRecord rec = Render(world_.Advance(frame));
+    Write(rec);
+    return rec;
+}
+
+FrameRecord ChannelPipeline::Render(const scene::FrameState& frame) {
     FrameRecord rec;
-    const scene::SceneState state = world_.State(frame);
-    rec.frame = frame;
-    rec.utc = state.utc;
-    rec.time_s = state.time_s;
+    state_ = world_.Compose(frame);
+    rec.frame = state_.frame;
+    rec.utc = state_.utc;
+    rec.time_s = state_.time_s;
 
     auto t0 = std::chrono::steady_clock::now();
-    otw_->Render(state, samples_);
+    otw_->Render(state_, samples_);
     rec.renderMs = MsSince(t0);
 
     t0 = std::chrono::steady_clock::now();
-    const Image pixels = sensors::IntegrateFootprint(samples_, channel_.supersampling);
-    const double ev = channel_.exposure.mode == scene::ExposureMode::Auto
-                          ? sensors::AutoExposureEv(pixels, channel_.exposure.keyValue)
-                          : channel_.exposure.ev;
-    rec.exposureEv = ev;
-    const float scale = float(std::exp2(ev));
+    sensors::IntegrateFootprint(samples_, channel_.supersampling, pixels_);
+    ev_ = channel_.exposure.mode == scene::ExposureMode::Auto
+              ? sensors::AutoExposureEv(pixels_, channel_.exposure.keyValue)
+              : channel_.exposure.ev;
+    rec.exposureEv = ev_;
+    displayValid_ = false;
     rec.sensorMs = MsSince(t0);
+    return rec;
+}
 
-    t0 = std::chrono::steady_clock::now();
-    const sensors::ImageMetadata md = FrameMetadata(world_, channel_, state, otw_->Camera(), ev);
+const std::vector<uint8_t>& ChannelPipeline::DisplayRgb8() {
+    if (!displayValid_) {
+        display8_ = display_->ToDisplay8(pixels_, float(std::exp2(ev_)));
+        displayValid_ = true;
+    }
+    return display8_;
+}
+
+void ChannelPipeline::Write(FrameRecord& rec) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const sensors::ImageMetadata md = FrameMetadata(world_, channel_, state_, otw_->Camera(), ev_);
     char stem[64];
-    std::snprintf(stem, sizeof stem, "_%06lld", (long long)frame);
+    std::snprintf(stem, sizeof stem, "_%06lld", (long long)rec.frame);
     const std::string base = channel_.name + stem;
-    std::vector<uint8_t> display;  // the display transform runs once, for any 8-bit formats
     for (const std::string& fmt : formats_) {
         const std::filesystem::path path = channelDir_ / (base + "." + fmt);
-        if (fmt == "exr") {
-            sensors::WriteExr(path, pixels, md);
-        } else {
-            if (display.empty()) display = display_->ToDisplay8(pixels, scale);
-            sensors::WriteDisplayImage8(path, display, pixels.width, pixels.height, 3, md);
-        }
+        if (fmt == "exr")
+            sensors::WriteExr(path, pixels_, md);
+        else
+            sensors::WriteDisplayImage8(path, DisplayRgb8(), pixels_.width, pixels_.height, 3, md);
         rec.files.push_back(path);
     }
     rec.writeMs = MsSince(t0);
-    return rec;
 }
 
 }  // namespace seasense::channels

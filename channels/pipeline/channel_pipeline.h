@@ -35,6 +35,16 @@ class ChannelPipeline {
     // Renders frame n and writes its files atomically. Runs in the caller's oneTBB arena.
     FrameRecord RenderAndWrite(int64_t frame);
 
+    // The two halves of RenderAndWrite, for the frame-locked run: Render takes the published
+    // dynamic state, renders and applies the sensor model (record.files stays empty); Write
+    // then writes the frame's files (the display transform runs at most once per frame).
+    FrameRecord Render(const scene::FrameState& frame);
+    void Write(FrameRecord& record);
+    // The display image of the last rendered frame: 8-bit RGB, Width()×Height(), row 0 on top.
+    const std::vector<uint8_t>& DisplayRgb8();
+    int Width() const { return channel_.width; }
+    int Height() const { return channel_.height; }
+
     const std::filesystem::path& ChannelDir() const { return channelDir_; }
     const OtwChannel& Otw() const { return *otw_; }
 
@@ -46,6 +56,11 @@ class ChannelPipeline {
     std::unique_ptr<OtwChannel> otw_;
     std::unique_ptr<sensors::OcioDisplay> display_;
     Image samples_;
+    Image pixels_;                   // the last frame's sensor image (linear)
+    scene::SceneState state_;        // the last frame's scene
+    double ev_ = 0.0;                // the last frame's exposure
+    std::vector<uint8_t> display8_;  // display transform of pixels_, when asked for
+    bool displayValid_ = false;
 };
 
 // The project's OCIO config: $SEASENSE_OCIO if set, else configs/ocio/config.ocio found

@@ -29,11 +29,13 @@ struct WorldSettings {
     uint64_t seed = 1;
 };
 
-// A directional sun set by the user (the ephemeris issue adds the real sun).
+// The sun: fixed by the user, or (`sun: ephemeris`) placed by the ephemeris at the frame's UTC
+// time with a direct-normal illuminance from the air mass and turbidity.
 struct SunSettings {
-    double azimuth_rad = 0.0;        // from true north, clockwise
-    double elevation_rad = 0.5;      // above the horizon
-    double illuminance_lux = 1.0e5;  // on a surface normal to the sun, above the atmosphere path
+    bool fromEphemeris = false;
+    double azimuth_rad = 0.0;        // from true north, clockwise (fixed sun)
+    double elevation_rad = 0.5;      // above the horizon (fixed sun)
+    double illuminance_lux = 1.0e5;  // on a surface normal to the sun, at the ground (fixed sun)
 };
 
 struct SkySettings {
@@ -69,12 +71,17 @@ struct EntitySettings {
     glm::dvec3 position_m{0.0};
     Attitude attitude;
     double scale = 1.0;
-    std::string material;  // a name from the material table
+    std::string material;    // a name from the material table
+    double speed_mps = 0.0;  // along the heading, horizontal; position_m is at frame 0
+    // Heave, pitch and roll follow the sea surface under the hull (quasi-static: the height at
+    // the origin, pitch and roll from the heights at bow/stern and the beam ends).
+    bool rideWaves = false;
 };
 
 struct EyepointSettings {
-    glm::dvec3 position_m{0.0, 0.0, 2.0};
+    glm::dvec3 position_m{0.0, 0.0, 2.0};  // at frame 0
     Attitude attitude;
+    double speed_mps = 0.0;  // along the heading, horizontal
 };
 
 enum class ChannelKind { Otw, Flir, Nvg };

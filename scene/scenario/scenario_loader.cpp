@@ -106,14 +106,23 @@ GerstnerWaveSettings ReadWave(const ConfigValue& value) {
 EnvironmentSettings ReadEnvironment(ConfigMap& map) {
     EnvironmentSettings env;
     ReadMap(map.Require("environment", "a mapping"), [&](ConfigMap& e) {
-        ReadMap(e.Require("sun", "a mapping"), [&](ConfigMap& sun) {
-            env.sun.azimuth_rad =
-                sun.GetDouble("azimuth_deg", NumberRange::Any("deg")) * kRadPerDeg;
-            env.sun.elevation_rad =
-                sun.GetDouble("elevation_deg", NumberRange::Closed(-90, 90, "deg")) * kRadPerDeg;
-            env.sun.illuminance_lux = sun.GetDouble(
-                "illuminance_lux", NumberRange::NonNegative("lux"), env.sun.illuminance_lux);
-        });
+        const ConfigValue sunValue =
+            e.Require("sun", "'ephemeris' or a mapping {azimuth_deg, elevation_deg}");
+        if (sunValue.Node().IsScalar()) {
+            if (sunValue.AsString() != "ephemeris")
+                sunValue.Fail("'ephemeris' or a mapping {azimuth_deg, elevation_deg}");
+            env.sun.fromEphemeris = true;
+        } else {
+            ReadMap(sunValue, [&](ConfigMap& sun) {
+                env.sun.azimuth_rad =
+                    sun.GetDouble("azimuth_deg", NumberRange::Any("deg")) * kRadPerDeg;
+                env.sun.elevation_rad =
+                    sun.GetDouble("elevation_deg", NumberRange::Closed(-90, 90, "deg")) *
+                    kRadPerDeg;
+                env.sun.illuminance_lux = sun.GetDouble(
+                    "illuminance_lux", NumberRange::NonNegative("lux"), env.sun.illuminance_lux);
+            });
+        }
         if (std::optional<ConfigValue> sky = e.Find("sky")) {
             ReadMap(*sky, [&](ConfigMap& s) {
                 // Preetham et al. (1999) fit their sky model for turbidity 1.7 .. 10.
@@ -174,6 +183,8 @@ EntitySettings ReadEntity(const ConfigValue& value, const std::filesystem::path&
         entity.position_m = e.GetVec3("position_m", NumberRange::Any("m"));
         entity.attitude = ReadAttitude(e);
         entity.scale = e.GetDouble("scale", NumberRange::Positive(), entity.scale);
+        entity.speed_mps = e.GetDouble("speed_mps", NumberRange::Closed(-100, 100, "m/s"), 0.0);
+        entity.rideWaves = e.GetBool("ride_waves", false);
 
         const std::string expectedMaterial =
             "a material of " + materialFile + " (" + ListOrCount(materialNames) + ")";
@@ -354,6 +365,8 @@ Scenario LoadScenario(const std::filesystem::path& file) {
         ReadMap(root.Require("eyepoint", "a mapping"), [&](ConfigMap& eye) {
             scenario.eyepoint.position_m = eye.GetVec3("position_m", NumberRange::Any("m"));
             scenario.eyepoint.attitude = ReadAttitude(eye);
+            scenario.eyepoint.speed_mps =
+                eye.GetDouble("speed_mps", NumberRange::Closed(-300, 300, "m/s"), 0.0);
         });
 
         const std::vector<ConfigValue> channels =

@@ -102,6 +102,29 @@ double SunIlluminance_lux(double altitude_rad, double distance_m) {
     return std::pow(10.0, log10E) * distanceRatio * distanceRatio;
 }
 
+double RelativeAirMass(double altitude_rad) {
+    CheckAltitude(altitude_rad, "RelativeAirMass");
+    const double h_deg = std::max(altitude_rad / kDeg, 0.0);
+    return 1.0 / (std::sin(h_deg * kDeg) + 0.50572 * std::pow(h_deg + 6.07995, -1.6364));
+}
+
+double DirectNormalSunIlluminance_lux(double altitude_rad, double distance_m,
+                                      double luminousTurbidity) {
+    CheckAltitude(altitude_rad, "DirectNormalSunIlluminance_lux");
+    CheckDistance(distance_m, "DirectNormalSunIlluminance_lux");
+    if (!std::isfinite(luminousTurbidity) || luminousTurbidity < 0.0)
+        throw InputError("DirectNormalSunIlluminance_lux: turbidity " +
+                         std::to_string(luminousTurbidity) + " is not a number >= 0");
+    // The disc (0.2666° radius) is gone once its upper limb is below the apparent horizon.
+    if (altitude_rad < -0.2666 * kDeg) return 0.0;
+    constexpr double kLuminousSolarConstant_lux = 133800.0;
+    const double m = RelativeAirMass(altitude_rad);
+    const double av = 1.0 / (9.9 + 0.043 * m);
+    const double distanceRatio = kAstronomicalUnit_m / distance_m;
+    return kLuminousSolarConstant_lux * distanceRatio * distanceRatio *
+           std::exp(-av * m * luminousTurbidity);
+}
+
 double MoonIlluminance_lux(double altitude_rad, double phaseAngle_rad, double distance_m) {
     CheckAltitude(altitude_rad, "MoonIlluminance_lux");
     CheckDistance(distance_m, "MoonIlluminance_lux");

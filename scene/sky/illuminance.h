@@ -38,6 +38,22 @@ double SunIlluminance_lux(double altitude_rad, double distance_m = 1.495978707e1
 // Throws InputError for a non-finite or out-of-range argument.
 double MoonIlluminance_lux(double altitude_rad, double phaseAngle_rad, double distance_m);
 
+// Relative optical air mass at apparent (refracted) altitude altitude_rad, after Kasten and
+// Young, Appl. Opt. 28, 4735 (1989): m = 1 / (sin h + 0.50572 (h° + 6.07995°)^−1.6364);
+// 1 at the zenith, 38.09 at the horizon. Throws InputError outside [−π/2, π/2] or for NaN;
+// altitudes below the horizon are evaluated at the horizon.
+double RelativeAirMass(double altitude_rad);
+
+// Direct-normal illuminance of the sun at the ground (lux) at apparent altitude altitude_rad:
+// E = E_v0 (1 au / d)² exp(−a_v m T_v) with the luminous solar constant E_v0 = 133 800 lx
+// (Darula, Kittler & Gueymard, Solar Energy 79, 559 (2005)), the luminous extinction
+// coefficient of a clean dry atmosphere a_v = 1 / (9.9 + 0.043 m) (Navvab et al., Energy and
+// Buildings 6, 293 (1984)), m = RelativeAirMass and the luminous turbidity factor T_v (≈ 2
+// very clear to 6 hazy; the scenario's sky turbidity is used). Zero once the upper limb has
+// set. Throws InputError for bad arguments.
+double DirectNormalSunIlluminance_lux(double altitude_rad, double distance_m,
+                                      double luminousTurbidity);
+
 // Clear-sky night-sky floor (lux): starlight, zodiacal light and airglow with no moon.
 double NightSkyIlluminance_lux();
 

@@ -5,6 +5,7 @@
 #include <map>
 
 #include "scene/core/error.h"
+#include "scene/sky/illuminance.h"
 
 namespace seasense::scene {
 
@@ -19,33 +20,93 @@ World::World(const Scenario& scenario) : scenario_(scenario), ocean_(scenario.en
             it = cache.emplace(key, std::move(mesh)).first;
         }
         models_.push_back(it->second);
+        glm::dvec2 half(0.5);
+        for (const glm::vec3& v : it->second->positions)
+            half = glm::max(half, glm::dvec2(std::abs(v.x), std::abs(v.y)));
+        halfExtent_m_.push_back(half);
         if (!scenario_.FindMaterial(e.material))
             throw InputError(scenario_.file.string() + ": entity '" + e.name +
                              "' names unknown material '" + e.material + "'");
     }
 }
 
-SceneState World::State(int64_t frame) const {
+namespace {
+
+// A pose moving at speed_mps along its heading on the horizontal plane.
+Pose MovingPose(const glm::dvec3& start_m, const Attitude& attitude, double speed_mps, double t_s) {
+    const glm::dvec3 heading{std::sin(attitude.heading_rad), std::cos(attitude.heading_rad), 0.0};
+    return PoseFrom(start_m + heading * (speed_mps * t_s), attitude);
+}
+
+}  // namespace
+
+FrameState World::Advance(int64_t frame) const {
     const WorldSettings& w = scenario_.world;
-    SceneState s;
+    FrameState s;
     s.frame = frame;
     s.time_s = double(frame) * w.timeScale / w.frameRate_hz;
     s.utc = w.start.PlusSeconds(s.time_s);
 
     const SunSettings& sun = scenario_.environment.sun;
-    s.sun.azimuth_rad = sun.azimuth_rad;
-    s.sun.elevation_rad = sun.elevation_rad;
-    s.sun.direction = DirectionFromAzimuthElevation(sun.azimuth_rad, sun.elevation_rad);
-    s.sun.illuminance_lux = sun.illuminance_lux;
+    if (sun.fromEphemeris) {
+        Observer observer;
+        observer.latitude_deg = w.latitude_deg;
+        observer.longitude_deg = w.longitude_deg;
+        const CelestialPosition p = SunPosition(s.utc, observer);
+        s.sun.azimuth_rad = p.azimuth_rad;
+        s.sun.elevation_rad = p.altitude_rad;
+        s.sun.direction = p.direction;
+        s.sun.illuminance_lux = DirectNormalSunIlluminance_lux(p.altitude_rad, p.distance_m,
+                                                               scenario_.environment.sky.turbidity);
+    } else {
+        s.sun.azimuth_rad = sun.azimuth_rad;
+        s.sun.elevation_rad = sun.elevation_rad;
+        s.sun.direction = DirectionFromAzimuthElevation(sun.azimuth_rad, sun.elevation_rad);
+        s.sun.illuminance_lux = sun.illuminance_lux;
+    }
 
-    s.eyepoint = PoseFrom(scenario_.eyepoint.position_m, scenario_.eyepoint.attitude);
+    const EyepointSettings& eye = scenario_.eyepoint;
+    s.eyepoint = MovingPose(eye.position_m, eye.attitude, eye.speed_mps, s.time_s);
+    for (size_t i = 0; i < scenario_.entities.size(); ++i) {
+        const EntitySettings& e = scenario_.entities[i];
+        Pose pose = MovingPose(e.position_m, e.attitude, e.speed_mps, s.time_s);
+        if (e.rideWaves) {
+            // Quasi-static wave following: heave at the origin, pitch and roll from the surface
+            // heights under bow/stern and the beam ends (body y forward, x to starboard).
+            const glm::dvec3 fwd = pose.worldFromBody[1], right = pose.worldFromBody[0];
+            const glm::dvec2 half = halfExtent_m_[i];
+            const auto h = [&](const glm::dvec3& p) { return ocean_.HeightAt(p.x, p.y, s.time_s); };
+            const glm::dvec3 o = pose.position_m;
+            const double bow = h(o + fwd * half.y), stern = h(o - fwd * half.y);
+            const double stbd = h(o + right * half.x), port = h(o - right * half.x);
+            Attitude a = e.attitude;
+            a.pitch_rad += std::atan2(bow - stern, 2.0 * half.y);
+            a.roll_rad += std::atan2(port - stbd, 2.0 * half.x);  // starboard down is positive
+            pose = PoseFrom(o + glm::dvec3(0.0, 0.0, h(o)), a);
+        }
+        s.entityPoses.push_back(pose);
+    }
+    return s;
+}
+
+SceneState World::Compose(const FrameState& f) const {
+    if (f.entityPoses.size() != scenario_.entities.size())
+        throw InputError("scene state of frame " + std::to_string(f.frame) + " has " +
+                         std::to_string(f.entityPoses.size()) + " entities; the scenario has " +
+                         std::to_string(scenario_.entities.size()));
+    SceneState s;
+    s.frame = f.frame;
+    s.time_s = f.time_s;
+    s.utc = f.utc;
+    s.sun = f.sun;
+    s.eyepoint = f.eyepoint;
     for (size_t i = 0; i < scenario_.entities.size(); ++i) {
         const EntitySettings& e = scenario_.entities[i];
         EntityState es;
         es.name = e.name;
         es.material = e.material;
         es.reflectanceRgb = scenario_.FindMaterial(e.material)->reflectanceRgb;
-        es.pose = PoseFrom(e.position_m, e.attitude);
+        es.pose = f.entityPoses[i];
         es.bodyMesh = models_[i];
         s.entities.push_back(std::move(es));
     }

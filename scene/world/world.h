@@ -10,6 +10,7 @@
 #include "scene/models/triangle_mesh.h"
 #include "scene/ocean/gerstner.h"
 #include "scene/scenario/scenario.h"
+#include "scene/sky/ephemeris.h"
 
 namespace seasense::scene {
 
@@ -29,6 +30,17 @@ struct SunState {
     double illuminance_lux = 0.0;  // on a surface normal to the sun
 };
 
+// The part of a frame's scene that changes with time: what the host of a run publishes to the
+// channel renderers (scene/world's static content — meshes, materials — each builds itself).
+struct FrameState {
+    int64_t frame = 0;
+    double time_s = 0.0;  // simulated seconds since frame 0
+    UtcTime utc;
+    SunState sun;
+    Pose eyepoint;
+    std::vector<Pose> entityPoses;  // one per scenario entity, in scenario order
+};
+
 // Everything a channel needs to render frame `frame`, fixed for that frame.
 struct SceneState {
     int64_t frame = 0;
@@ -44,8 +56,14 @@ class World {
     // Loads every model the scenario names (InputError on failure).
     explicit World(const Scenario& scenario);
 
-    // State of frame n: simulated time n · timeScale / frameRate after the start.
-    SceneState State(int64_t frame) const;
+    // The dynamic state of frame n: simulated time n · timeScale / frameRate after the start,
+    // the sun, the moving eyepoint and entities.
+    FrameState Advance(int64_t frame) const;
+    // The full scene of a published dynamic state. InputError if the state does not fit this
+    // world (entity count).
+    SceneState Compose(const FrameState& frame) const;
+    // Compose(Advance(frame)).
+    SceneState State(int64_t frame) const { return Compose(Advance(frame)); }
 
     const Scenario& GetScenario() const { return scenario_; }
     const GerstnerOcean& Ocean() const { return ocean_; }
@@ -54,6 +72,8 @@ class World {
     Scenario scenario_;
     GerstnerOcean ocean_;
     std::vector<std::shared_ptr<const TriangleMesh>> models_;  // one per entity
+    // Half length (body y) and half beam (body x) of each entity's mesh, for riding the waves.
+    std::vector<glm::dvec2> halfExtent_m_;
 };
 
 }  // namespace seasense::scene

@@ -1,0 +1,514 @@
+// The frame-locked run: a host process advancing the scene and one renderer process per
+// channel, meeting in shared memory (channels/sync); outputs sync.csv, mosaic.mp4, summary.json.
+#include "channels/cli/run.h"
+
+#include <signal.h>
+#include <tbb/task_arena.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "channels/cli/progress.h"
+#include "channels/pipeline/channel_pipeline.h"
+#include "channels/sync/frame_lock.h"
+#include "channels/sync/mosaic.h"
+#include "channels/sync/renderer_process.h"
+#include "channels/sync/shm_segment.h"
+#include "channels/sync/state_codec.h"
+#include "scene/core/error.h"
+#include "scene/scenario/scenario_loader.h"
+#include "sensors/output/image_writer.h"
+
+namespace seasense::channels {
+
+namespace {
+
+volatile sig_atomic_t g_signal = 0;
+
+extern "C" void OnStopSignal(int sig) { g_signal = sig; }
+
+// SIGINT/SIGTERM set g_signal; waits notice it within one liveness poll. No SA_RESTART:
+// a sleeping futex returns at once.
+void InstallStopHandlers() {
+    struct sigaction sa {};
+    sa.sa_handler = OnStopSignal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, nullptr);
+    sigaction(SIGTERM, &sa, nullptr);
+}
+
+double Percentile(std::vector<double> v, double p) {
+    if (v.empty()) return 0.0;
+    std::sort(v.begin(), v.end());
+    // Nearest-rank percentile.
+    const size_t rank = size_t(std::ceil(p / 100.0 * double(v.size())));
+    return v[std::clamp<size_t>(rank, 1, v.size()) - 1];
+}
+
+nlohmann::json Stats(const std::vector<double>& v) {
+    nlohmann::json j;
+    double sum = 0.0;
+    for (double x : v) sum += x;
+    j["mean"] = v.empty() ? 0.0 : sum / double(v.size());
+    j["p50"] = Percentile(v, 50);
+    j["p99"] = Percentile(v, 99);
+    j["max"] = v.empty() ? 0.0 : *std::max_element(v.begin(), v.end());
+    return j;
+}
+
+// Removes the segment and stops the renderers on every exit path of the host.
+struct HostCleanup {
+    sync::Segment* segment = nullptr;
+    std::vector<pid_t>* children = nullptr;
+    ~HostCleanup() {
+        if (children) sync::TerminateProcesses(*children, 2.0);
+        if (segment) segment->Unlink();
+    }
+};
+
+// A text file written under a temporary name and renamed into place when complete.
+class StreamedFile {
+  public:
+    explicit StreamedFile(std::filesystem::path path)
+        : path_(std::move(path)),
+          temp_(path_.parent_path() /
+                ("." + path_.filename().string() + "." + std::to_string(::getpid()) + ".tmp")) {
+        out_.open(temp_, std::ios::binary | std::ios::trunc);
+        if (!out_) throw RuntimeError("cannot write " + temp_.string());
+    }
+    ~StreamedFile() {
+        if (out_.is_open()) {
+            out_.close();
+            std::error_code ec;
+            std::filesystem::remove(temp_, ec);
+        }
+    }
+    std::ofstream& Out() { return out_; }
+    void Finish() {
+        out_.close();
+        if (!out_) throw RuntimeError("cannot write " + temp_.string());
+        std::error_code ec;
+        std::filesystem::rename(temp_, path_, ec);
+        if (ec)
+            throw RuntimeError("cannot move " + temp_.string() + " into place: " + ec.message());
+    }
+
+  private:
+    std::filesystem::path path_, temp_;
+    std::ofstream out_;
+};
+
+void SleepUntilNs(int64_t t) {
+    while (!g_signal) {
+        const int64_t now = sync::MonotonicNs();
+        if (now >= t) return;
+        std::this_thread::sleep_for(
+            std::chrono::nanoseconds(std::min<int64_t>(t - now, 20'000'000)));
+    }
+}
+
+const char* KindName(scene::ChannelKind k) {
+    switch (k) {
+        case scene::ChannelKind::Otw:
+            return "otw";
+        case scene::ChannelKind::Flir:
+            return "flir";
+        case scene::ChannelKind::Nvg:
+            return "nvg";
+    }
+    return "?";
+}
+
+}  // namespace
+
+#ifndef SEASENSE_SOURCE_DIR
+#define SEASENSE_SOURCE_DIR "."
+#endif
+
+std::filesystem::path DefaultRunConfig() {
+    return std::filesystem::path(SEASENSE_SOURCE_DIR) / "configs" / "five-channel.yaml";
+}
+
+int RunHost(const RunOptions& opt) {
+    if (opt.frames < 1 || opt.frames > (int64_t(1) << 27))
+        throw InputError("--frames: expected an integer in [1, 134217728]");
+    if (!(opt.rate_hz >= 0.0) || !std::isfinite(opt.rate_hz))
+        throw InputError("--rate: expected a number of frames per second >= 0 (0 = unpaced)");
+    if (opt.threadsPerChannel < 0)
+        throw InputError("--threads: expected an integer >= 0 (0 = all cores)");
+    const scene::Scenario scenario = scene::LoadScenario(opt.config);
+    for (const scene::ChannelSettings& ch : scenario.channels)
+        if (ch.kind != scene::ChannelKind::Otw)
+            throw InputError(scenario.file.string() + ": channel '" + ch.name + "' has kind '" +
+                             KindName(ch.kind) + "', which this build cannot render yet");
+    for (const std::string& name : opt.external)
+        if (!scenario.FindChannel(name))
+            throw InputError("--external: the scenario has no channel named '" + name + "'");
+    const std::string runId = opt.runId.empty() ? std::to_string(::getpid()) : opt.runId;
+    sync::ValidateRunId(runId);
+    const scene::World world(scenario);
+
+    std::error_code ec;
+    std::filesystem::create_directories(opt.out, ec);
+    if (ec)
+        throw RuntimeError("cannot create output folder " + opt.out.string() + ": " + ec.message());
+    const std::filesystem::path outDir = std::filesystem::absolute(opt.out);
+
+    for (const std::string& name : sync::RemoveStaleSegments())
+        std::fprintf(
+            stderr, "seasense: removed stale shared-memory segment /dev/shm%s (its host is gone)\n",
+            name.c_str());
+
+    sync::SegmentSpec spec;
+    spec.runId = runId;
+    size_t maxImage = 0;
+    for (const scene::ChannelSettings& ch : scenario.channels) {
+        spec.channelNames.push_back(ch.name);
+        maxImage = std::max(maxImage, size_t(ch.width) * size_t(ch.height) * 3);
+    }
+    spec.configPath = std::filesystem::absolute(scenario.file).string();
+    spec.scenarioHash = scenario.hash;
+    spec.outDir = outDir.string();
+    spec.flags = (opt.images ? 0u : uint32_t(sync::kFlagNoImages)) |
+                 (opt.video ? 0u : uint32_t(sync::kFlagNoMosaic));
+    spec.threadsPerChannel = opt.threadsPerChannel;
+    spec.firstFrame = 0;
+    spec.frameCount = opt.frames;
+    spec.stateBytes = sync::EncodedFrameStateBytes(scenario.entities.size());
+    spec.imageBytes = opt.video ? maxImage : 0;
+    sync::Segment segment = sync::Segment::Create(spec);
+    sync::SegmentHeader& header = segment.Header();
+    const uint32_t channelCount = header.channelCount;
+
+    std::vector<pid_t> children(channelCount, 0);
+    HostCleanup cleanup{&segment, &children};
+    InstallStopHandlers();
+
+    const std::string self = sync::SelfExecutable();
+    for (uint32_t c = 0; c < channelCount; ++c) {
+        const std::string name = header.channels[c].name;
+        if (std::find(opt.external.begin(), opt.external.end(), name) != opt.external.end()) {
+            std::fprintf(
+                stderr,
+                "seasense: waiting for channel '%s': run\n  %s channel --attach %s --channel %s\n",
+                name.c_str(), self.c_str(), runId.c_str(), name.c_str());
+            continue;
+        }
+        children[c] = sync::SpawnProcess({self, "channel", "--attach", runId, "--channel", name});
+    }
+
+    // Why the run must end, when a wait reports a dead peer.
+    std::string failure;
+    const auto alive = [&]() -> bool {
+        for (uint32_t c = 0; c < channelCount; ++c) {
+            const std::string name = header.channels[c].name;
+            if (children[c] > 0) {
+                if (std::optional<sync::ProcessExit> e = sync::PollProcess(children[c])) {
+                    // A renderer leaves normally once it has presented its last frame.
+                    const uint32_t presented = header.channels[c].presented.load();
+                    const bool finished =
+                        presented >= header.frameCount ||
+                        (header.status.load() == uint32_t(sync::RunStatus::Stopping) &&
+                         presented > header.lastFrameIndex.load());
+                    if (!e->signaled && e->code == 0 && finished) {
+                        children[c] = 0;
+                        continue;
+                    }
+                    failure = "channel '" + name + "' (renderer pid " +
+                              std::to_string(children[c]) + ") " + sync::Describe(*e);
+                    children[c] = 0;
+                    return false;
+                }
+            } else {
+                const int pid = header.channels[c].pid.load(std::memory_order_acquire);
+                if (pid > 0 && !sync::ProcessExists(pid)) {
+                    failure = "channel '" + name + "' (renderer pid " + std::to_string(pid) +
+                              ", started by hand) is gone";
+                    return false;
+                }
+            }
+        }
+        return g_signal == 0;
+    };
+    sync::HostLock lock(segment);
+
+    const auto fail = [&](const std::string& what) -> RuntimeError {
+        lock.Abort();
+        return RuntimeError(what);
+    };
+    sync::WaitResult r = lock.WaitAttached(alive, opt.attachTimeout_s);
+    if (r != sync::WaitResult::Ready) {
+        if (g_signal && failure.empty()) {
+            lock.Abort();
+            return 128 + g_signal;
+        }
+        throw fail(r == sync::WaitResult::TimedOut ? "not every channel attached within " +
+                                                         std::to_string(opt.attachTimeout_s) + " s"
+                                                   : failure + " before attaching");
+    }
+    header.status.store(uint32_t(sync::RunStatus::Running), std::memory_order_release);
+
+    std::unique_ptr<sync::MosaicVideo> video;
+    if (opt.video) {
+        std::vector<sync::MosaicTile> tiles;
+        for (const scene::ChannelSettings& ch : scenario.channels)
+            tiles.push_back({ch.name, ch.width, ch.height});
+        const double fps = opt.rate_hz > 0.0 ? opt.rate_hz : scenario.world.frameRate_hz;
+        video = std::make_unique<sync::MosaicVideo>(outDir / "mosaic.mp4", tiles, fps);
+    }
+    StreamedFile csv(outDir / "sync.csv");
+    csv.Out()
+        << "frame,channel,time_utc,publish_ns,start_ns,done_ns,present_ns,render_ms,wait_us\n";
+
+    const int64_t periodNs = opt.rate_hz > 0.0 ? int64_t(std::llround(1e9 / opt.rate_hz)) : 0;
+    int64_t runStartNs = 0, lastPresentNs = 0;
+    const auto publish = [&](uint32_t index) {
+        if (periodNs > 0) SleepUntilNs(runStartNs + int64_t(index) * periodNs);
+        const scene::FrameState fs = world.Advance(spec.firstFrame + int64_t(index));
+        uint8_t* bytes = lock.BeginPublish(index);
+        const size_t n = sync::EncodeFrameState(fs, bytes, header.stateBytes);
+        lock.EndPublish(index, fs.frame, n);
+    };
+
+    std::vector<double> skewUs, waitUs, frameMs;
+    std::vector<std::vector<double>> renderMs(channelCount);
+    int64_t overruns = 0, completed = 0;
+    std::string status = "complete";
+    int exitStatus = 0;
+    Progress progress(opt.frames, "frames");
+
+    const auto writeSummary = [&] {
+        const double wall_s = double(lastPresentNs - runStartNs) * 1e-9;
+        nlohmann::json doc;
+        doc["run_id"] = runId;
+        doc["scenario"] = scenario.file.string();
+        doc["scenario_hash"] = scenario.hash;
+        doc["status"] = status;
+        doc["frames_requested"] = opt.frames;
+        doc["frames"] = completed;
+        doc["channels"] = spec.channelNames;
+        doc["wall_s"] = wall_s;
+        doc["fps"] = wall_s > 0.0 ? double(completed) / wall_s : 0.0;
+        doc["rate_hz"] = opt.rate_hz;
+        doc["overruns"] = overruns;
+        doc["skew_us"] = Stats(skewUs);
+        doc["barrier_wait_us"] = Stats(waitUs);
+        doc["frame_interval_ms"] = Stats(frameMs);
+        nlohmann::json render;
+        for (uint32_t c = 0; c < channelCount; ++c)
+            render[spec.channelNames[c]] = Stats(renderMs[c]);
+        doc["render_ms"] = render;
+        doc["threads_per_channel"] = opt.threadsPerChannel;
+        doc["hardware_threads"] = std::thread::hardware_concurrency();
+        sensors::WriteTextFileAtomic(outDir / "summary.json", doc.dump(2) + "\n");
+    };
+
+    runStartNs = sync::MonotonicNs();
+    const uint32_t frames = uint32_t(opt.frames);
+    for (uint32_t i = 0; i < std::min<uint32_t>(frames, sync::kSlotCount); ++i) publish(i);
+    lastPresentNs = runStartNs;
+    for (uint32_t i = 0; i < frames; ++i) {
+        r = lock.WaitPresented(i, alive, opt.frameTimeout_s);
+        if (r != sync::WaitResult::Ready && g_signal && failure.empty()) {
+            // Clean shutdown: the frame in progress completes everywhere, nothing after it.
+            lock.Stop(i);
+            const auto renderersAlive = [&] {
+                for (uint32_t c = 0; c < channelCount; ++c)
+                    if (children[c] > 0 && sync::PollProcess(children[c]))
+                        return children[c] = 0, false;
+                return true;
+            };
+            r = lock.WaitPresented(i, renderersAlive, 30.0);
+            status = "interrupted";
+            exitStatus = 128 + g_signal;
+            if (r != sync::WaitResult::Ready) break;
+        } else if (r != sync::WaitResult::Ready) {
+            const std::string what =
+                r == sync::WaitResult::TimedOut
+                    ? "frame " + std::to_string(spec.firstFrame + i) +
+                          " was not presented by every channel within " +
+                          std::to_string(opt.frameTimeout_s) + " s"
+                    : failure + " at frame " + std::to_string(spec.firstFrame + i);
+            lock.Abort();
+            status = "failed: " + what;
+            progress.Finish();
+            std::fprintf(stderr, "seasense: run stopped: %s\n", what.c_str());
+            // Outputs so far stay complete; the renderers stop, the segment goes.
+            sync::TerminateProcesses(children, 2.0);
+            csv.Finish();
+            if (video) video->Finish();
+            writeSummary();
+            throw RuntimeError(what);
+        }
+
+        // Consume frame i: timings, sync log, mosaic.
+        const int slot = int(i % sync::kSlotCount);
+        const sync::StateSlot& st = header.slots[slot];
+        int64_t minPresent = INT64_MAX, maxPresent = INT64_MIN;
+        std::vector<const uint8_t*> images(channelCount, nullptr);
+        const std::string utc = scene::FormatIso8601(scenario.world.start.PlusSeconds(
+            double(st.frame) * scenario.world.timeScale / scenario.world.frameRate_hz));
+        for (uint32_t c = 0; c < channelCount; ++c) {
+            const sync::FrameTiming& t = header.channels[c].timing[slot];
+            CHECK_MSG(t.frame == st.frame, "channel timing does not belong to the frame");
+            minPresent = std::min(minPresent, t.presentNs);
+            maxPresent = std::max(maxPresent, t.presentNs);
+            const auto rel = [&](int64_t ns) { return ns - header.startNs; };
+            char row[512];
+            std::snprintf(row, sizeof row, "%lld,%s,%s,%lld,%lld,%lld,%lld,%.3f,%.1f\n",
+                          (long long)st.frame, header.channels[c].name, utc.c_str(),
+                          (long long)rel(st.publishNs), (long long)rel(t.startNs),
+                          (long long)rel(t.doneNs), (long long)rel(t.presentNs), t.renderMs,
+                          t.waitUs);
+            csv.Out() << row;
+            renderMs[c].push_back(t.renderMs);
+            waitUs.push_back(t.waitUs);
+            if (video && t.imageBytes == t.imageWidth * t.imageHeight * 3 && t.imageBytes > 0)
+                images[c] = segment.ImageBytes(int(c), slot);
+        }
+        csv.Out().flush();
+        skewUs.push_back(double(maxPresent - minPresent) * 1e-3);
+        if (periodNs > 0 && maxPresent > runStartNs + int64_t(i + 1) * periodNs) ++overruns;
+        frameMs.push_back(double(maxPresent - lastPresentNs) * 1e-6);
+        lastPresentNs = maxPresent;
+        if (video)
+            video->AddFrame(images, "frame " + std::to_string(st.frame) + "  " + utc + "  t = " +
+                                        std::to_string(st.frame * scenario.world.timeScale /
+                                                       scenario.world.frameRate_hz)
+                                            .substr(0, 8) +
+                                        " s");
+        ++completed;
+        progress.Update(completed);
+        if (status != "complete") break;
+        if (i + sync::kSlotCount < frames) publish(i + sync::kSlotCount);
+    }
+    progress.Finish();
+    const double wall_s = double(lastPresentNs - runStartNs) * 1e-9;
+
+    // The renderers leave after their last frame (or the stop); reap them.
+    const int64_t reapDeadline = sync::MonotonicNs() + 10'000'000'000;
+    for (uint32_t c = 0; c < channelCount; ++c) {
+        while (children[c] > 0) {
+            if (std::optional<sync::ProcessExit> e = sync::PollProcess(children[c])) {
+                if (e->signaled || e->code != 0)
+                    std::fprintf(stderr, "seasense: channel '%s' %s at the end of the run\n",
+                                 header.channels[c].name, sync::Describe(*e).c_str());
+                children[c] = 0;
+            } else if (sync::MonotonicNs() > reapDeadline) {
+                break;
+            } else {
+                std::this_thread::sleep_for(std::chrono::milliseconds(2));
+            }
+        }
+    }
+
+    csv.Finish();
+    if (video) video->Finish();
+
+    writeSummary();
+    std::fprintf(stderr,
+                 "seasense: %lld frames of %u channels in %.2f s (%.2f fps), skew p99 %.0f us\n",
+                 (long long)completed, channelCount, wall_s,
+                 wall_s > 0 ? double(completed) / wall_s : 0.0, Percentile(skewUs, 99));
+    return exitStatus;
+}
+
+int RunChannelRenderer(const ChannelOptions& opt) {
+    sync::Segment segment = sync::Segment::Attach(opt.runId, 10.0);
+    sync::SegmentHeader& header = segment.Header();
+    InstallStopHandlers();
+    const int hostPid = header.hostPid;
+    const std::string runId = header.runId;
+
+    scene::Scenario scenario = scene::LoadScenario(header.configPath);
+    if (scenario.hash != header.scenarioHash)
+        throw RuntimeError("scenario " + std::string(header.configPath) + " changed since run '" +
+                           runId + "' started (hash " + scenario.hash + ", the run has " +
+                           header.scenarioHash + ")");
+    const scene::ChannelSettings* ch = scenario.FindChannel(opt.channel);
+    if (!ch || segment.FindChannel(opt.channel) < 0)
+        throw InputError("run '" + runId + "' has no channel named '" + opt.channel + "'");
+    const int threads = opt.threads >= 0 ? opt.threads : header.threadsPerChannel;
+    tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
+    const scene::World world(scenario);
+    std::unique_ptr<ChannelPipeline> pipeline;
+    arena.execute([&] {
+        pipeline = std::make_unique<ChannelPipeline>(world, *ch, header.outDir, ch->formats,
+                                                     DefaultOcioConfig());
+    });
+    const bool writeImages = !(header.flags & sync::kFlagNoImages);
+    const bool copyImages = !(header.flags & sync::kFlagNoMosaic);
+    if (copyImages && uint64_t(ch->width) * uint64_t(ch->height) * 3 > header.imageBytes)
+        throw RuntimeError("run '" + runId + "' image slots are too small for channel '" +
+                           ch->name + "'");
+
+    sync::ChannelLock lock(segment, opt.channel);
+    bool hostGone = false;
+    const auto alive = [&] {
+        if (!sync::ProcessExists(hostPid)) hostGone = true;
+        return !hostGone && g_signal == 0;
+    };
+    const auto ended = [&](sync::WaitResult r, uint32_t index) -> std::optional<int> {
+        if (r == sync::WaitResult::Ready) return std::nullopt;
+        if (r == sync::WaitResult::Stopped) return 0;
+        if (hostGone) {
+            // The host cannot clean up after itself any more.
+            segment.Unlink();
+            std::fprintf(stderr,
+                         "seasense: channel '%s': host (pid %d) of run '%s' is gone; exiting\n",
+                         opt.channel.c_str(), hostPid, runId.c_str());
+            return 1;
+        }
+        if (g_signal) return 128 + g_signal;
+        std::fprintf(stderr, "seasense: channel '%s': timed out waiting at frame index %u\n",
+                     opt.channel.c_str(), index);
+        return 1;
+    };
+
+    constexpr double kWaitTimeout_s = 600.0;
+    const uint32_t frames = uint32_t(header.frameCount);
+    for (uint32_t i = 0; i < frames; ++i) {
+        const uint8_t* stateBytes = nullptr;
+        uint64_t n = 0;
+        int64_t frame = 0;
+        if (auto e =
+                ended(lock.WaitPublished(i, alive, kWaitTimeout_s, &stateBytes, &n, &frame), i))
+            return *e;
+        sync::FrameTiming timing;
+        timing.frame = frame;
+        timing.startNs = sync::MonotonicNs();
+        const scene::FrameState state = sync::DecodeFrameState(stateBytes, n);
+        FrameRecord rec;
+        arena.execute([&] { rec = pipeline->Render(state); });
+        timing.doneNs = sync::MonotonicNs();
+        timing.renderMs = double(timing.doneNs - timing.startNs) * 1e-6;
+        lock.Done(i);
+        if (auto e = ended(lock.WaitAllDone(i, alive, kWaitTimeout_s), i)) return *e;
+        timing.presentNs = sync::MonotonicNs();
+        timing.waitUs = double(timing.presentNs - timing.doneNs) * 1e-3;
+        const int slot = int(i % sync::kSlotCount);
+        if (copyImages) {
+            const std::vector<uint8_t>* rgbPtr = nullptr;
+            arena.execute([&] { rgbPtr = &pipeline->DisplayRgb8(); });
+            const std::vector<uint8_t>& rgb = *rgbPtr;
+            std::memcpy(segment.ImageBytes(lock.Index(), slot), rgb.data(), rgb.size());
+            timing.imageWidth = uint32_t(pipeline->Width());
+            timing.imageHeight = uint32_t(pipeline->Height());
+            timing.imageChannels = 3;
+            timing.imageBytes = uint32_t(rgb.size());
+        }
+        if (writeImages) arena.execute([&] { pipeline->Write(rec); });
+        lock.Block().timing[slot] = timing;
+        lock.Presented(i);
+    }
+    return 0;
+}
+
+}  // namespace seasense::channels

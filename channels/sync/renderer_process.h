@@ -1,0 +1,36 @@
+// Child processes of a run: spawning renderers, reaping them without blocking, naming how
+// they ended, and stopping them (SIGTERM, then SIGKILL after a grace period).
+#pragma once
+
+#include <sys/types.h>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace seasense::channels::sync {
+
+struct ProcessExit {
+    bool signaled = false;
+    int code = 0;  // exit status, or the signal number when signaled
+};
+
+// "exited with status 3" / "killed by signal 9 (SIGKILL)".
+std::string Describe(const ProcessExit& exit);
+
+// Starts argv[0] with arguments argv (posix_spawn, safe in a threaded parent) in its own
+// process group so that a terminal's Ctrl-C reaches only the host, which then stops the
+// renderers itself. RuntimeError on failure.
+pid_t SpawnProcess(const std::vector<std::string>& argv);
+
+// Reaps pid if it has ended (waitpid WNOHANG); nullopt while it runs.
+std::optional<ProcessExit> PollProcess(pid_t pid);
+
+// Sends SIGTERM to each still running pid, waits up to grace_s for them to exit, then
+// SIGKILLs and reaps the rest. Already reaped pids (≤ 0) are skipped.
+void TerminateProcesses(const std::vector<pid_t>& pids, double grace_s);
+
+// The path of the running executable (/proc/self/exe).
+std::string SelfExecutable();
+
+}  // namespace seasense::channels::sync
