@@ -171,7 +171,9 @@ int RunHost(const RunOptions& opt) {
     size_t maxImage = 0;
     for (const scene::ChannelSettings& ch : scenario.channels) {
         spec.channelNames.push_back(ch.name);
-        maxImage = std::max(maxImage, size_t(ch.width) * size_t(ch.height) * 3);
+        int w = 0, h = 0;
+        sync::MosaicPreviewSize(ch.width, ch.height, w, h);
+        maxImage = std::max(maxImage, size_t(w) * size_t(h) * 3);
     }
     spec.configPath = std::filesystem::absolute(scenario.file).string();
     spec.scenarioHash = scenario.hash;
@@ -258,8 +260,11 @@ int RunHost(const RunOptions& opt) {
     std::unique_ptr<sync::MosaicVideo> video;
     if (opt.video) {
         std::vector<sync::MosaicTile> tiles;
-        for (const scene::ChannelSettings& ch : scenario.channels)
-            tiles.push_back({ch.name, ch.width, ch.height});
+        for (const scene::ChannelSettings& ch : scenario.channels) {
+            sync::MosaicTile tile{ch.name, 0, 0};
+            sync::MosaicPreviewSize(ch.width, ch.height, tile.width, tile.height);
+            tiles.push_back(tile);
+        }
         const double fps = opt.rate_hz > 0.0 ? opt.rate_hz : scenario.world.frameRate_hz;
         video = std::make_unique<sync::MosaicVideo>(outDir / "mosaic.mp4", tiles, fps);
     }
@@ -370,7 +375,10 @@ int RunHost(const RunOptions& opt) {
             csv.Out() << row;
             renderMs[c].push_back(t.renderMs);
             waitUs.push_back(t.waitUs);
-            if (video && t.imageBytes == t.imageWidth * t.imageHeight * 3 && t.imageBytes > 0)
+            int w = 0, h = 0;
+            sync::MosaicPreviewSize(scenario.channels[c].width, scenario.channels[c].height, w, h);
+            if (video && t.imageWidth == uint32_t(w) && t.imageHeight == uint32_t(h) &&
+                t.imageBytes == uint32_t(w * h * 3))
                 images[c] = segment.ImageBytes(int(c), slot);
         }
         csv.Out().flush();
@@ -445,7 +453,9 @@ int RunChannelRenderer(const ChannelOptions& opt) {
     });
     const bool writeImages = !(header.flags & sync::kFlagNoImages);
     const bool copyImages = !(header.flags & sync::kFlagNoMosaic);
-    if (copyImages && uint64_t(ch->width) * uint64_t(ch->height) * 3 > header.imageBytes)
+    int previewW = 0, previewH = 0;
+    sync::MosaicPreviewSize(ch->width, ch->height, previewW, previewH);
+    if (copyImages && uint64_t(previewW) * uint64_t(previewH) * 3 > header.imageBytes)
         throw RuntimeError("run '" + runId + "' image slots are too small for channel '" +
                            ch->name + "'");
 
@@ -495,12 +505,11 @@ int RunChannelRenderer(const ChannelOptions& opt) {
         timing.waitUs = double(timing.presentNs - timing.doneNs) * 1e-3;
         const int slot = int(i % sync::kSlotCount);
         if (copyImages) {
-            const std::vector<uint8_t>* rgbPtr = nullptr;
-            arena.execute([&] { rgbPtr = &pipeline->DisplayRgb8(); });
-            const std::vector<uint8_t>& rgb = *rgbPtr;
+            std::vector<uint8_t> rgb;
+            arena.execute([&] { rgb = pipeline->PreviewRgb8(previewW, previewH); });
             std::memcpy(segment.ImageBytes(lock.Index(), slot), rgb.data(), rgb.size());
-            timing.imageWidth = uint32_t(pipeline->Width());
-            timing.imageHeight = uint32_t(pipeline->Height());
+            timing.imageWidth = uint32_t(previewW);
+            timing.imageHeight = uint32_t(previewH);
             timing.imageChannels = 3;
             timing.imageBytes = uint32_t(rgb.size());
         }

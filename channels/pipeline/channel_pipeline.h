@@ -42,6 +42,10 @@ class ChannelPipeline {
     void Write(FrameRecord& record);
     // The display image of the last rendered frame: 8-bit RGB, Width()×Height(), row 0 on top.
     const std::vector<uint8_t>& DisplayRgb8();
+    // The last frame at a reduced size for previews (the run's mosaic): the linear sensor
+    // image area-averaged to width×height, then displayed; 8-bit RGB. Cheaper than
+    // DisplayRgb8 by the area ratio, since the display transform dominates.
+    std::vector<uint8_t> PreviewRgb8(int width, int height) const;
     int Width() const { return channel_.width; }
     int Height() const { return channel_.height; }
 

@@ -31,11 +31,17 @@ void Label(cv::Mat& img, const std::string& text, cv::Point at, double scale) {
 
 }  // namespace
 
+void MosaicPreviewSize(int channelWidth, int channelHeight, int& width, int& height) {
+    width = std::min(channelWidth, kMosaicTileWidth);
+    height = std::max(1, int(std::lround(double(width) * channelHeight / channelWidth)));
+}
+
 MosaicVideo::MosaicVideo(const std::filesystem::path& path, const std::vector<MosaicTile>& tiles,
                          double fps, int tileWidth_px)
     : impl_(std::make_unique<Impl>()), path_(path), tiles_(tiles) {
     CHECK(!tiles.empty() && tileWidth_px >= 16 && fps > 0.0);
-    columns_ = int(std::ceil(std::sqrt(double(tiles.size()) - 1e-9)));
+    columns_ = tiles.size() <= 3 ? int(tiles.size())
+                                 : int(std::ceil(std::sqrt(double(tiles.size()) - 1e-9)));
     const int rows = int((tiles.size() + size_t(columns_) - 1) / size_t(columns_));
     tileW_ = tileWidth_px & ~1;
     double maxAspect = 0.0;

@@ -15,10 +15,18 @@ struct MosaicTile {
     int width = 0, height = 0;  // channel display image size
 };
 
+// Width of one channel's tile in the mosaic, pixels.
+inline constexpr int kMosaicTileWidth = 320;
+
+// Size of a channel's preview image for the mosaic: kMosaicTileWidth wide (or the channel's
+// own width if smaller), the channel's aspect ratio kept.
+void MosaicPreviewSize(int channelWidth, int channelHeight, int& width, int& height);
+
 class MosaicVideo {
   public:
-    // Tiles in reading order, columns = ⌈√n⌉ (3 for five channels, so that the first three
-    // — the contiguous out-the-window channels of the default run — form the top row). Each
+    // Tiles in reading order: one row for up to three channels, else ⌈√n⌉ columns (3 for
+    // five, so that the three contiguous out-the-window channels of the default run form the
+    // top row). Each
     // tile is tileWidth_px wide, images scaled to fit. Writes to a hidden temporary file in
     // the folder of path; Finish() renames it to path. RuntimeError when no MP4 encoder opens.
     MosaicVideo(const std::filesystem::path& path, const std::vector<MosaicTile>& tiles, double fps,

@@ -242,6 +242,9 @@ void WriteDisplayImage(const fs::path& path, const void* pixels, size_t pixelCou
                                             << height << "x" << channels);
     OIIO::ImageSpec spec(width, height, channels, type);
     if (std::string(format) == "tiff") spec.attribute("compression", "zip");
+    // zlib level 1 instead of libpng's default 6: 2.4× faster on a 640×480 frame for ~1.6×
+    // the bytes, which matters when five channels write every frame of a run.
+    if (std::string(format) == "png") spec.attribute("png:compressionLevel", 1);
     AddMetadata(spec, metadata, path);
     WriteAtomically(path, [&](const fs::path& tempPath) {
         WriteWithOiio(format, tempPath, path, spec, type, pixels);

@@ -130,5 +130,70 @@ TEST(OtwChannel, BoxShadowOnAPlateHasLengthHeightOverTanElevation) {
     std::filesystem::remove_all(dir);
 }
 
+TEST(OtwChannel, PoleOnTheBorderOfAdjacentChannelsLinesUp) {
+    // Contiguous channels (−60° and 0° heading, 60° wide each) meet at −30°. A 2 m wide,
+    // 30 m tall pole 200 m away on that border shows its left half at the right edge of the
+    // left channel and its right half at the left edge of the centre one: top and waterline
+    // rows agree within one pixel, and each side covers the columns the pinhole projection
+    // gives for ±atan(1 / 200) about the border.
+    const std::filesystem::path dir =
+        std::filesystem::temp_directory_path() / ("seasense_pole_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    WriteBoxObj(dir / "pole.obj", {-1, -0.5f, -5}, {1, 0.5f, 30});
+    scene::Scenario sc = CalmSeaScenario(10.0, 60.0);
+    sc.materials = {{"grey", glm::dvec3(0.5)}};
+    const double border = -30.0 * M_PI / 180.0, range = 200.0;
+    scene::EntitySettings pole{"pole",
+                               dir / "pole.obj",
+                               {range * std::sin(border), range * std::cos(border), 0.0},
+                               {},
+                               1.0,
+                               "grey"};
+    pole.attitude.heading_rad = border;  // faces the eye
+    sc.entities.push_back(pole);
+    scene::ChannelSettings left = sc.channels[0], centre = sc.channels[0];
+    left.width = centre.width = 640;
+    left.height = centre.height = 480;
+    left.attitude.heading_rad = -60.0 * M_PI / 180.0;
+    const scene::World world(sc);
+    struct Extent {
+        int columns = 0, top = 1 << 30, bottom = -1;
+    };
+    // Pole pixels in the image column band [x0, x1).
+    const auto measure = [&](const scene::ChannelSettings& ch, int x0, int x1) {
+        OtwChannel otw(world, ch);
+        Image radiance;
+        tbb::task_arena arena(2);
+        arena.execute([&] { otw.Render(world.State(0), radiance); });
+        const VisibilityBuffer& vis = otw.Visibility();
+        const uint32_t first = vis.primitiveBase.at(1);
+        Extent e;
+        for (int x = x0; x < x1; ++x) {
+            bool any = false;
+            for (int y = 0; y < vis.height; ++y) {
+                const uint32_t p = vis.primitive[vis.Index(x, y)];
+                if (p == kNoPrimitive || p < first) continue;
+                any = true;
+                if (x == (x0 == 0 ? 0 : x1 - 1)) {  // the column at the shared border
+                    e.top = std::min(e.top, y);
+                    e.bottom = std::max(e.bottom, y);
+                }
+            }
+            e.columns += any;
+        }
+        return e;
+    };
+    const Extent l = measure(left, 600, 640), c = measure(centre, 0, 40);
+    // Pole edge ±atan(1/200) from the border = 30° − δ off the channel axis.
+    const double delta = std::atan(1.0 / range), tanHalf = std::tan(M_PI / 6.0);
+    const double edgePx = (std::tan(M_PI / 6.0 - delta) / tanHalf + 1.0) * 0.5 * 640.0;
+    EXPECT_NEAR(l.columns, 640.0 - edgePx, 1.0);
+    EXPECT_NEAR(c.columns, 640.0 - edgePx, 1.0);
+    EXPECT_NEAR(l.top, c.top, 1.0);
+    EXPECT_NEAR(l.bottom, c.bottom, 1.0);
+    EXPECT_GT(l.bottom - l.top, 20);  // the pole really is there
+    std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace seasense::channels
