@@ -188,6 +188,42 @@ TEST_F(ScenarioLoaderTest, ValidScenarioConvertsToSiUnitsAndRadians) {
     EXPECT_EQ(s.FindMaterial("foam"), nullptr);
 }
 
+TEST_F(ScenarioLoaderTest, EphemerisSunAndMotionAreRead) {
+    const std::string text = Replace(
+        Replace(
+            Replace(valid_, "  sun: {azimuth_deg: 240, elevation_deg: 25, illuminance_lux: 90000}",
+                    "  sun: ephemeris"),
+            "    scale: 1.5\n", "    scale: 1.5\n    speed_mps: 6.5\n    ride_waves: true\n"),
+        "eyepoint:\n", "eyepoint:\n  speed_mps: -2\n");
+    const Scenario sc = LoadScenario(Write(text));
+    EXPECT_TRUE(sc.environment.sun.fromEphemeris);
+    ASSERT_FALSE(sc.entities.empty());
+    EXPECT_EQ(sc.entities[0].speed_mps, 6.5);
+    EXPECT_TRUE(sc.entities[0].rideWaves);
+    EXPECT_EQ(sc.eyepoint.speed_mps, -2.0);
+    const Scenario fixed = LoadScenario(Write(valid_));
+    EXPECT_FALSE(fixed.environment.sun.fromEphemeris);
+    EXPECT_EQ(fixed.entities[0].speed_mps, 0.0);
+    EXPECT_FALSE(fixed.entities[0].rideWaves);
+}
+
+TEST_F(ScenarioLoaderTest, BadSunAndSpeedsAreRejected) {
+    const std::string sun =
+        Replace(valid_, "  sun: {azimuth_deg: 240, elevation_deg: 25, illuminance_lux: 90000}",
+                "  sun: almanac");
+    EXPECT_NE(ErrorFor(sun).find("environment.sun: expected 'ephemeris' or a mapping"),
+              std::string::npos)
+        << ErrorFor(sun);
+    const std::string fast =
+        Replace(valid_, "    scale: 1.5\n", "    scale: 1.5\n    speed_mps: 500\n");
+    EXPECT_NE(ErrorFor(fast).find("entities[0].speed_mps: expected"), std::string::npos)
+        << ErrorFor(fast);
+    const std::string ride =
+        Replace(valid_, "    scale: 1.5\n", "    scale: 1.5\n    ride_waves: maybe\n");
+    EXPECT_NE(ErrorFor(ride).find("entities[0].ride_waves: expected"), std::string::npos)
+        << ErrorFor(ride);
+}
+
 TEST_F(ScenarioLoaderTest, HashFollowsTheFileBytes) {
     const Scenario a = LoadScenario(Write(valid_));
     const Scenario b = LoadScenario(Write(valid_ + "# a comment changes the bytes\n"));
@@ -307,7 +343,8 @@ TEST_F(ScenarioLoaderTest, FieldOfViewMustLieInsideTheOpenInterval) {
 TEST_F(ScenarioLoaderTest, WrongNodeTypeIsNamed) {
     const std::string sun = Replace(
         valid_, "sun: {azimuth_deg: 240, elevation_deg: 25, illuminance_lux: 90000}", "sun: 25");
-    EXPECT_EQ(ErrorFor(sun), At(sun, "sun:", "25", "environment.sun") + "a mapping, found 25");
+    EXPECT_EQ(ErrorFor(sun), At(sun, "sun:", "25", "environment.sun") +
+                                 "'ephemeris' or a mapping {azimuth_deg, elevation_deg}, found 25");
     const std::string fov = Replace(valid_, "    hfov_deg: 60\n", "    hfov_deg: [60]\n");
     EXPECT_EQ(ErrorFor(fov), At(fov, "hfov_deg", "[", "channels[0].hfov_deg") +
                                  "a number (deg) in (0, 180), found a sequence of 1 item");

@@ -193,5 +193,37 @@ TEST(Illuminance, RejectsBadInput) {
     EXPECT_THROW(NaturalIlluminance(t, observer, nan), InputError);
 }
 
+TEST(DirectSun, KastenYoungAirMassAtZenithAndHorizon) {
+    // Kasten & Young (1989) tabulate the air mass of the ISO standard atmosphere, 1.0 at the
+    // zenith and 38.0868 at the horizon; their fit is within 0.5 % of the table there. Down
+    // to 60° zenith distance the air mass is sec z within 1 % (plane-parallel atmosphere).
+    EXPECT_NEAR(RelativeAirMass(M_PI / 2), 1.0, 5e-4);
+    EXPECT_NEAR(RelativeAirMass(0.0), 38.0868, 0.005 * 38.0868);
+    for (double alt_deg : {90.0, 60.0, 45.0, 30.0})
+        EXPECT_NEAR(RelativeAirMass(alt_deg * M_PI / 180) * std::sin(alt_deg * M_PI / 180), 1.0,
+                    0.01)
+            << alt_deg;
+    EXPECT_THROW(RelativeAirMass(std::nan("")), InputError);
+}
+
+TEST(DirectSun, ExtinctionFollowsBeerLambertAndTheDiscSets) {
+    const double au = 1.495978707e11;
+    // No turbidity: the luminous solar constant reaches the ground (Darula et al. 2005).
+    EXPECT_NEAR(DirectNormalSunIlluminance_lux(M_PI / 2, au, 0.0), 133800.0, 1e-6);
+    // ln E is linear in the turbidity factor: doubling T squares the transmittance.
+    const double e1 = DirectNormalSunIlluminance_lux(0.5, au, 2.0) / 133800.0;
+    const double e2 = DirectNormalSunIlluminance_lux(0.5, au, 4.0) / 133800.0;
+    EXPECT_NEAR(e2, e1 * e1, 1e-12);
+    // Clear-sky direct-normal illuminance of a high sun is of order 1e5 lx (IES handbook
+    // range 80–110 klx); at 3° it is a few klx at most.
+    const double high = DirectNormalSunIlluminance_lux(60 * M_PI / 180, au, 3.0);
+    EXPECT_GT(high, 80000.0);
+    EXPECT_LT(high, 110000.0);
+    EXPECT_LT(DirectNormalSunIlluminance_lux(3 * M_PI / 180, au, 3.0), 5000.0);
+    // Below the horizon by more than the disc radius: set.
+    EXPECT_EQ(DirectNormalSunIlluminance_lux(-0.3 * M_PI / 180, au, 3.0), 0.0);
+    EXPECT_GT(DirectNormalSunIlluminance_lux(-0.2 * M_PI / 180, au, 3.0), 0.0);
+}
+
 }  // namespace
 }  // namespace seasense::scene
