@@ -143,16 +143,17 @@ const std::vector<uint8_t>& ChannelPipeline::DisplayRgb8() {
     return display8_;
 }
 
-std::vector<uint8_t> ChannelPipeline::PreviewRgb8(int width, int height) const {
+std::vector<uint8_t> ChannelPipeline::PreviewRgb8(int width, int height) {
     CHECK(width > 0 && height > 0);
+    if (!previewLut_) previewLut_ = std::make_unique<sensors::DisplayLut>(*display_);
     if (width == pixels_.width && height == pixels_.height)
-        return display_->ToDisplay8(pixels_, float(std::exp2(ev_)));
+        return previewLut_->ToDisplay8(pixels_, float(std::exp2(ev_)));
     Image small(width, height, 3);
     const cv::Mat src(pixels_.height, pixels_.width, CV_32FC3,
                       const_cast<float*>(pixels_.pixels.data()));
     cv::Mat dst(height, width, CV_32FC3, small.pixels.data());
     cv::resize(src, dst, dst.size(), 0, 0, cv::INTER_AREA);
-    return display_->ToDisplay8(small, float(std::exp2(ev_)));
+    return previewLut_->ToDisplay8(small, float(std::exp2(ev_)));
 }
 
 void ChannelPipeline::Write(FrameRecord& rec) {

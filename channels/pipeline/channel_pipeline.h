@@ -9,6 +9,7 @@
 
 #include "channels/otw/otw_channel.h"
 #include "scene/world/world.h"
+#include "sensors/display/display_lut.h"
 #include "sensors/display/ocio_display.h"
 
 namespace seasense::channels {
@@ -43,9 +44,9 @@ class ChannelPipeline {
     // The display image of the last rendered frame: 8-bit RGB, Width()×Height(), row 0 on top.
     const std::vector<uint8_t>& DisplayRgb8();
     // The last frame at a reduced size for previews (the run's mosaic): the linear sensor
-    // image area-averaged to width×height, then displayed; 8-bit RGB. Cheaper than
-    // DisplayRgb8 by the area ratio, since the display transform dominates.
-    std::vector<uint8_t> PreviewRgb8(int width, int height) const;
+    // image area-averaged to width×height, then displayed through a 3-D LUT of the channel's
+    // display transform (sensors::DisplayLut, within a few code values of it); 8-bit RGB.
+    std::vector<uint8_t> PreviewRgb8(int width, int height);
     int Width() const { return channel_.width; }
     int Height() const { return channel_.height; }
 
@@ -65,6 +66,7 @@ class ChannelPipeline {
     double ev_ = 0.0;                // the last frame's exposure
     std::vector<uint8_t> display8_;  // display transform of pixels_, when asked for
     bool displayValid_ = false;
+    std::unique_ptr<sensors::DisplayLut> previewLut_;  // built on the first preview
 };
 
 // The project's OCIO config: $SEASENSE_OCIO if set, else configs/ocio/config.ocio found
