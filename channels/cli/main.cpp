@@ -1,4 +1,6 @@
 // The seasense command line: subcommands, and the one place errors become exit statuses.
+#include <malloc.h>
+
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
@@ -29,6 +31,11 @@ std::vector<std::string> SplitCommas(const std::string& s) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    // Frame-sized buffers are allocated and freed every frame. Keep them in the heap instead
+    // of letting glibc return them to the kernel (mmap threshold, heap trimming) only to
+    // fault fresh zero pages back in on the next frame.
+    mallopt(M_MMAP_THRESHOLD, 32 << 20);
+    mallopt(M_TRIM_THRESHOLD, 1 << 30);
     CLI::App app{
         "seasense: sensor-channel simulator for maritime visual simulation\n"
         "(out-the-window, FLIR and NVG channels from one scene core).\n"
