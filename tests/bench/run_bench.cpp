@@ -20,6 +20,12 @@ namespace {
 
 const LivenessCheck kAlways = [] { return true; };
 
+std::string ChannelName(int c) {
+    std::string name(1, 'c');
+    name += char('0' + c);
+    return name;
+}
+
 // Five forked processes attach and run the channel side of the protocol doing no work, so the
 // host's time per frame is the protocol's own cost: publish, wake, done, barrier, present.
 void BM_FrameLockTrivialRenderers(benchmark::State& state) {
@@ -28,7 +34,7 @@ void BM_FrameLockTrivialRenderers(benchmark::State& state) {
     const std::string runId = "bench" + std::to_string(::getpid());
     SegmentSpec spec;
     spec.runId = runId;
-    for (int c = 0; c < channels; ++c) spec.channelNames.push_back("c" + std::to_string(c));
+    for (int c = 0; c < channels; ++c) spec.channelNames.push_back(ChannelName(c));
     spec.frameCount = frames;
     spec.stateBytes = 64;
     double perFrameUs = 0.0;
@@ -39,7 +45,7 @@ void BM_FrameLockTrivialRenderers(benchmark::State& state) {
             const pid_t pid = ::fork();
             if (pid == 0) {
                 Segment mine = Segment::Attach(runId, 5.0);
-                ChannelLock lock(mine, "c" + std::to_string(c));
+                ChannelLock lock(mine, ChannelName(c));
                 for (uint32_t i = 0; i < frames; ++i) {
                     const uint8_t* s = nullptr;
                     uint64_t n = 0;
