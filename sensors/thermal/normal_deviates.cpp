@@ -1,0 +1,70 @@
+// Table inversion of the standard normal CDF for per-pixel noise.
+#include "sensors/thermal/normal_deviates.h"
+
+#include <array>
+#include <cmath>
+#include <numbers>
+
+namespace seasense::sensors {
+
+namespace {
+
+constexpr int kTableBits = 13;
+constexpr int kTableSize = 1 << kTableBits;
+constexpr int kFractionBits = 31 - kTableBits;
+
+// |z| with P(|Z| ≤ z) = v for v ∈ [0, 1) given as the complement q = 1 − v (exact for the
+// 31-bit v): Newton's method on ln erfc(z/√2) = ln q, which is smooth and concave in z, so
+// the iteration from the upper side converges monotonically.
+double HalfNormalQuantile(double q) {
+    if (q >= 1.0) return 0.0;
+    const double target = std::log(q);
+    // Start above the root: |z| ≤ √(−2 ln q) (Chernoff bound erfc(z/√2) ≤ e^{−z²/2}).
+    double z = std::sqrt(-2.0 * target) + 1e-3;
+    for (int it = 0; it < 60; ++it) {
+        const double e = std::erfc(z / std::numbers::sqrt2);
+        // d/dz ln erfc(z/√2) = −√(2/π) e^{−z²/2} / erfc(z/√2)
+        const double slope = -std::sqrt(2.0 / std::numbers::pi) * std::exp(-0.5 * z * z) / e;
+        const double step = (std::log(e) - target) / slope;
+        z -= step;
+        if (std::abs(step) < 1e-13 * (1.0 + z)) break;
+    }
+    return z;
+}
+
+struct QuantileTable {
+    std::array<float, kTableSize> value{};  // |z| at v = k/kTableSize
+    QuantileTable() {
+        for (int k = 0; k < kTableSize; ++k)
+            value[size_t(k)] = float(HalfNormalQuantile(1.0 - double(k) / kTableSize));
+    }
+};
+
+const QuantileTable& Table() {
+    static const QuantileTable table;
+    return table;
+}
+
+}  // namespace
+
+float NormalFromBits(uint32_t bits) {
+    const QuantileTable& t = Table();
+    const uint32_t v = bits >> 1;  // 31 bits of v·2³¹
+    const uint32_t k = v >> kFractionBits;
+    float z;
+    if (k + 1 < uint32_t(kTableSize)) {
+        const float f = float(v & ((1u << kFractionBits) - 1)) * (1.0f / (1u << kFractionBits));
+        z = t.value[k] + f * (t.value[k + 1] - t.value[k]);
+    } else {
+        // 1 − v for the 31-bit v, exact in double.
+        z = float(HalfNormalQuantile(double((1u << 31) - v) * 0x1.0p-31));
+    }
+    return (bits & 1u) ? -z : z;
+}
+
+void NormalPair(uint64_t bits, float& z0, float& z1) {
+    z0 = NormalFromBits(uint32_t(bits >> 32));
+    z1 = NormalFromBits(uint32_t(bits));
+}
+
+}  // namespace seasense::sensors

@@ -1,0 +1,330 @@
+// Thermal imager chain: sampling kernel, lag, NETD noise, fixed pattern, NUC, ADC and AGC.
+#include "sensors/thermal/thermal_imager.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <sstream>
+
+#include "scene/core/error.h"
+#include "scene/core/rng.h"
+#include "sensors/thermal/normal_deviates.h"
+
+namespace seasense::sensors {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+// Random streams of the counter RNG (scene/core/rng.h): one per pattern, one per frame of
+// temporal noise and one per NUC calibration frame, so no two draws share a (stream, counter).
+constexpr uint64_t kStreamPixelOffset = 1;
+constexpr uint64_t kStreamPixelGain = 2;
+constexpr uint64_t kStreamRow = 3;
+constexpr uint64_t kStreamColumn = 4;
+constexpr uint64_t kStreamTemporal = uint64_t(1) << 40;     // + frame index
+constexpr uint64_t kStreamCalibration = uint64_t(2) << 40;  // + calibration frame index
+
+// A pixel's gain never drops below this fraction of nominal, so a large gain spread cannot
+// give a pixel zero or inverted response.
+constexpr double kMinPixelGain = 0.01;
+
+inline float Gaussian(uint64_t seed, uint64_t stream, uint64_t counter) {
+    return NormalFromBits(uint32_t(scene::HashBits(seed, stream, counter) >> 32));
+}
+
+// Noise counter of pixel (x, y): one hash serves the pair (x, x + 1), x even.
+inline uint64_t PairCounter(int x, int y) {
+    return (uint64_t(uint32_t(y)) << 32) | uint32_t(x / 2);
+}
+
+inline uint16_t Quantize(double v) {
+    if (!(v > 0.0)) return 0;  // also NaN
+    if (v >= double(kAdcMaxCount)) return kAdcMaxCount;
+    return uint16_t(v + 0.5);  // round half up; v ≥ 0
+}
+
+void Validate(const ThermalImagerSettings& s, int supersamples) {
+    std::ostringstream msg;
+    auto fail = [&](const char* what, double v, const char* expected) {
+        msg << "thermal imager: " << what << " = " << v << "; expected " << expected;
+        throw InputError(msg.str());
+    };
+    auto positive = [&](const char* what, double v) {
+        if (!(std::isfinite(v) && v > 0)) fail(what, v, "a finite value > 0");
+    };
+    auto nonNegative = [&](const char* what, double v) {
+        if (!(std::isfinite(v) && v >= 0)) fail(what, v, "a finite value >= 0");
+    };
+    if (s.width_px < 1 || s.height_px < 1 || s.width_px > 32768 || s.height_px > 32768)
+        fail("width × height (px)", double(s.width_px) * s.height_px, "1 … 32768 on each side");
+    if (supersamples < 1 || supersamples > 16) fail("supersamples", supersamples, "1 … 16");
+    positive("pixel pitch (m)", s.pitch_m);
+    if (!(s.fillFactor > 0 && s.fillFactor <= 1)) fail("fill factor", s.fillFactor, "(0, 1]");
+    nonNegative("time constant (s)", s.timeConstant_s);
+    positive("focal length (m)", s.focalLength_m);
+    positive("F-number", s.fNumber);
+    if (!(s.opticsTransmission > 0 && s.opticsTransmission <= 1))
+        fail("optics transmission", s.opticsTransmission, "(0, 1]");
+    nonNegative("aberration sigma (m)", s.aberrationSigma_m);
+    if (s.psfRadius_px < 1) fail("PSF radius (px)", s.psfRadius_px, ">= 1");
+    nonNegative("NETD (K)", s.netd_K);
+    positive("NETD reference temperature (K)", s.netdReference_K);
+    nonNegative("offset FPN (K)", s.offsetFpn_K);
+    if (!(s.gainFpn >= 0 && s.gainFpn <= 0.5)) fail("gain FPN", s.gainFpn, "[0, 0.5]");
+    nonNegative("row FPN (K)", s.rowFpn_K);
+    nonNegative("column FPN (K)", s.columnFpn_K);
+    if (s.nuc) {
+        positive("NUC low temperature (K)", s.nucLow_K);
+        if (!(std::isfinite(s.nucHigh_K) && s.nucHigh_K > s.nucLow_K))
+            fail("NUC high temperature (K)", s.nucHigh_K, "a value above the low temperature");
+        if (s.nucFrames < 1) fail("NUC frames", s.nucFrames, ">= 1");
+    }
+    positive("ADC minimum temperature (K)", s.adcMin_K);
+    if (!(std::isfinite(s.adcMax_K) && s.adcMax_K > s.adcMin_K))
+        fail("ADC maximum temperature (K)", s.adcMax_K, "a value above the minimum");
+}
+
+SamplingKernel MakeKernel(const ThermalImagerSettings& s, const radiometry::Band& band,
+                          int supersamples) {
+    Validate(s, supersamples);
+    OpticsGeometry g;
+    g.fNumber = s.fNumber;
+    g.pitch_m = s.pitch_m;
+    g.fillFactor = s.fillFactor;
+    g.aberrationSigma_m = s.aberrationSigma_m;
+    g.referenceT_K = s.netdReference_K;
+    return BuildSamplingKernel(band, g, supersamples,
+                               SamplingKernelRadius_px(band, g, s.psfRadius_px));
+}
+
+}  // namespace
+
+double FocalPlaneIrradiance(double radiance_W_m2_sr, double tau, double fNumber) {
+    return tau * kPi * radiance_W_m2_sr / (4.0 * fNumber * fNumber + 1.0);
+}
+
+double ApparentTemperature(const radiometry::BandRadianceTable& table, double radiance_W_m2_sr,
+                           double tauPath, double airT_K) {
+    std::ostringstream msg;
+    if (!(tauPath > 0.0 && tauPath <= 1.0)) {
+        msg << "apparent temperature: path transmission " << tauPath << "; expected (0, 1]";
+        throw InputError(msg.str());
+    }
+    if (!std::isfinite(radiance_W_m2_sr) || !(std::isfinite(airT_K) && airT_K > 0.0)) {
+        msg << "apparent temperature: radiance " << radiance_W_m2_sr << " W/(m² sr), air " << airT_K
+            << " K; expected a finite radiance and an air temperature > 0 K";
+        throw InputError(msg.str());
+    }
+    const double path = tauPath < 1.0 ? (1.0 - tauPath) * table.Radiance(airT_K) : 0.0;
+    const double target = (radiance_W_m2_sr - path) / tauPath;
+    if (!(target > 0.0)) {
+        msg << "apparent temperature: measured radiance " << radiance_W_m2_sr
+            << " W/(m² sr) is not above the path radiance " << path
+            << " W/(m² sr); expected a target brighter than absolute zero";
+        throw InputError(msg.str());
+    }
+    return table.Temperature(target);
+}
+
+ThermalImager::ThermalImager(const ThermalImagerSettings& settings, radiometry::Band band,
+                             int supersamples)
+    : settings_(settings),
+      table_(std::move(band)),
+      kernel_(MakeKernel(settings, table_.GetBand(), supersamples)),
+      display_(settings.agc),
+      radiance_(settings.width_px, settings.height_px, 1),
+      signal_(settings.width_px, settings.height_px, 1),
+      counts_(size_t(settings.width_px) * size_t(settings.height_px), 0) {
+    const ThermalImagerSettings& s = settings_;
+    irradiancePerRadiance_ = FocalPlaneIrradiance(1.0, s.opticsTransmission, s.fNumber);
+    // NETD: the temperature step whose signal change equals the temporal noise std, so
+    // σ_E = NETD · dE/dT at the reference temperature.
+    noiseSigma_ = s.netd_K * irradiancePerRadiance_ * table_.RadianceDerivative(s.netdReference_K);
+    const double eMin = BlackbodyIrradiance(s.adcMin_K), eMax = BlackbodyIrradiance(s.adcMax_K);
+    adcGain_ = double(kAdcMaxCount) / (eMax - eMin);
+    adcOffset_ = -adcGain_ * eMin;
+    BuildFixedPattern();
+    if (s.nuc) CalibrateNuc();
+}
+
+double ThermalImager::BlackbodyIrradiance(double T_K) const {
+    return irradiancePerRadiance_ * table_.Radiance(T_K);
+}
+
+double ThermalImager::HorizontalFov_rad() const {
+    return 2.0 *
+           std::atan(settings_.width_px * settings_.pitch_m / (2.0 * settings_.focalLength_m));
+}
+
+void ThermalImager::BuildFixedPattern() {
+    const ThermalImagerSettings& s = settings_;
+    const bool pattern = s.offsetFpn_K > 0 || s.gainFpn > 0 || s.rowFpn_K > 0 || s.columnFpn_K > 0;
+    if (!pattern && !s.nuc) return;
+    const int w = s.width_px, h = s.height_px;
+    const size_t n = size_t(w) * size_t(h);
+    rawGain_.assign(n, 1.0f);
+    rawOffset_.assign(n, 0.0f);
+    // Offsets are specified in kelvin at the NETD reference, like the NETD itself.
+    const double perKelvin = irradiancePerRadiance_ * table_.RadianceDerivative(s.netdReference_K);
+    std::vector<double> column(static_cast<size_t>(w));
+    for (int x = 0; x < w; ++x)
+        column[size_t(x)] = s.columnFpn_K * Gaussian(s.seed, kStreamColumn, uint64_t(x));
+    tbb::parallel_for(0, h, [&](int y) {
+        const double row = s.rowFpn_K * Gaussian(s.seed, kStreamRow, uint64_t(y));
+        for (int x = 0; x < w; ++x) {
+            const size_t i = size_t(y) * size_t(w) + size_t(x);
+            const double g = 1.0 + s.gainFpn * Gaussian(s.seed, kStreamPixelGain, i);
+            const double o = s.offsetFpn_K * Gaussian(s.seed, kStreamPixelOffset, i);
+            rawGain_[i] = float(std::max(g, kMinPixelGain));
+            rawOffset_[i] = float((o + row + column[size_t(x)]) * perKelvin);
+        }
+    });
+    gain_ = rawGain_;
+    offset_ = rawOffset_;
+    noiseScale_.assign(n, 1.0f);
+}
+
+void ThermalImager::CalibrateNuc() {
+    // Two-point NUC (Holst, "Electro-Optical Imaging System Performance", ch. 12; Scribner et
+    // al., Proc. SPIE 1308, 1990): each pixel's mean response to uniform blackbodies at T1 and
+    // T2 defines the linear correction s' = a·s + b that maps them to the ideal pixel's
+    // signals E1 and E2. The means come from nucFrames noisy frames, so the correction
+    // carries the calibration noise σ/√frames a real camera has.
+    const ThermalImagerSettings& s = settings_;
+    const int w = s.width_px, h = s.height_px, frames = s.nucFrames;
+    const double e1 = BlackbodyIrradiance(s.nucLow_K), e2 = BlackbodyIrradiance(s.nucHigh_K);
+    tbb::parallel_for(0, h, [&](int y) {
+        std::vector<double> sum1(size_t(w), 0.0), sum2(size_t(w), 0.0);
+        for (int f = 0; f < 2 * frames; ++f) {
+            std::vector<double>& sum = f < frames ? sum1 : sum2;
+            const double e = f < frames ? e1 : e2;
+            for (int x = 0; x < w; x += 2) {
+                float z[2] = {0.0f, 0.0f};
+                if (noiseSigma_ > 0)
+                    NormalPair(scene::HashBits(s.seed, kStreamCalibration + uint64_t(f),
+                                               PairCounter(x, y)),
+                               z[0], z[1]);
+                for (int k = 0; k < 2 && x + k < w; ++k)
+                    sum[size_t(x + k)] += RawSignal(size_t(y) * size_t(w) + size_t(x + k), e, z[k]);
+            }
+        }
+        for (int x = 0; x < w; ++x) {
+            const size_t i = size_t(y) * size_t(w) + size_t(x);
+            const double s1 = sum1[size_t(x)] / frames, s2 = sum2[size_t(x)] / frames;
+            // A pixel whose calibration gave no response difference keeps its raw response.
+            if (!(s2 > s1)) continue;
+            const double a = (e2 - e1) / (s2 - s1);
+            const double b = e1 - a * s1;
+            gain_[i] = float(a * rawGain_[i]);
+            offset_[i] = float(a * rawOffset_[i] + b);
+            noiseScale_[i] = float(a);
+        }
+    });
+}
+
+double ThermalImager::RawSignal(size_t i, double E, double z) const {
+    return double(rawGain_[i]) * E + double(rawOffset_[i]) + noiseSigma_ * z;
+}
+
+void ThermalImager::Process(const Image& samples, double time_s) {
+    const int w = settings_.width_px, h = settings_.height_px, n = kernel_.supersamples;
+    CHECK_MSG(samples.channels == 1 && samples.width == w * n && samples.height == h * n,
+              "thermal imager input " << samples.width << "×" << samples.height << "×"
+                                      << samples.channels << ", expected " << w * n << "×" << h * n
+                                      << "×1");
+    CHECK(std::isfinite(time_s));
+    const bool first = frame_ == 0;
+    CHECK_MSG(first || time_s > lastTime_s_,
+              "frame time " << time_s << " s not after " << lastTime_s_ << " s");
+    const double dt_s = first ? 0.0 : time_s - lastTime_s_;
+    // First-order lag of the bolometer, exact for a scene held constant over the frame:
+    // y_n = y_{n−1} + (1 − exp(−Δt/τ))(x_n − y_{n−1}) (issue 5). The first frame starts settled.
+    const double alpha = first || settings_.timeConstant_s == 0.0
+                             ? 1.0
+                             : 1.0 - std::exp(-dt_s / settings_.timeConstant_s);
+    const double tau = settings_.opticsTransmission;
+    const double kE = irradiancePerRadiance_ / tau;  // detector radiance → irradiance
+    const bool ideal = gain_.empty();
+    const bool noisy = noiseSigma_ > 0.0;
+    const float sigma = float(noiseSigma_);
+    // scene::HashBits(seed, stream, c) = Mix64(key ^ c) with the key below, hoisted out of
+    // the pixel loop.
+    const uint64_t key =
+        scene::Mix64(scene::Mix64(settings_.seed) ^ (kStreamTemporal + uint64_t(frame_)));
+    tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
+        std::vector<float> scratch;
+        for (int y = rows.begin(); y < rows.end(); ++y) {
+            float* rad = radiance_.At(0, y);
+            float* sig = signal_.At(0, y);
+            uint16_t* cnt = counts_.data() + size_t(y) * size_t(w);
+            SampleKernelRow(samples, kernel_, y, sig, scratch);  // blurred at-aperture radiance
+            for (int x = 0; x < w; x += 2) {
+                float z[2] = {0.0f, 0.0f};
+                if (noisy) NormalPair(scene::Mix64(key ^ PairCounter(x, y)), z[0], z[1]);
+                for (int k = 0; k < 2 && x + k < w; ++k) {
+                    const int xx = x + k;
+                    const double L = tau * double(sig[xx]);
+                    const double lagged = alpha == 1.0 ? L : rad[xx] + alpha * (L - rad[xx]);
+                    rad[xx] = float(lagged);
+                    const double E = kE * lagged;
+                    double s;
+                    if (ideal) {
+                        s = E + double(sigma * z[k]);
+                    } else {
+                        const size_t i = size_t(y) * size_t(w) + size_t(xx);
+                        s = double(gain_[i]) * E + double(offset_[i]) +
+                            double(noiseScale_[i] * sigma * z[k]);
+                    }
+                    sig[xx] = float(s);
+                    cnt[xx] = Quantize(adcGain_ * s + adcOffset_);
+                }
+            }
+        }
+    });
+    display_.Update(counts_, dt_s);
+    display_.Render(counts_, display8_);
+    lastTime_s_ = time_s;
+    ++frame_;
+}
+
+Image ThermalImager::ApparentTemperature() const {
+    Image T(radiance_.width, radiance_.height, 1);
+    const double invTau = 1.0 / settings_.opticsTransmission;
+    tbb::parallel_for(0, T.height, [&](int y) {
+        const float* rad = radiance_.At(0, y);
+        float* t = T.At(0, y);
+        for (int x = 0; x < T.width; ++x) {
+            const double L = double(rad[x]) * invTau;
+            t[x] = L > 0.0 ? float(table_.Temperature(L)) : 0.0f;
+        }
+    });
+    return T;
+}
+
+ImageMetadata ThermalImager::Metadata() const {
+    const ThermalImagerSettings& s = settings_;
+    ImageMetadata m;
+    m.Set("seasense:band", GetBand().Name());
+    m.Set("seasense:band_range_m", std::vector<float>{float(GetBand().MinWavelength_m()),
+                                                      float(GetBand().MaxWavelength_m())});
+    m.Set("seasense:netd_K", float(s.netd_K));
+    m.Set("seasense:netd_reference_K", float(s.netdReference_K));
+    m.Set("seasense:f_number", float(s.fNumber));
+    m.Set("seasense:focal_length_m", float(s.focalLength_m));
+    m.Set("seasense:pitch_m", float(s.pitch_m));
+    m.Set("seasense:fill_factor", float(s.fillFactor));
+    m.Set("seasense:optics_transmission", float(s.opticsTransmission));
+    m.Set("seasense:aberration_sigma_m", float(s.aberrationSigma_m));
+    m.Set("seasense:time_constant_s", float(s.timeConstant_s));
+    m.Set("seasense:adc_bits", kAdcBits);
+    m.Set("seasense:adc_range_K", std::vector<float>{float(s.adcMin_K), float(s.adcMax_K)});
+    m.Set("seasense:nuc", s.nuc ? 1 : 0);
+    m.Set("seasense:frame_index", int(frame_ - 1));
+    return m;
+}
+
+}  // namespace seasense::sensors

@@ -1,0 +1,56 @@
+// Normal deviates against the normal distribution's moments, tail probabilities, quantiles.
+#include "sensors/thermal/normal_deviates.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "scene/core/rng.h"
+
+namespace seasense::sensors {
+namespace {
+
+TEST(NormalDeviates, MomentsAndTailProbabilitiesMatchTheNormalDistribution) {
+    const int pairs = 1 << 19;
+    double sum = 0, sum2 = 0, sum4 = 0;
+    int beyond1 = 0, beyond2 = 0, beyond3 = 0;
+    for (int i = 0; i < pairs; ++i) {
+        float z[2];
+        NormalPair(scene::HashBits(7, 11, uint64_t(i)), z[0], z[1]);
+        for (float v : z) {
+            sum += v;
+            sum2 += double(v) * v;
+            sum4 += double(v) * v * v * v;
+            beyond1 += std::abs(v) > 1.0f;
+            beyond2 += std::abs(v) > 2.0f;
+            beyond3 += std::abs(v) > 3.0f;
+        }
+    }
+    const double n = 2.0 * pairs;
+    // Standard errors for n = 2²⁰: mean 0.001, variance 0.0014, kurtosis ~0.005.
+    EXPECT_NEAR(sum / n, 0.0, 0.005);
+    EXPECT_NEAR(sum2 / n, 1.0, 0.007);
+    EXPECT_NEAR(sum4 / n, 3.0, 0.03);
+    // P(|Z| > k) = erfc(k/√2): 0.317311, 0.0455003, 0.0026998.
+    EXPECT_NEAR(beyond1 / n, 0.317311, 0.0025);
+    EXPECT_NEAR(beyond2 / n, 0.0455003, 0.0010);
+    EXPECT_NEAR(beyond3 / n, 0.0026998, 0.00025);
+}
+
+TEST(NormalDeviates, QuantilesAreExactAtTableNodesAndInTheTail) {
+    // Bits with v = ½ (sign bit clear): |z| = Φ⁻¹(¾) = 0.6744897501960817 (A&S 26.2.23 /
+    // table 26.1), and the sign bit negates it.
+    EXPECT_NEAR(NormalFromBits(1u << 31), 0.6744897501960817, 1e-6);
+    EXPECT_NEAR(NormalFromBits((1u << 31) | 1u), -0.6744897501960817, 1e-6);
+    EXPECT_EQ(NormalFromBits(0u), 0.0f);
+    // Deep in the tail (the exact Newton branch): v = 1 − k·2⁻³¹ ⇒ erfc(|z|/√2) = k·2⁻³¹.
+    for (uint32_t k : {1u, 7u, 1000u, 200000u}) {
+        const uint32_t v = (1u << 31) - k;
+        const double z = NormalFromBits(v << 1);
+        EXPECT_NEAR(std::erfc(z / std::numbers::sqrt2) / (k * 0x1.0p-31), 1.0, 1e-5) << k;
+    }
+}
+
+}  // namespace
+}  // namespace seasense::sensors
