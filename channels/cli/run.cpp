@@ -145,7 +145,7 @@ int RunHost(const RunOptions& opt) {
         throw InputError("--threads: expected an integer >= 0 (0 = all cores)");
     const scene::Scenario scenario = scene::LoadScenario(opt.config);
     for (const scene::ChannelSettings& ch : scenario.channels)
-        if (ch.kind != scene::ChannelKind::Otw)
+        if (ch.kind == scene::ChannelKind::Nvg)
             throw InputError(scenario.file.string() + ": channel '" + ch.name + "' has kind '" +
                              KindName(ch.kind) + "', which this build cannot render yet");
     for (const std::string& name : opt.external)
@@ -321,7 +321,9 @@ int RunHost(const RunOptions& opt) {
     lastPresentNs = runStartNs;
     for (uint32_t i = 0; i < frames; ++i) {
         r = lock.WaitPresented(i, alive, opt.frameTimeout_s);
-        if (r != sync::WaitResult::Ready && g_signal && failure.empty()) {
+        // The signal is checked here as well as in the waits' liveness polls: when frames
+        // come faster than one poll interval a wait may never poll.
+        if (g_signal && failure.empty()) {
             // Clean shutdown: the frame in progress completes everywhere, nothing after it.
             lock.Stop(i);
             const auto renderersAlive = [&] {
@@ -330,7 +332,7 @@ int RunHost(const RunOptions& opt) {
                         return children[c] = 0, false;
                 return true;
             };
-            r = lock.WaitPresented(i, renderersAlive, 30.0);
+            if (r != sync::WaitResult::Ready) r = lock.WaitPresented(i, renderersAlive, 30.0);
             status = "interrupted";
             exitStatus = 128 + g_signal;
             if (r != sync::WaitResult::Ready) break;
@@ -516,6 +518,8 @@ int RunChannelRenderer(const ChannelOptions& opt) {
         if (writeImages) arena.execute([&] { pipeline->Write(rec); });
         lock.Block().timing[slot] = timing;
         lock.Presented(i);
+        // Fast frames may never reach a wait's liveness poll: look at the signal here too.
+        if (g_signal) return 128 + g_signal;
     }
     return 0;
 }

@@ -31,10 +31,6 @@ constexpr float kSeaAlbedo = 0.06f;
 // Koschmieder: extinction coefficient for a 2 % contrast threshold, β = 3.912 / V.
 double ExtinctionFromVisibility(double visibility_m) { return 3.912 / visibility_m; }
 
-// Sea mesh vertex spacing on screen: waves are smooth at this scale and their normals are
-// interpolated per sample.
-constexpr double kOceanVertexSpacing_px = 6.0;
-
 // Whether the ray origin + t·direction, t ≥ 0, meets the box [lo, hi] (slab test; Kay & Kajiya,
 // SIGGRAPH 1986). Inline for the per-sample shadow-caster prefilter.
 struct RayBoxTest {
@@ -289,119 +285,10 @@ F4 Interpolate3(F4 b0, F4 b1, F4 b2, F4 a0, F4 a1, F4 a2) {
 
 }  // namespace
 
-namespace {
-
-// Calls fn(d) for unit world directions along the boundary of the camera's frustum (33 per
-// edge); fn returns false to stop early.
-template <class Fn>
-void ForEachFrustumBoundaryDirection(const ChannelCamera& cam, Fn&& fn) {
-    constexpr int kSteps = 32;
-    for (int e = 0; e < 4; ++e) {
-        for (int i = 0; i <= kSteps; ++i) {
-            const double s = double(i) / kSteps;
-            const double u = e == 0 ? s : e == 1 ? 1.0 : e == 2 ? 1.0 - s : 0.0;
-            const double v = e == 0 ? 0.0 : e == 1 ? s : e == 2 ? 1.0 : 1.0 - s;
-            if (!fn(cam.SampleDirection(u * cam.SampleWidth() - 0.5, v * cam.SampleHeight() - 0.5)))
-                return;
-        }
-    }
-}
-
-// Whether the straight-down direction lies inside the frustum (its boundary winds around it).
-bool FrustumContainsNadir(const ChannelCamera& cam) {
-    const glm::dvec3 down =
-        glm::transpose(cam.worldFromCamera.worldFromBody) * glm::dvec3(0, 0, -1);
-    if (down.y <= 0.0) return false;  // behind the camera
-    return std::abs(down.x / down.y) <= cam.TanHalfH() &&
-           std::abs(down.z / down.y) <= cam.TanHalfV();
-}
-
-}  // namespace
-
-void FrustumAzimuthSector(const ChannelCamera& cam, double margin, double& lo, double& hi) {
-    const glm::dvec3 axis = cam.worldFromCamera.worldFromBody * glm::dvec3(0, 1, 0);
-    const double centre = std::atan2(axis.x, axis.y);
-    double minRel = 0.0, maxRel = 0.0;
-    bool full = false;
-    // The azimuth extremes of a convex cone of directions lie on its boundary.
-    ForEachFrustumBoundaryDirection(cam, [&](const glm::dvec3& d) {
-        if (std::hypot(d.x, d.y) < 0.05) {
-            full = true;  // within ~3° of the zenith or nadir: all azimuths are near
-            return false;
-        }
-        const double rel = std::remainder(std::atan2(d.x, d.y) - centre, 2.0 * M_PI);
-        minRel = std::min(minRel, rel);
-        maxRel = std::max(maxRel, rel);
-        return true;
-    });
-    if (full || maxRel - minRel + 2.0 * margin >= 2.0 * M_PI) {
-        lo = 0.0;
-        hi = 2.0 * M_PI;
-        return;
-    }
-    lo = centre + minRel - margin;
-    hi = centre + maxRel + margin;
-}
-
-double NearestVisibleSeaRange_m(const ChannelCamera& cam, double crestHeight_m,
-                                double horizontalReach_m) {
-    const double h = cam.worldFromCamera.position_m.z - crestHeight_m;
-    if (h <= 0.0 || FrustumContainsNadir(cam)) return 0.0;
-    // The steepest downward view ray meets the crest plane nearest: range = h / slope.
-    double slope = 0.0;
-    ForEachFrustumBoundaryDirection(cam, [&](const glm::dvec3& d) {
-        slope = std::max(slope, -d.z / std::max(std::hypot(d.x, d.y), 1e-9));
-        return true;
-    });
-    if (slope <= 0.0) return std::numeric_limits<double>::infinity();  // no ray looks down
-    // Sampled boundary and straight-line rays: keep a 20 % margin, then allow for vertices
-    // that the waves carry horizontally toward the eye.
-    return std::max(0.0, 0.8 * h / slope - horizontalReach_m);
-}
-
 OtwChannel::OtwChannel(const scene::World& world, const scene::ChannelSettings& settings)
-    : world_(world), settings_(settings) {
-    const scene::SceneState s0 = world.State(0);
-    for (const scene::EntityState& e : s0.entities) {
-        worldMeshes_.push_back(scene::TransformMesh(*e.bodyMesh, e.pose));
-        entityPoses_.push_back(e.pose);
+    : world_(world), settings_(settings), geometry_(world, settings) {
+    for (const scene::EntityState& e : world.State(0).entities)
         reflectance_.push_back(e.reflectanceRgb);
-        occlusionIds_.push_back(
-            occlusion_.AddMesh(worldMeshes_.back().positions, worldMeshes_.back().indices));
-    }
-    occlusion_.Commit();
-    UpdateCasterBounds();
-}
-
-void OtwChannel::UpdateEntities(const scene::SceneState& state) {
-    CHECK(state.entities.size() == worldMeshes_.size());
-    bool moved = false;
-    for (size_t i = 0; i < state.entities.size(); ++i) {
-        const scene::Pose& pose = state.entities[i].pose;
-        if (pose.position_m == entityPoses_[i].position_m &&
-            pose.worldFromBody == entityPoses_[i].worldFromBody)
-            continue;
-        worldMeshes_[i] = scene::TransformMesh(*state.entities[i].bodyMesh, pose);
-        entityPoses_[i] = pose;
-        occlusion_.UpdateMesh(occlusionIds_[i], worldMeshes_[i].positions);
-        moved = true;
-    }
-    if (!moved) return;
-    occlusion_.Commit();
-    UpdateCasterBounds();
-}
-
-void OtwChannel::UpdateCasterBounds() {
-    glm::vec3 lo(std::numeric_limits<float>::infinity()), hi(-lo);
-    for (const scene::TriangleMesh& m : worldMeshes_)
-        for (const glm::vec3& p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
-    // Far wider than OcclusionScene's 1e-5 relative + 0.1 mm margin, so that this test
-    // passing is implied by MayOcclude passing despite float rounding.
-    const float margin_m = 1e-3f * std::max({glm::abs(lo).x, glm::abs(lo).y, glm::abs(lo).z,
-                                             glm::abs(hi).x, glm::abs(hi).y, glm::abs(hi).z}) +
-                           0.1f;
-    casterMin_ = lo - margin_m;
-    casterMax_ = hi + margin_m;
 }
 
 struct OtwChannel::ShadeScratch {
@@ -413,41 +300,26 @@ OtwChannel::~OtwChannel() = default;
 void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     const scene::Scenario& sc = world_.GetScenario();
     const scene::EnvironmentSettings& env = sc.environment;
-    camera_ = MakeChannelCamera(state.eyepoint, settings_);
-    const ChannelCamera& cam = camera_;
-    UpdateEntities(state);
-    const int sw = cam.SampleWidth(), sh = cam.SampleHeight();
-
     using Clock = std::chrono::steady_clock;
     const auto Ms = [](Clock::time_point a, Clock::time_point b) {
         return std::chrono::duration<double, std::milli>(b - a).count();
     };
-    const Clock::time_point t0 = Clock::now();
-    // Sea mesh for this view: vertices about 4 pixels apart on screen.
-    scene::OceanMeshRequest req;
-    req.eye_m = cam.worldFromCamera.position_m;
-    req.time_s = state.time_s;
-    req.angularStep_rad = kOceanVertexSpacing_px * cam.hfov_rad / double(cam.width);
-    FrustumAzimuthSector(cam, 20.0 * M_PI / 180.0, req.azimuthMin_rad, req.azimuthMax_rad);
-    const scene::GerstnerOcean& sea = world_.Ocean();
-    req.minRange_m = NearestVisibleSeaRange_m(cam, sea.MaxAmplitude_m(), sea.MaxHorizontal_m());
-    scene::BuildOceanMesh(sea, req, ocean_);
-
-    std::vector<RasterMesh> meshes;
-    // The sea is seen from both sides only when a camera dips below it; cull back faces.
-    meshes.push_back({ocean_.positions, ocean_.indices, true});
-    for (const scene::TriangleMesh& m : worldMeshes_)
-        meshes.push_back({m.positions, m.indices, true});
-    const Clock::time_point t1 = Clock::now();
-    rasterizer_.Render(meshes, cam.Raster(), vis_);
+    geometry_.Update(state);
     const Clock::time_point t2 = Clock::now();
+    const ChannelCamera& cam = geometry_.Camera();
+    const int sw = cam.SampleWidth(), sh = cam.SampleHeight();
+    const scene::OceanMesh& ocean = geometry_.Ocean();
+    const std::vector<scene::TriangleMesh>& entityMeshes = geometry_.EntityMeshes();
+    const VisibilityBuffer& vis = geometry_.Visibility();
+    const OcclusionScene& occlusion = geometry_.Occlusion();
+    const ViewFrameStats& view = geometry_.Stats();
 
     stats_ = {};
-    stats_.raster = rasterizer_.Stats();
-    stats_.meshMs = Ms(t0, t1);
-    stats_.rasterMs = Ms(t1, t2);
-    stats_.oceanTriangles = ocean_.indices.size() / 3;
-    for (const scene::TriangleMesh& m : worldMeshes_) stats_.modelTriangles += m.TriangleCount();
+    stats_.raster = view.raster;
+    stats_.meshMs = view.meshMs;
+    stats_.rasterMs = view.rasterMs;
+    stats_.oceanTriangles = view.oceanTriangles;
+    stats_.modelTriangles = view.modelTriangles;
 
     if (!sky_ || skySun_ != state.sun.direction || skySunLux_ != state.sun.illuminance_lux) {
         sky_ = std::make_unique<radiometry::AnalyticSky>(
@@ -467,7 +339,7 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     const float slopeVar = CoxMunkSlopeVariance(env.windSpeed_mps);
     static const radiometry::FresnelTable fresnel(radiometry::kSeaWaterIndexVisible);
     const glm::vec3 eye(cam.worldFromCamera.position_m);
-    const bool shadows = settings_.shadows && !occlusion_.Empty() && sunDir.z > 0.0f;
+    const bool shadows = settings_.shadows && !occlusion.Empty() && sunDir.z > 0.0f;
 
     if (radiance.width != sw || radiance.height != sh || radiance.channels != 3)
         radiance = Image(sw, sh, 3);
@@ -492,15 +364,15 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
         const uint32_t* I;
     };
     std::vector<MeshRef> meshRefs;
-    meshRefs.push_back({ocean_.positions.data(), ocean_.normals.data(), ocean_.indices.data()});
-    for (const scene::TriangleMesh& m : worldMeshes_)
+    meshRefs.push_back({ocean.positions.data(), ocean.normals.data(), ocean.indices.data()});
+    for (const scene::TriangleMesh& m : entityMeshes)
         meshRefs.push_back({m.positions.data(), m.normals.data(), m.indices.data()});
     const uint32_t firstModelPrimitive =
-        vis_.primitiveBase.size() > 1 ? vis_.primitiveBase[1] : kNoPrimitive;
+        vis.primitiveBase.size() > 1 ? vis.primitiveBase[1] : kNoPrimitive;
 
     const SeaShading seaShading{eye, sunDir, sunE, downwelling, beta, slopeVar, fresnel, sky};
 
-    const RayBoxTest casters(casterMin_, casterMax_, sunDir);
+    const RayBoxTest casters(geometry_.CasterMin(), geometry_.CasterMax(), sunDir);
 
     tbb::parallel_for(0, blocks, [&](int block) {
         const int y0 = block * kRowsPerBlock, y1 = std::min(sh, y0 + kRowsPerBlock);
@@ -522,10 +394,10 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
         size_t skyCount = 0, seaCount = 0;
         CachedTriangle tri;
         for (int y = y0; y < y1; ++y) {
-            const size_t rowIdx = vis_.Index(0, y);
-            const uint32_t* primRow = vis_.primitive.data() + rowIdx;
-            const float* b1Row = vis_.b1.data() + rowIdx;
-            const float* b2Row = vis_.b2.data() + rowIdx;
+            const size_t rowIdx = vis.Index(0, y);
+            const uint32_t* primRow = vis.primitive.data() + rowIdx;
+            const float* b1Row = vis.b1.data() + rowIdx;
+            const float* b2Row = vis.b2.data() + rowIdx;
             const uint32_t kRow = uint32_t(size_t(y - y0) * size_t(sw));
             for (int x = 0; x < sw; ++x) {
                 const uint32_t k = kRow + uint32_t(x);
@@ -542,12 +414,12 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
                     int mesh = 0;
                     if (prim >= firstModelPrimitive) {
                         mesh = 1;
-                        while (mesh + 1 < int(vis_.primitiveBase.size()) &&
-                               prim >= vis_.primitiveBase[size_t(mesh) + 1])
+                        while (mesh + 1 < int(vis.primitiveBase.size()) &&
+                               prim >= vis.primitiveBase[size_t(mesh) + 1])
                             ++mesh;
                     }
                     const MeshRef& m = meshRefs[size_t(mesh)];
-                    const uint32_t t = prim - vis_.primitiveBase[size_t(mesh)];
+                    const uint32_t t = prim - vis.primitiveBase[size_t(mesh)];
                     const uint32_t i0 = m.I[3 * t], i1 = m.I[3 * t + 1], i2 = m.I[3 * t + 2];
                     tri.prim = prim, tri.mesh = mesh;
                     tri.p0 = Load3(m.P[i0]), tri.p1 = Load3(m.P[i1]), tri.p2 = Load3(m.P[i2]);
@@ -576,7 +448,7 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
                 sc.modelMesh.push_back(tri.mesh);
                 if (shadows) {
                     const glm::vec3 o = ShadowRayOrigin(position, nrm);
-                    if (casters.MayHit(o) && occlusion_.MayOcclude(o, sunDir, 1e30f)) {
+                    if (casters.MayHit(o) && occlusion.MayOcclude(o, sunDir, 1e30f)) {
                         sc.origins.push_back(o);
                         sc.originOwner.push_back(k);
                     }
@@ -608,7 +480,7 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
                 for (; hit != 0; hit &= hit - 1) {
                     const int l = __builtin_ctz(unsigned(hit));
                     const glm::vec3 origin(o[0][l], o[1][l], o[2][l]);
-                    if (occlusion_.MayOcclude(origin, sunDir, 1e30f)) {
+                    if (occlusion.MayOcclude(origin, sunDir, 1e30f)) {
                         sc.origins.push_back(origin);
                         sc.originOwner.push_back(kSeaOwner | uint32_t(i + size_t(l)));
                     }
@@ -617,7 +489,7 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
         }
         if (!sc.origins.empty()) {
             sc.vis.resize(sc.origins.size());
-            occlusion_.DirectionalVisibility(sc.origins, sunDir, 0.0f, sc.vis);
+            occlusion.DirectionalVisibility(sc.origins, sunDir, 0.0f, sc.vis);
             for (size_t r = 0; r < sc.origins.size(); ++r) {
                 const uint32_t owner = sc.originOwner[r];
                 if (owner & kSeaOwner)

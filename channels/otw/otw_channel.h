@@ -5,13 +5,9 @@
 #include <memory>
 #include <vector>
 
-#include "channels/camera/channel_camera.h"
-#include "channels/occlusion/occlusion.h"
-#include "channels/raster/rasterizer.h"
+#include "channels/view/view_geometry.h"
 #include "radiometry/sky/analytic_sky.h"
 #include "scene/core/image.h"
-#include "scene/models/triangle_mesh.h"
-#include "scene/ocean/ocean_mesh.h"
 #include "scene/world/world.h"
 
 namespace seasense::channels {
@@ -38,33 +34,19 @@ class OtwChannel {
     void Render(const scene::SceneState& state, Image& radiance);
 
     const OtwFrameStats& Stats() const { return stats_; }
-    const ChannelCamera& Camera() const { return camera_; }
+    const ChannelCamera& Camera() const { return geometry_.Camera(); }
     // The last frame's visibility buffer (supersampled grid): mesh 0 is the sea, mesh i ≥ 1
     // the (i−1)-th entity.
-    const VisibilityBuffer& Visibility() const { return vis_; }
+    const VisibilityBuffer& Visibility() const { return geometry_.Visibility(); }
 
   private:
     // Per-thread shading scratch, kept between frames so that a frame neither allocates nor
     // zero-fills its sample lists (fresh pages cost page faults on every frame).
     struct ShadeScratch;
-    // Moves entity meshes to the frame's poses (transform, Embree refit) when they changed.
-    void UpdateEntities(const scene::SceneState& state);
-    void UpdateCasterBounds();
-
     const scene::World& world_;
     scene::ChannelSettings settings_;
-    ChannelCamera camera_;
-    Rasterizer rasterizer_;
-    OcclusionScene occlusion_;
-    std::vector<scene::TriangleMesh> worldMeshes_;  // entity meshes in the world frame
-    std::vector<scene::Pose> entityPoses_;          // the poses worldMeshes_ were built at
-    std::vector<uint32_t> occlusionIds_;            // Embree geometry of each entity
-    std::vector<glm::dvec3> reflectance_;           // per entity
-    // Bounding box of all shadow casters, widened well beyond OcclusionScene's own caster
-    // bounds: a cheap inline test that leaves only candidates for MayOcclude.
-    glm::vec3 casterMin_{0.0f}, casterMax_{0.0f};
-    scene::OceanMesh ocean_;
-    VisibilityBuffer vis_;
+    ViewGeometry geometry_;
+    std::vector<glm::dvec3> reflectance_;  // per entity
     // The sky depends only on the sun and turbidity: rebuilt when they change.
     std::unique_ptr<radiometry::AnalyticSky> sky_;
     glm::dvec3 skySun_{0.0};
@@ -72,17 +54,5 @@ class OtwChannel {
     std::unique_ptr<ShadeScratch> scratch_;
     OtwFrameStats stats_;
 };
-
-// Azimuth sector [min, max] (radians, clockwise from north) that the camera's frustum covers,
-// widened by margin_rad; max − min = 2π when it looks close to straight up or down.
-void FrustumAzimuthSector(const ChannelCamera& camera, double margin_rad, double& min_rad,
-                          double& max_rad);
-
-// Horizontal distance (m) inside which no sea can be seen by the camera: the steepest
-// downward view ray meets the plane of the highest crest, less a 20 % margin and the waves'
-// horizontal reach. 0 when the eye is below the crests or looks straight down; +∞ when no
-// view ray points down.
-double NearestVisibleSeaRange_m(const ChannelCamera& camera, double crestHeight_m,
-                                double horizontalReach_m);
 
 }  // namespace seasense::channels

@@ -1,5 +1,6 @@
 // One channel end to end for a frame: render at-aperture radiance, apply the sensor model
-// (detector footprint, exposure), display through OCIO and write the frame's files.
+// (detector footprint, exposure), display (OCIO for visible, white-hot for thermal) and write
+// the frame's files.
 #pragma once
 
 #include <filesystem>
@@ -7,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "channels/flir/flir_channel.h"
 #include "channels/otw/otw_channel.h"
 #include "scene/world/world.h"
 #include "sensors/display/display_lut.h"
@@ -29,6 +31,9 @@ class ChannelPipeline {
   public:
     // outDir: files go to outDir/<channel>/. formats ⊂ {exr, png, tiff}. ocioConfig: path of
     // the OCIO config for visible channels. Throws InputError for an unsupported channel kind.
+    // Flir channels: the sensor is the detector footprint; EXR holds band radiance
+    // (W·m⁻²·sr⁻¹) and apparent temperature (K); the display is white-hot, linear between the
+    // frame's minimum and maximum apparent temperature.
     ChannelPipeline(const scene::World& world, const scene::ChannelSettings& channel,
                     std::filesystem::path outDir, std::vector<std::string> formats,
                     const std::filesystem::path& ocioConfig);
@@ -51,20 +56,32 @@ class ChannelPipeline {
     int Height() const { return channel_.height; }
 
     const std::filesystem::path& ChannelDir() const { return channelDir_; }
-    const OtwChannel& Otw() const { return *otw_; }
+    // The channel renderer: Otw() for kind otw, Flir() for kind flir (CHECK-fails otherwise).
+    const OtwChannel& Otw() const;
+    const FlirChannel& Flir() const;
+    // Flir channels: the last frame's apparent (blackbody-equivalent) temperature, K,
+    // Width()×Height()×1.
+    const Image& ApparentTemperature() const { return temperature_; }
 
   private:
     const scene::World& world_;
     scene::ChannelSettings channel_;
     std::filesystem::path channelDir_;
     std::vector<std::string> formats_;
+    const ChannelCamera& Camera() const;
+    // White-hot 8-bit RGB of a temperature image, linear from lo_K (black) to hi_K (white).
+    static std::vector<uint8_t> WhiteHot8(const Image& temperature, double lo_K, double hi_K);
+
     std::unique_ptr<OtwChannel> otw_;
+    std::unique_ptr<FlirChannel> flir_;
     std::unique_ptr<sensors::OcioDisplay> display_;
     Image samples_;
-    Image pixels_;                   // the last frame's sensor image (linear)
-    scene::SceneState state_;        // the last frame's scene
-    double ev_ = 0.0;                // the last frame's exposure
-    std::vector<uint8_t> display8_;  // display transform of pixels_, when asked for
+    Image pixels_;                        // the last frame's sensor image (linear)
+    Image temperature_;                   // flir: apparent temperature of pixels_, K
+    double minT_K_ = 0.0, maxT_K_ = 0.0;  // flir: display range of the last frame
+    scene::SceneState state_;             // the last frame's scene
+    double ev_ = 0.0;                     // the last frame's exposure
+    std::vector<uint8_t> display8_;       // display transform of pixels_, when asked for
     bool displayValid_ = false;
     std::unique_ptr<sensors::DisplayLut> previewLut_;  // built on the first preview
 };

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "scene/config/config.h"
 #include "scene/core/time.h"
 
 namespace seasense::scene {
@@ -62,6 +63,11 @@ struct EnvironmentSettings {
     double windSpeed_mps = 5.0;      // at 10 m
     double windDirection_rad = 0.0;  // direction the wind blows toward, from north clockwise
     OceanSettings ocean;
+    // environment.atmosphere and environment.sea as written: parsed and validated by
+    // radiometry::ParseAtmosphereSettings / ParseSeaSettings where the infrared channels are
+    // built (scene does not depend on radiometry). Absent: the parsers' defaults.
+    std::optional<ConfigValue> atmosphere;
+    std::optional<ConfigValue> sea;
 };
 
 // A static mesh placed in the world. Positions are ENU metres at the model origin.
@@ -85,6 +91,9 @@ struct EyepointSettings {
 };
 
 enum class ChannelKind { Otw, Flir, Nvg };
+
+// Spectral band of an infrared (flir) channel.
+enum class InfraredBand { Lwir, Mwir };
 
 enum class ExposureMode { Manual, Auto };
 
@@ -110,6 +119,7 @@ struct ChannelSettings {
     std::vector<std::string> formats{"exr", "png"};
     ExposureSettings exposure;
     std::string ocioView = "ACES 1.0 - SDR Video";  // display view of configs/ocio/config.ocio
+    InfraredBand band = InfraredBand::Lwir;         // flir channels only
 };
 
 struct MaterialSettings {
@@ -126,6 +136,9 @@ struct Scenario {
     EyepointSettings eyepoint;
     std::vector<ChannelSettings> channels;
     std::vector<MaterialSettings> materials;  // from the material table file
+    // The `materials:` mapping of the material table file, for radiometry::ParseMaterialTable
+    // (emissivities and thermal models); set by LoadScenario.
+    std::optional<ConfigValue> materialTable;
 
     const ChannelSettings* FindChannel(const std::string& name) const;
     const MaterialSettings* FindMaterial(const std::string& name) const;

@@ -25,6 +25,8 @@ constexpr size_t kMaxChannels = 64;
 constexpr size_t kMaxEntities = 100000;
 
 const std::vector<std::string> kChannelKinds = {"otw", "flir", "nvg"};
+// In the order of InfraredBand.
+const std::vector<std::string> kInfraredBands = {"lwir", "mwir"};
 const std::vector<std::string> kExposureModes = {"auto", "manual"};
 const std::vector<std::string> kOutputFormats = {"exr", "png", "tiff"};
 const std::vector<std::string> kModelExtensions = {".obj", ".gltf", ".glb"};
@@ -139,6 +141,8 @@ EnvironmentSettings ReadEnvironment(ConfigMap& map) {
                     w.GetDouble("direction_deg", NumberRange::Any("deg")) * kRadPerDeg;
             });
         }
+        env.atmosphere = e.Find("atmosphere");
+        env.sea = e.Find("sea");
         ReadMap(e.Require("ocean", "a mapping"), [&](ConfigMap& ocean) {
             env.ocean.depth_m =
                 ocean.GetDouble("depth_m", NumberRange::Positive("m"), env.ocean.depth_m);
@@ -275,6 +279,8 @@ ChannelSettings ReadChannel(const ConfigValue& value) {
         }
         if (std::optional<ConfigValue> exposure = c.Find("exposure"))
             channel.exposure = ReadExposure(*exposure);
+        if (channel.kind == ChannelKind::Flir)
+            channel.band = InfraredBand(c.GetEnum("band", kInfraredBands, 0));
         if (std::optional<ConfigValue> view = c.Find("ocio_view")) {
             channel.ocioView = view->AsString();
             if (channel.ocioView.empty()) view->Fail("a non-empty OpenColorIO view name");
@@ -307,11 +313,13 @@ std::filesystem::path FindMaterialFile(ConfigMap& root, const std::filesystem::p
 
 }  // namespace
 
-std::vector<MaterialSettings> LoadMaterialTable(const std::filesystem::path& file) {
+std::vector<MaterialSettings> LoadMaterialTable(const std::filesystem::path& file,
+                                                std::optional<ConfigValue>* tableNode) {
     const ConfigDocument document = LoadConfigFile(file);
     std::vector<MaterialSettings> materials;
     ReadMap(document.root, [&](ConfigMap& root) {
         ConfigMap table = root.GetMap("materials");
+        if (tableNode) *tableNode = table.Value();
         for (const auto& [name, value] : table.Entries()) {
             if (!IsSimpleName(name))
                 value.Fail("a material named with letters, digits, '_' and '-'",
@@ -320,6 +328,9 @@ std::vector<MaterialSettings> LoadMaterialTable(const std::filesystem::path& fil
             material.name = name;
             ReadMap(value, [&](ConfigMap& m) {
                 material.reflectanceRgb = m.GetVec3("reflectance_rgb", NumberRange::Closed(0, 1));
+                // The infrared and thermal keys belong to radiometry::ParseMaterialTable,
+                // which validates them (Scenario::materialTable).
+                m.Entries();
             });
             materials.push_back(material);
         }
@@ -343,7 +354,7 @@ Scenario LoadScenario(const std::filesystem::path& file) {
 
         const std::filesystem::path materialFile =
             FindMaterialFile(root, folder, document.root.Location());
-        scenario.materials = LoadMaterialTable(materialFile);
+        scenario.materials = LoadMaterialTable(materialFile, &scenario.materialTable);
         std::vector<std::string> materialNames;
         for (const MaterialSettings& m : scenario.materials) materialNames.push_back(m.name);
 

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <vector>
 
 #include "scene/scenario/scenario.h"
@@ -13,8 +14,10 @@ namespace seasense::scene {
 // file's folder. Throws ConfigError (an InputError) naming file:line:column and key path.
 Scenario LoadScenario(const std::filesystem::path& file);
 
-// Reads a material table: a top-level "materials:" mapping of name -> {reflectance_rgb}.
-// Materials come back in file order. Throws ConfigError on any problem.
-std::vector<MaterialSettings> LoadMaterialTable(const std::filesystem::path& file);
+// Reads a material table: a top-level "materials:" mapping of name -> {reflectance_rgb, ...}
+// (the other keys are radiometry::ParseMaterialTable's). Materials come back in file order;
+// when table is given it receives the `materials:` node. Throws ConfigError on any problem.
+std::vector<MaterialSettings> LoadMaterialTable(const std::filesystem::path& file,
+                                                std::optional<ConfigValue>* table = nullptr);
 
 }  // namespace seasense::scene

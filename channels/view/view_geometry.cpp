@@ -1,0 +1,169 @@
+// View geometry: frustum-limited sea mesh, entity refit and rasterization shared by the
+// channel renderers (moved unchanged out of the OTW channel).
+#include "channels/view/view_geometry.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "scene/core/check.h"
+
+namespace seasense::channels {
+
+namespace {
+
+// Sea mesh vertex spacing on screen: waves are smooth at this scale and their normals are
+// interpolated per sample.
+constexpr double kOceanVertexSpacing_px = 6.0;
+
+// Calls fn(d) for unit world directions along the boundary of the camera's frustum (33 per
+// edge); fn returns false to stop early.
+template <class Fn>
+void ForEachFrustumBoundaryDirection(const ChannelCamera& cam, Fn&& fn) {
+    constexpr int kSteps = 32;
+    for (int e = 0; e < 4; ++e) {
+        for (int i = 0; i <= kSteps; ++i) {
+            const double s = double(i) / kSteps;
+            const double u = e == 0 ? s : e == 1 ? 1.0 : e == 2 ? 1.0 - s : 0.0;
+            const double v = e == 0 ? 0.0 : e == 1 ? s : e == 2 ? 1.0 : 1.0 - s;
+            if (!fn(cam.SampleDirection(u * cam.SampleWidth() - 0.5, v * cam.SampleHeight() - 0.5)))
+                return;
+        }
+    }
+}
+
+// Whether the straight-down direction lies inside the frustum (its boundary winds around it).
+bool FrustumContainsNadir(const ChannelCamera& cam) {
+    const glm::dvec3 down =
+        glm::transpose(cam.worldFromCamera.worldFromBody) * glm::dvec3(0, 0, -1);
+    if (down.y <= 0.0) return false;  // behind the camera
+    return std::abs(down.x / down.y) <= cam.TanHalfH() &&
+           std::abs(down.z / down.y) <= cam.TanHalfV();
+}
+
+}  // namespace
+
+void FrustumAzimuthSector(const ChannelCamera& cam, double margin, double& lo, double& hi) {
+    const glm::dvec3 axis = cam.worldFromCamera.worldFromBody * glm::dvec3(0, 1, 0);
+    const double centre = std::atan2(axis.x, axis.y);
+    double minRel = 0.0, maxRel = 0.0;
+    bool full = false;
+    // The azimuth extremes of a convex cone of directions lie on its boundary.
+    ForEachFrustumBoundaryDirection(cam, [&](const glm::dvec3& d) {
+        if (std::hypot(d.x, d.y) < 0.05) {
+            full = true;  // within ~3° of the zenith or nadir: all azimuths are near
+            return false;
+        }
+        const double rel = std::remainder(std::atan2(d.x, d.y) - centre, 2.0 * M_PI);
+        minRel = std::min(minRel, rel);
+        maxRel = std::max(maxRel, rel);
+        return true;
+    });
+    if (full || maxRel - minRel + 2.0 * margin >= 2.0 * M_PI) {
+        lo = 0.0;
+        hi = 2.0 * M_PI;
+        return;
+    }
+    lo = centre + minRel - margin;
+    hi = centre + maxRel + margin;
+}
+
+double NearestVisibleSeaRange_m(const ChannelCamera& cam, double crestHeight_m,
+                                double horizontalReach_m) {
+    const double h = cam.worldFromCamera.position_m.z - crestHeight_m;
+    if (h <= 0.0 || FrustumContainsNadir(cam)) return 0.0;
+    // The steepest downward view ray meets the crest plane nearest: range = h / slope.
+    double slope = 0.0;
+    ForEachFrustumBoundaryDirection(cam, [&](const glm::dvec3& d) {
+        slope = std::max(slope, -d.z / std::max(std::hypot(d.x, d.y), 1e-9));
+        return true;
+    });
+    if (slope <= 0.0) return std::numeric_limits<double>::infinity();  // no ray looks down
+    // Sampled boundary and straight-line rays: keep a 20 % margin, then allow for vertices
+    // that the waves carry horizontally toward the eye.
+    return std::max(0.0, 0.8 * h / slope - horizontalReach_m);
+}
+
+ViewGeometry::ViewGeometry(const scene::World& world, const scene::ChannelSettings& settings)
+    : world_(world), settings_(settings) {
+    const scene::SceneState s0 = world.State(0);
+    for (const scene::EntityState& e : s0.entities) {
+        worldMeshes_.push_back(scene::TransformMesh(*e.bodyMesh, e.pose));
+        entityPoses_.push_back(e.pose);
+        occlusionIds_.push_back(
+            occlusion_.AddMesh(worldMeshes_.back().positions, worldMeshes_.back().indices));
+    }
+    occlusion_.Commit();
+    UpdateCasterBounds();
+}
+
+void ViewGeometry::UpdateEntities(const scene::SceneState& state) {
+    CHECK(state.entities.size() == worldMeshes_.size());
+    bool moved = false;
+    for (size_t i = 0; i < state.entities.size(); ++i) {
+        const scene::Pose& pose = state.entities[i].pose;
+        if (pose.position_m == entityPoses_[i].position_m &&
+            pose.worldFromBody == entityPoses_[i].worldFromBody)
+            continue;
+        worldMeshes_[i] = scene::TransformMesh(*state.entities[i].bodyMesh, pose);
+        entityPoses_[i] = pose;
+        occlusion_.UpdateMesh(occlusionIds_[i], worldMeshes_[i].positions);
+        moved = true;
+    }
+    if (!moved) return;
+    occlusion_.Commit();
+    UpdateCasterBounds();
+}
+
+void ViewGeometry::UpdateCasterBounds() {
+    glm::vec3 lo(std::numeric_limits<float>::infinity()), hi(-lo);
+    for (const scene::TriangleMesh& m : worldMeshes_)
+        for (const glm::vec3& p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+    // Far wider than OcclusionScene's 1e-5 relative + 0.1 mm margin, so that this test
+    // passing is implied by MayOcclude passing despite float rounding.
+    const float margin_m = 1e-3f * std::max({glm::abs(lo).x, glm::abs(lo).y, glm::abs(lo).z,
+                                             glm::abs(hi).x, glm::abs(hi).y, glm::abs(hi).z}) +
+                           0.1f;
+    casterMin_ = lo - margin_m;
+    casterMax_ = hi + margin_m;
+}
+
+void ViewGeometry::Update(const scene::SceneState& state) {
+    camera_ = MakeChannelCamera(state.eyepoint, settings_);
+    const ChannelCamera& cam = camera_;
+    UpdateEntities(state);
+
+    using Clock = std::chrono::steady_clock;
+    const auto Ms = [](Clock::time_point a, Clock::time_point b) {
+        return std::chrono::duration<double, std::milli>(b - a).count();
+    };
+    const Clock::time_point t0 = Clock::now();
+    // Sea mesh for this view: vertices kOceanVertexSpacing_px apart on screen.
+    scene::OceanMeshRequest req;
+    req.eye_m = cam.worldFromCamera.position_m;
+    req.time_s = state.time_s;
+    req.angularStep_rad = kOceanVertexSpacing_px * cam.hfov_rad / double(cam.width);
+    FrustumAzimuthSector(cam, 20.0 * M_PI / 180.0, req.azimuthMin_rad, req.azimuthMax_rad);
+    const scene::GerstnerOcean& sea = world_.Ocean();
+    req.minRange_m = NearestVisibleSeaRange_m(cam, sea.MaxAmplitude_m(), sea.MaxHorizontal_m());
+    scene::BuildOceanMesh(sea, req, ocean_);
+
+    std::vector<RasterMesh> meshes;
+    // The sea is seen from both sides only when a camera dips below it; cull back faces.
+    meshes.push_back({ocean_.positions, ocean_.indices, true});
+    for (const scene::TriangleMesh& m : worldMeshes_)
+        meshes.push_back({m.positions, m.indices, true});
+    const Clock::time_point t1 = Clock::now();
+    rasterizer_.Render(meshes, cam.Raster(), vis_);
+    const Clock::time_point t2 = Clock::now();
+
+    stats_ = {};
+    stats_.raster = rasterizer_.Stats();
+    stats_.meshMs = Ms(t0, t1);
+    stats_.rasterMs = Ms(t1, t2);
+    stats_.oceanTriangles = ocean_.indices.size() / 3;
+    for (const scene::TriangleMesh& m : worldMeshes_) stats_.modelTriangles += m.TriangleCount();
+}
+
+}  // namespace seasense::channels

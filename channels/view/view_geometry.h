@@ -1,0 +1,80 @@
+// View geometry shared by the channel renderers: the camera of a frame, the sea mesh for the
+// view, entity meshes at the frame's poses (Embree refit), shadow-caster bounds and the
+// rasterized visibility buffer.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "channels/camera/channel_camera.h"
+#include "channels/occlusion/occlusion.h"
+#include "channels/raster/rasterizer.h"
+#include "scene/models/triangle_mesh.h"
+#include "scene/ocean/ocean_mesh.h"
+#include "scene/world/world.h"
+
+namespace seasense::channels {
+
+struct ViewFrameStats {
+    uint64_t oceanTriangles = 0;
+    uint64_t modelTriangles = 0;
+    double meshMs = 0.0;    // sea mesh for the view
+    double rasterMs = 0.0;  // visibility buffer
+    RasterStats raster;
+};
+
+class ViewGeometry {
+  public:
+    // Builds the occlusion scene from the world's models at frame 0 (committed once).
+    ViewGeometry(const scene::World& world, const scene::ChannelSettings& settings);
+
+    // Prepares frame `state`: the channel camera at the state's eyepoint, entity meshes moved
+    // to their poses (refit only when a pose changed), the sea mesh for the view and the
+    // visibility buffer. Runs in the caller's oneTBB arena; deterministic.
+    void Update(const scene::SceneState& state);
+
+    const ChannelCamera& Camera() const { return camera_; }
+    // The last frame's visibility buffer (supersampled grid): mesh 0 is the sea, mesh i ≥ 1
+    // the (i−1)-th entity.
+    const VisibilityBuffer& Visibility() const { return vis_; }
+    const scene::OceanMesh& Ocean() const { return ocean_; }
+    // Entity meshes in the world frame (ENU metres) at the last frame's poses.
+    const std::vector<scene::TriangleMesh>& EntityMeshes() const { return worldMeshes_; }
+    const OcclusionScene& Occlusion() const { return occlusion_; }
+    // Bounding box (world, m) of all shadow casters, widened well beyond OcclusionScene's own
+    // caster bounds: a cheap inline test that leaves only candidates for MayOcclude.
+    const glm::vec3& CasterMin() const { return casterMin_; }
+    const glm::vec3& CasterMax() const { return casterMax_; }
+    const ViewFrameStats& Stats() const { return stats_; }
+
+  private:
+    void UpdateEntities(const scene::SceneState& state);
+    void UpdateCasterBounds();
+
+    const scene::World& world_;
+    scene::ChannelSettings settings_;
+    ChannelCamera camera_;
+    Rasterizer rasterizer_;
+    OcclusionScene occlusion_;
+    std::vector<scene::TriangleMesh> worldMeshes_;  // entity meshes in the world frame
+    std::vector<scene::Pose> entityPoses_;          // the poses worldMeshes_ were built at
+    std::vector<uint32_t> occlusionIds_;            // Embree geometry of each entity
+    glm::vec3 casterMin_{0.0f}, casterMax_{0.0f};
+    scene::OceanMesh ocean_;
+    VisibilityBuffer vis_;
+    ViewFrameStats stats_;
+};
+
+// Azimuth sector [min, max] (radians, clockwise from north) that the camera's frustum covers,
+// widened by margin_rad; max − min = 2π when it looks close to straight up or down.
+void FrustumAzimuthSector(const ChannelCamera& camera, double margin_rad, double& min_rad,
+                          double& max_rad);
+
+// Horizontal distance (m) inside which no sea can be seen by the camera: the steepest
+// downward view ray meets the plane of the highest crest, less a 20 % margin and the waves'
+// horizontal reach. 0 when the eye is below the crests or looks straight down; +∞ when no
+// view ray points down.
+double NearestVisibleSeaRange_m(const ChannelCamera& camera, double crestHeight_m,
+                                double horizontalReach_m);
+
+}  // namespace seasense::channels

@@ -1,0 +1,286 @@
+// FLIR channel against analytic radiometry: a blackbody plate, the sea at nadir, Kirchhoff's
+// law in an isothermal scene, sunlit versus shaded hull sides, determinism, and capture output.
+#include "channels/flir/flir_channel.h"
+
+#include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+#include <tbb/task_arena.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include "scene/config/config.h"
+#include "tests/support/meshes.h"
+#include "tests/support/shell.h"
+
+namespace seasense::channels {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kMaterials = R"(materials:
+  black:
+    reflectance_rgb: [0.05, 0.05, 0.05]
+    emissivity_mwir: 1.0
+    emissivity_lwir: 1.0
+    thermal: {model: fixed, temperature_K: 320}
+  grey_at_air:
+    reflectance_rgb: [0.5, 0.5, 0.5]
+    emissivity_mwir: 0.6
+    emissivity_lwir: 0.6
+    thermal: {model: air}
+  paint:
+    reflectance_rgb: [0.3, 0.3, 0.3]
+    emissivity_mwir: 0.9
+    emissivity_lwir: 0.9
+    thermal: {model: heat_balance, solar_absorptance: 0.7, areal_heat_capacity_J_m2K: 20000}
+)";
+
+// The value of a YAML text's root (kept alive by the node's shared memory).
+scene::ConfigValue ParseValue(const std::string& text, const std::string& name) {
+    return scene::ParseConfigText(text, name).root;
+}
+
+scene::ConfigValue MaterialTableNode() {
+    scene::ConfigMap root(ParseValue(kMaterials, "test_materials.yaml"));
+    return root.Require("materials", "a mapping");
+}
+
+fs::path TempDir(const std::string& name) {
+    const fs::path d =
+        fs::temp_directory_path() / ("seasense_flir_" + name + "_" + std::to_string(::getpid()));
+    fs::remove_all(d);
+    fs::create_directories(d);
+    return d;
+}
+
+// testing::MakeBox(lo, hi) (body axes x right, y forward, z up) as an OBJ in glTF axes
+// (+X left, +Y up, +Z forward), as the OTW channel tests write it.
+void WriteBoxObj(const fs::path& file, glm::vec3 lo, glm::vec3 hi) {
+    const seasense::testing::SimpleMesh box = seasense::testing::MakeBox(lo, hi);
+    std::ofstream out(file);
+    for (const glm::vec3& p : box.positions)
+        out << "v " << -p.x << " " << p.z << " " << p.y << "\n";
+    for (size_t t = 0; t < box.indices.size(); t += 3)
+        out << "f " << box.indices[t] + 1 << " " << box.indices[t + 1] + 1 << " "
+            << box.indices[t + 2] + 1 << "\n";
+}
+
+scene::Scenario BaseScenario(double amplitude_m = 1e-4) {
+    scene::Scenario sc;
+    sc.world.start = *scene::ParseIso8601("2026-03-20T15:00:00Z");
+    sc.environment.sun.elevation_rad = 0.6;
+    sc.environment.sun.illuminance_lux = 9e4;
+    sc.environment.windSpeed_mps = 4.0;
+    scene::GerstnerWaveSettings w;
+    w.wavelength_m = 20.0;
+    w.amplitude_m = amplitude_m;
+    w.steepness = amplitude_m > 0.01 ? 0.6 : 0.0;
+    sc.environment.ocean.waves.push_back(w);
+    sc.environment.atmosphere =
+        ParseValue("air_temperature_K: 290\nrelative_humidity: 0.7\n", "atmosphere.yaml");
+    sc.environment.sea = ParseValue("temperature_K: 293\n", "sea.yaml");
+    sc.materials = {
+        {"black", glm::dvec3(0.05)}, {"grey_at_air", glm::dvec3(0.5)}, {"paint", glm::dvec3(0.3)}};
+    sc.materialTable = MaterialTableNode();
+    scene::ChannelSettings ch;
+    ch.name = "ir";
+    ch.kind = scene::ChannelKind::Flir;
+    ch.width = 64;
+    ch.height = 48;
+    ch.hfov_rad = 30.0 * M_PI / 180.0;
+    ch.supersampling = 1;
+    sc.channels.push_back(ch);
+    return sc;
+}
+
+Image RenderOnce(const scene::World& world, FlirChannel& flir, int threads, int64_t frame = 0) {
+    Image radiance;
+    tbb::task_arena arena(threads);
+    arena.execute([&] { flir.Render(world.State(frame), radiance); });
+    return radiance;
+}
+
+TEST(FlirChannel, BlackbodyPlateReadsItsTemperature) {
+    // An ε = 1 plate at 320 K fills the view from 10 m straight above: the reflected sky
+    // vanishes, so inverting L = τ B(T) + (1 − τ) B(T_air) with the path's τ gives T.
+    const fs::path dir = TempDir("plate");
+    WriteBoxObj(dir / "plate.obj", {-30, -30, 0}, {30, 30, 0.2f});
+    for (scene::InfraredBand band : {scene::InfraredBand::Lwir, scene::InfraredBand::Mwir}) {
+        scene::Scenario sc = BaseScenario();
+        sc.entities.push_back({"plate", dir / "plate.obj", {0, 0, 0}, {}, 1.0, "black"});
+        sc.eyepoint.position_m = {0, 0, 10.2};
+        sc.eyepoint.attitude.pitch_rad = -0.5 * M_PI;
+        sc.channels[0].band = band;
+        const scene::World world(sc);
+        FlirChannel flir(world, sc.channels[0]);
+        const Image L = RenderOnce(world, flir, 2);
+        const ChannelCamera& cam = flir.Camera();
+        const radiometry::Atmosphere& air = flir.GetAtmosphere();
+        double worst = 0.0;
+        for (int y = 0; y < L.height; ++y)
+            for (int x = 0; x < L.width; ++x) {
+                const glm::dvec3 d = cam.SampleDirection(x, y);
+                const double range = 10.0 / -d.z;
+                const double tau = air.Transmittance(range);
+                const double B = (L.At(x, y)[0] - (1.0 - tau) * air.AirRadiance()) / tau;
+                worst = std::max(worst, std::abs(flir.RadianceTable().Temperature(B) - 320.0));
+            }
+        EXPECT_LT(worst, 0.05) << flir.GetBand().Name();
+    }
+    fs::remove_all(dir);
+}
+
+TEST(FlirChannel, CalmSeaAtNadirIsEmissionPlusReflectedZenithSky) {
+    // L = τ [ε(0°) B(T_sea) + (1 − ε(0°)) L_sky(zenith)] + (1 − τ) B(T_air), with ε from the
+    // exact Masuda quadrature (not the channel's table) and the exact sky and path sums.
+    scene::Scenario sc = BaseScenario();
+    sc.eyepoint.position_m = {0, 0, 10.0};
+    sc.eyepoint.attitude.pitch_rad = -0.5 * M_PI;
+    sc.channels[0].width = sc.channels[0].height = 9;
+    sc.channels[0].hfov_rad = 1.0 * M_PI / 180.0;
+    const scene::World world(sc);
+    FlirChannel flir(world, sc.channels[0]);
+    const Image L = RenderOnce(world, flir, 2);
+    const radiometry::Band band = radiometry::Band::Lwir();
+    const radiometry::SeaSurfaceEmissivity sea(band);
+    const double eps = sea.EmissivityForWind(1.0, 4.0);
+    const radiometry::Atmosphere& air = flir.GetAtmosphere();
+    const double tau = air.Transmittance(10.0);
+    const double expected =
+        tau * (eps * radiometry::BandRadiance(band, 293.0) + (1.0 - eps) * air.SkyRadiance(1.0)) +
+        (1.0 - tau) * air.AirRadiance();
+    EXPECT_GT(eps, 0.98);
+    EXPECT_NEAR(L.At(4, 4)[0], expected, 1e-3 * expected);
+}
+
+TEST(FlirChannel, IsothermalSceneRendersTheAirBlackbodyEverywhere) {
+    // Kirchhoff: in a dense fog (visibility 100 m: aerosol optical depth ≈ 39 to the zenith)
+    // the sky is B(T_air); with the sea and a grey (ε = 0.6) box at T_air too, emission plus
+    // reflection plus path radiance give B(T_air) in every sample, whatever ε and τ are.
+    const fs::path dir = TempDir("iso");
+    WriteBoxObj(dir / "box.obj", {-2, -2, 0}, {2, 2, 3});
+    scene::Scenario sc = BaseScenario(0.3);
+    sc.environment.visibility_m = 100.0;
+    sc.environment.sea = ParseValue("temperature_K: 290\n", "sea.yaml");
+    sc.entities.push_back({"box", dir / "box.obj", {0, 15, 0}, {}, 1.0, "grey_at_air"});
+    sc.eyepoint.position_m = {0, 0, 3};
+    sc.eyepoint.attitude.pitch_rad = -0.1;
+    const scene::World world(sc);
+    FlirChannel flir(world, sc.channels[0]);
+    const Image L = RenderOnce(world, flir, 2);
+    const double B = flir.RadianceTable().Radiance(290.0);
+    for (float v : L.pixels) ASSERT_NEAR(v, B, 2e-4 * B);
+    fs::remove_all(dir);
+}
+
+TEST(FlirChannel, SunlitHullSideIsWarmerThanTheShadedSideInTheAfternoon) {
+    // Equator, equinox, 15:00 local solar time: the sun stands ≈ 45° up in the west. A box
+    // seen head-on from the west shows its sunlit face, from the east its shaded face.
+    const fs::path dir = TempDir("sides");
+    WriteBoxObj(dir / "hull.obj", {-2, -2, 0}, {2, 2, 4});
+    double apparent[2] = {0, 0}, classT[2] = {0, 0};
+    for (int side = 0; side < 2; ++side) {
+        scene::Scenario sc = BaseScenario();
+        sc.environment.sun.fromEphemeris = true;
+        sc.entities.push_back({"hull", dir / "hull.obj", {0, 0, 0}, {}, 1.0, "paint"});
+        const double sign = side == 0 ? -1.0 : 1.0;  // west, then east of the box
+        sc.eyepoint.position_m = {sign * 20.0, 0, 2};
+        sc.eyepoint.attitude.heading_rad = side == 0 ? 0.5 * M_PI : 1.5 * M_PI;
+        sc.channels[0].hfov_rad = 4.0 * M_PI / 180.0;
+        const scene::World world(sc);
+        FlirChannel flir(world, sc.channels[0]);
+        const Image L = RenderOnce(world, flir, 2);
+        apparent[side] = flir.RadianceTable().Temperature(L.At(32, 24)[0]);
+        // Orientation classes: 7 = west, 3 = east; +10 sunlit.
+        const auto T = flir.EntityTemperatures_K(0, 0.0);
+        classT[side] = side == 0 ? T[10 + 7] : T[3];
+    }
+    EXPECT_GT(classT[0], classT[1] + 5.0);
+    EXPECT_GT(apparent[0], apparent[1] + 3.0);
+    fs::remove_all(dir);
+}
+
+TEST(FlirChannel, OneAndTwoThreadsGiveBitIdenticalFrames) {
+    const fs::path dir = TempDir("det");
+    WriteBoxObj(dir / "hull.obj", {-3, -8, 0}, {3, 8, 5});
+    scene::Scenario sc = BaseScenario(0.4);
+    sc.environment.sun.fromEphemeris = true;
+    sc.entities.push_back({"hull", dir / "hull.obj", {5, 60, 0}, {}, 1.0, "paint"});
+    sc.eyepoint.position_m = {0, 0, 6};
+    sc.eyepoint.attitude.pitch_rad = -0.05;
+    sc.channels[0].width = 160;
+    sc.channels[0].height = 120;
+    sc.channels[0].supersampling = 2;
+    const scene::World world(sc);
+    FlirChannel a(world, sc.channels[0]), b(world, sc.channels[0]);
+    const Image one = RenderOnce(world, a, 1, 3), two = RenderOnce(world, b, 2, 3);
+    ASSERT_EQ(one.pixels.size(), two.pixels.size());
+    EXPECT_EQ(std::memcmp(one.pixels.data(), two.pixels.data(), one.pixels.size() * 4), 0);
+    fs::remove_all(dir);
+}
+
+TEST(FlirChannel, CaptureWritesRadianceAndTemperatureExr) {
+    const fs::path dir = TempDir("capture");
+    const fs::path src = SEASENSE_SOURCE_DIR;
+    std::ofstream(dir / "flir.yaml") << R"(world:
+  origin: {latitude_deg: 33.2, longitude_deg: -117.4}
+  start_utc: "2026-06-21T22:00:00Z"
+environment:
+  sun: ephemeris
+  visibility_m: 20000
+  wind: {speed_mps: 6, direction_deg: 30}
+  atmosphere: {air_temperature_K: 291, relative_humidity: 0.7, pressure_Pa: 101000}
+  sea: {temperature_K: 292}
+  ocean:
+    waves:
+      - {direction_deg: 30, wavelength_m: 30, amplitude_m: 0.3, steepness: 0.8}
+materials_file: )" << (src / "configs/materials.yaml").string()
+                                     << R"(
+entities:
+  - name: boat
+    model: )" << (src / "configs/models/patrol_boat.obj").string()
+                                     << R"(
+    position_m: [0, 80, 0]
+    heading_deg: 90
+    material: hull_gray
+eyepoint:
+  position_m: [0, 0, 4]
+  pitch_deg: -3
+channels:
+  - name: ir
+    kind: flir
+    band: mwir
+    resolution: [80, 60]
+    hfov_deg: 40
+    output: {formats: [exr, png]}
+)";
+    const seasense::testing::ShellResult r = seasense::testing::Shell(
+        std::string(SEASENSE_BINARY) + " capture --config " + (dir / "flir.yaml").string() +
+        " --channel ir --out " + (dir / "out").string() + " --frames 1 --threads 2");
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(fs::exists(dir / "out/ir/ir_000000.png"));
+    auto in = OIIO::ImageInput::open((dir / "out/ir/ir_000000.exr").string());
+    ASSERT_TRUE(in);
+    const OIIO::ImageSpec& spec = in->spec();
+    ASSERT_EQ(spec.nchannels, 2);
+    EXPECT_EQ(spec.channelnames[0], "L");
+    EXPECT_EQ(spec.channelnames[1], "T");
+    EXPECT_EQ(spec.get_string_attribute("seasense:band"), radiometry::Band::Mwir().Name());
+    std::vector<float> px(size_t(spec.width) * spec.height * 2);
+    ASSERT_TRUE(in->read_image(0, 0, 0, 2, OIIO::TypeDesc::FLOAT, px.data()));
+    // Each pixel's T is the blackbody temperature of its L (the band's exact inverse), and
+    // everything in view lies between a cold sky and a sun-warmed hull.
+    for (size_t i = 0; i < px.size(); i += 2) {
+        const double T = radiometry::BandTemperature(radiometry::Band::Mwir(), px[i]);
+        ASSERT_NEAR(px[i + 1], T, 0.01);
+        ASSERT_GT(px[i + 1], 200.0f);
+        ASSERT_LT(px[i + 1], 360.0f);
+    }
+    fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace seasense::channels
