@@ -13,7 +13,7 @@ namespace seasense::channels::sync {
 // "SEASHM01" read as a little-endian 64-bit word.
 inline constexpr uint64_t kSegmentMagic = 0x31304d4853414553ull;
 // Bumped whenever the layout below changes; a segment of another version is refused.
-inline constexpr uint32_t kLayoutVersion = 1;
+inline constexpr uint32_t kLayoutVersion = 2;
 inline constexpr int kMaxChannels = 16;
 // State slots: the host publishes frame n+1 while channels may still present frame n, and
 // never writes the slot of frame n+2 before every channel has presented frame n.

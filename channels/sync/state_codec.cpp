@@ -77,7 +77,7 @@ class Reader {
 size_t EncodedFrameStateBytes(size_t entityCount) {
     constexpr size_t kPose = 12 * sizeof(double);
     return sizeof(uint32_t) + sizeof(uint32_t) + 2 * sizeof(int64_t) + sizeof(double) +
-           6 * sizeof(double) + kPose + entityCount * kPose;
+           6 * sizeof(double) + 8 * sizeof(double) + kPose + entityCount * kPose;
 }
 
 size_t EncodeFrameState(const scene::FrameState& s, uint8_t* buffer, size_t capacity) {
@@ -91,6 +91,12 @@ size_t EncodeFrameState(const scene::FrameState& s, uint8_t* buffer, size_t capa
     w.Put(s.sun.elevation_rad);
     w.Put(s.sun.azimuth_rad);
     w.Put(s.sun.illuminance_lux);
+    w.Put(s.moon.direction);
+    w.Put(s.moon.elevation_rad);
+    w.Put(s.moon.azimuth_rad);
+    w.Put(s.moon.illuminance_lux);
+    w.Put(s.moon.phaseAngle_rad);
+    w.Put(s.moon.distance_m);
     w.Put(s.eyepoint);
     for (const scene::Pose& p : s.entityPoses) w.Put(p);
     return w.Size();
@@ -113,6 +119,12 @@ scene::FrameState DecodeFrameState(const uint8_t* buffer, size_t bytes) {
     s.sun.elevation_rad = r.Get<double>();
     s.sun.azimuth_rad = r.Get<double>();
     s.sun.illuminance_lux = r.Get<double>();
+    s.moon.direction = r.Vec3();
+    s.moon.elevation_rad = r.Get<double>();
+    s.moon.azimuth_rad = r.Get<double>();
+    s.moon.illuminance_lux = r.Get<double>();
+    s.moon.phaseAngle_rad = r.Get<double>();
+    s.moon.distance_m = r.Get<double>();
     s.eyepoint = r.Pose();
     s.entityPoses.reserve(entities);
     for (uint32_t i = 0; i < entities; ++i) s.entityPoses.push_back(r.Pose());

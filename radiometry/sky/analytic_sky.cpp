@@ -7,6 +7,7 @@
 
 #include "radiometry/color/rec709.h"
 #include "scene/core/simd4.h"
+#include "scene/sky/illuminance.h"
 
 namespace seasense::radiometry {
 
@@ -65,10 +66,37 @@ glm::dvec3 DirectionFromHemiOct(double a, double b) {
     return glm::normalize(d);
 }
 
+// E_h = ∫ L cosθ dω over the upper hemisphere, midpoint rule in (cosθ, φ): dω = dμ dφ.
+template <typename RadianceFn>
+glm::dvec3 HorizontalIntegral(const RadianceFn& radiance) {
+    constexpr int kMu = 64, kPhi = 128;
+    glm::dvec3 sum(0.0);
+    for (int j = 0; j < kMu; ++j) {
+        const double mu = (j + 0.5) / kMu;
+        const double s = std::sqrt(1.0 - mu * mu);
+        for (int i = 0; i < kPhi; ++i) {
+            const double phi = 2.0 * M_PI * (i + 0.5) / kPhi;
+            sum += radiance(glm::dvec3{s * std::sin(phi), s * std::cos(phi), mu}) * mu;
+        }
+    }
+    return sum * (1.0 / kMu) * (2.0 * M_PI / kPhi);
+}
+
 }  // namespace
 
 AnalyticSky::AnalyticSky(const glm::dvec3& sunDirection, double sunIlluminance_lux, double T)
-    : sunDir_(glm::normalize(sunDirection)) {
+    : AnalyticSky(SkyConditions{
+          .sunDirection = sunDirection, .sunIlluminance_lux = sunIlluminance_lux, .turbidity = T}) {
+}
+
+AnalyticSky::AnalyticSky(const SkyConditions& c)
+    : conditions_(c), sunDir_(glm::normalize(c.sunDirection)) {
+    const double T = c.turbidity;
+    const double sunIlluminance_lux = c.sunIlluminance_lux;
+    if (c.moon) {
+        moonDir_ = glm::normalize(c.moonDirection);
+        moonZenith_rad_ = std::acos(std::clamp(moonDir_.z, -1.0, 1.0));
+    }
     glm::dvec3 sunForSky = sunDir_;
     if (sunForSky.z < 0.0) sunForSky = glm::normalize(glm::dvec3(sunForSky.x, sunForSky.y, 0.0));
     thetaSun_ = std::acos(std::clamp(sunForSky.z, -1.0, 1.0));
@@ -106,6 +134,15 @@ AnalyticSky::AnalyticSky(const glm::dvec3& sunDirection, double sunIlluminance_l
     sunIlluminanceRgb_ = glm::dvec3(sunIlluminance_lux * sunUp);
     sunRadiance_ = sunIlluminanceRgb_ / sunSolidAngle;
 
+    // Daylight scale: Preetham's dome integrated over the hemisphere against the measured
+    // clear-sky diffuse illuminance at the sun's altitude.
+    dayScale_ = 1.0;
+    const double preethamE = LuminanceRec709(
+        HorizontalIntegral([this](const glm::dvec3& d) { return PreethamRadiance(d); }));
+    const double sunAltitude_rad = std::asin(std::clamp(sunDir_.z, -1.0, 1.0));
+    dayScale_ =
+        preethamE > 0.0 ? scene::ClearSkyDiffuseIlluminance_lux(sunAltitude_rad) / preethamE : 0.0;
+
     table_.resize(size_t(kTableSize) * size_t(kTableSize), glm::vec4(0.0f));
     for (int j = 0; j < kTableSize; ++j) {
         for (int i = 0; i < kTableSize; ++i) {
@@ -125,18 +162,7 @@ AnalyticSky::AnalyticSky(const glm::dvec3& sunDirection, double sunIlluminance_l
             glm::vec4(glm::vec3(Radiance(glm::normalize(glm::dvec3(u, v, 0.0)))), 0.0f);
     }
 
-    // E_h = ∫ L cosθ dω over the upper hemisphere, midpoint rule in (cosθ, φ): dω = dμ dφ.
-    constexpr int kMu = 64, kPhi = 128;
-    glm::dvec3 sum(0.0);
-    for (int j = 0; j < kMu; ++j) {
-        const double mu = (j + 0.5) / kMu;
-        const double s = std::sqrt(1.0 - mu * mu);
-        for (int i = 0; i < kPhi; ++i) {
-            const double phi = 2.0 * M_PI * (i + 0.5) / kPhi;
-            sum += Radiance({s * std::sin(phi), s * std::cos(phi), mu}) * mu;
-        }
-    }
-    skyHorizontal_ = sum * (1.0 / kMu) * (2.0 * M_PI / kPhi);
+    skyHorizontal_ = HorizontalIntegral([this](const glm::dvec3& d) { return Radiance(d); });
 }
 
 double AnalyticSky::Perez(const double c[5], double cosTheta, double gamma) const {
@@ -152,6 +178,23 @@ glm::dvec3 AnalyticSky::Radiance(const glm::dvec3& dIn) const {
     if (d.z < 0.0) d = glm::dvec3(d.x, d.y, 0.0);
     const double len = glm::length(d);
     d = len > 0.0 ? d / len : glm::dvec3(0, 0, 1);
+    glm::dvec3 L = dayScale_ > 0.0 ? dayScale_ * PreethamRadiance(d) : glm::dvec3(0.0);
+    const SkyConditions& c = conditions_;
+    const double zenith_rad = std::acos(std::clamp(d.z, 0.0, 1.0));
+    double grey = 0.0;
+    if (c.darkZenithLuminance_cdm2 > 0.0)
+        grey += DarkSkyLuminance_cdm2(zenith_rad, c.extinctionV_magPerAirmass,
+                                      c.darkZenithLuminance_cdm2);
+    if (c.moon) {
+        const double separation_rad = std::acos(std::clamp(glm::dot(d, moonDir_), -1.0, 1.0));
+        grey += MoonlitSkyLuminance_cdm2(zenith_rad, moonZenith_rad_, separation_rad,
+                                         c.moonPhaseAngle_rad, c.moonDistance_m,
+                                         c.extinctionV_magPerAirmass);
+    }
+    return L + glm::dvec3(grey);
+}
+
+glm::dvec3 AnalyticSky::PreethamRadiance(const glm::dvec3& d) const {
     glm::dvec3 sunForSky = sunDir_;
     if (sunForSky.z < 0.0) sunForSky = glm::normalize(glm::dvec3(sunForSky.x, sunForSky.y, 0.0));
     const double gamma = std::acos(std::clamp(glm::dot(d, sunForSky), -1.0, 1.0));

@@ -1,10 +1,13 @@
-// Analytic clear daylight sky (Preetham, Shirley & Smits 1999) in scene-linear Rec.709
-// luminance units (cd/m²), with the sun disc and a direction table for per-sample lookups.
+// Clear sky radiance in scene-linear Rec.709 luminance units (cd/m²): Preetham's daylight
+// distribution scaled to measured clear-sky illuminance through sunset and twilight, the
+// moonless night sky and the moonlit sky; the sun disc; direction tables for lookups.
 #pragma once
 
 #include <cstddef>
 #include <glm/glm.hpp>
 #include <vector>
+
+#include "radiometry/sky/night_sky.h"
 
 namespace seasense::radiometry {
 
@@ -12,13 +15,34 @@ namespace seasense::radiometry {
 // 1 au = 149 597 870.7 km → 0.2666°).
 inline constexpr double kSunAngularRadius_rad = 4.6526e-3;
 
+// Everything that lights the sky dome, in the local ENU frame.
+struct SkyConditions {
+    glm::dvec3 sunDirection{0.0, 0.0, 1.0};  // unit vector toward the sun (apparent)
+    double sunIlluminance_lux = 0.0;         // on a plane normal to the sun, at the ground
+    double turbidity = 2.5;                  // Preetham's T (clear 2, hazy 6+)
+    // Moonless sky at the zenith (K&S eq. 2); 0 leaves the night sky out.
+    double darkZenithLuminance_cdm2 = kDarkZenithSky_nL * kNanoLambert_cdm2;
+    // V-band extinction (mag per air mass) for the night and moonlit sky; K&S's Mauna Kea
+    // value by default, ZenithExtinctionV_mag of the observer's height in a scenario.
+    double extinctionV_magPerAirmass = 0.172;
+    bool moon = false;                         // add the moonlit sky (K&S eqs. 15–21)
+    glm::dvec3 moonDirection{0.0, 0.0, -1.0};  // unit vector toward the moon (apparent)
+    double moonPhaseAngle_rad = 3.14159265358979323846;
+    double moonDistance_m = 3.844e8;
+};
+
 class AnalyticSky {
   public:
-    // sunDirection: unit ENU vector toward the sun. sunIlluminance_lux: illuminance on a
-    // plane normal to the sun. turbidity: Preetham's T (clear 2, hazy 6+). The sky's own
-    // luminance comes from Preetham's zenith-luminance fit; it is valid for sun elevations
-    // ≥ 0 (the sun is held at the horizon below that: twilight belongs to the sky model of
-    // the ephemeris issue).
+    // The daylight part has Preetham's distribution (shape and chromaticity) for the sun at
+    // its elevation, or on the horizon in its azimuth once it has set, scaled so that the
+    // dome's horizontal illuminance is scene::ClearSkyDiffuseIlluminance_lux of the sun's
+    // altitude: the IES clear sky by day (Preetham's own zenith-luminance fit is 2–14 times
+    // brighter than measured skies at low sun; Zotti, Wilkie & Purgathofer, WSCG 2007), Circular
+    // 171's twilight fall-off after sunset, nothing below −18°. Added to it: the moonless night
+    // sky and, when the moon is given, the sky lit by the moon (radiometry/sky/night_sky.h),
+    // both grey (equal Rec.709 components).
+    explicit AnalyticSky(const SkyConditions& conditions);
+    // Daylight sky with the moonless night sky and no moon.
     AnalyticSky(const glm::dvec3& sunDirection, double sunIlluminance_lux, double turbidity);
 
     // Sky radiance (cd/m², linear Rec.709) toward unit ENU direction d, without the sun disc.
@@ -51,10 +75,20 @@ class AnalyticSky {
     // numerical integration of L·cosθ over the hemisphere.
     glm::dvec3 HorizontalSkyIlluminance() const { return skyHorizontal_; }
 
+    // Factor applied to Preetham's own luminance for the daylight part (see the constructor).
+    double DaylightScale() const { return dayScale_; }
+    const SkyConditions& Conditions() const { return conditions_; }
+
   private:
+    // Preetham's radiance without the daylight scale and without night terms.
+    glm::dvec3 PreethamRadiance(const glm::dvec3& d) const;
     double Perez(const double coeffs[5], double cosTheta, double gamma) const;
 
+    SkyConditions conditions_;
     glm::dvec3 sunDir_;
+    glm::dvec3 moonDir_{0.0, 0.0, -1.0};
+    double moonZenith_rad_ = 3.14159265358979323846;
+    double dayScale_ = 1.0;
     glm::dvec3 sunRadiance_;
     glm::dvec3 sunIlluminanceRgb_;
     double thetaSun_;

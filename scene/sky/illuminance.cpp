@@ -10,6 +10,7 @@
 #include <string>
 
 #include "scene/core/error.h"
+#include "scene/sky/stars.h"
 
 namespace seasense::scene {
 namespace {
@@ -147,6 +148,33 @@ double MoonIlluminance_lux(double altitude_rad, double phaseAngle_rad, double di
                           kMoonPhaseQuartic_perDeg4 * phase2 * phase2 +
                           2.0 * std::log10(parallax_deg / kMoonMeanParallax_deg);
     return std::pow(10.0, log10E);
+}
+
+double ClearSkyDiffuseIlluminance_lux(double sunAltitude_rad) {
+    CheckAltitude(sunAltitude_rad, "ClearSkyDiffuseIlluminance_lux");
+    // IES clear sky at the horizon: 0.8 klx.
+    constexpr double kHorizon_lux = 800.0;
+    if (sunAltitude_rad >= 0.0) return kHorizon_lux + 15.5e3 * std::sqrt(std::sin(sunAltitude_rad));
+    return kHorizon_lux * SunIlluminance_lux(sunAltitude_rad) / SunIlluminance_lux(0.0);
+}
+
+double DirectNormalMoonIlluminance_lux(double altitude_rad, double phaseAngle_rad,
+                                       double distance_m, double observerHeight_m) {
+    CheckAltitude(altitude_rad, "DirectNormalMoonIlluminance_lux");
+    CheckDistance(distance_m, "DirectNormalMoonIlluminance_lux");
+    if (!std::isfinite(phaseAngle_rad) || phaseAngle_rad < -1e-12 ||
+        phaseAngle_rad > std::numbers::pi + 1e-12)
+        throw InputError("DirectNormalMoonIlluminance_lux: phase angle " +
+                         std::to_string(phaseAngle_rad) + " rad is not in [0, pi]");
+    // Mean semidiameter 15.5' (Meeus ch. 55): the disc is gone once the upper limb has set.
+    if (altitude_rad < -0.259 * kDeg) return 0.0;
+    const double a_deg = phaseAngle_rad / kDeg;
+    const double vmag = -12.73 + 0.026 * a_deg + 4e-9 * a_deg * a_deg * a_deg * a_deg;
+    constexpr double kMeanMoonDistance_m = 3.844e8;
+    const double r = kMeanMoonDistance_m / distance_m;
+    const double k = ZenithExtinctionV_mag(observerHeight_m);
+    return StarIlluminanceAboveAtmosphere_lux(vmag) * r * r *
+           std::pow(10.0, -0.4 * k * RelativeAirMass(altitude_rad));
 }
 
 double NightSkyIlluminance_lux() { return kNightSkyClear_lux; }

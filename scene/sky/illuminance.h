@@ -54,6 +54,23 @@ double RelativeAirMass(double altitude_rad);
 double DirectNormalSunIlluminance_lux(double altitude_rad, double distance_m,
                                       double luminousTurbidity);
 
+// Illuminance (lux) on a horizontal surface from the clear sky dome alone (no direct sun) at
+// apparent sun altitude sunAltitude_rad. Sun up: the IES clear-sky model
+// 0.8 + 15.5·(sin h)^½ klx (IES Lighting Handbook, Reference Volume 1984, ch. 7; CIE 110-1994).
+// Sun down: 800 lx scaled by Circular 171's twilight fall-off SunIlluminance_lux(h) /
+// SunIlluminance_lux(0) (all of which is sky light below the horizon), continuous at h = 0 and
+// zero below -18 deg, where the night sky takes over. Throws InputError for a bad altitude.
+double ClearSkyDiffuseIlluminance_lux(double sunAltitude_rad);
+
+// Direct-normal illuminance (lux) of the moon at the ground: Allen's magnitude law
+// V = -12.73 + 0.026|α| + 4e-9 α⁴ (α the phase angle in degrees; Allen, "Astrophysical
+// Quantities", 3rd ed. §65, as used by Krisciunas & Schaefer, PASP 103, 1033 (1991), eq. 9) at
+// the mean distance 384 400 km, scaled by the inverse square of distance_m, through
+// 10^(-0.4 k X) with k = ZenithExtinctionV_mag(observerHeight_m) and X = RelativeAirMass.
+// Zero once the upper limb has set. Throws InputError for bad arguments.
+double DirectNormalMoonIlluminance_lux(double altitude_rad, double phaseAngle_rad,
+                                       double distance_m, double observerHeight_m = 0.0);
+
 // Clear-sky night-sky floor (lux): starlight, zodiacal light and airglow with no moon.
 double NightSkyIlluminance_lux();
 

@@ -47,11 +47,22 @@ FrameState World::Advance(int64_t frame) const {
     s.time_s = double(frame) * w.timeScale / w.frameRate_hz;
     s.utc = w.start.PlusSeconds(s.time_s);
 
+    Observer observer;
+    observer.latitude_deg = w.latitude_deg;
+    observer.longitude_deg = w.longitude_deg;
+    observer.height_m = scenario_.eyepoint.position_m.z;
+    {
+        const CelestialPosition m = MoonPosition(s.utc, observer);
+        s.moon.direction = m.direction;
+        s.moon.elevation_rad = m.altitude_rad;
+        s.moon.azimuth_rad = m.azimuth_rad;
+        s.moon.distance_m = m.distance_m;
+        s.moon.phaseAngle_rad = MoonPhase(s.utc, observer).phaseAngle_rad;
+        s.moon.illuminance_lux = DirectNormalMoonIlluminance_lux(
+            m.altitude_rad, s.moon.phaseAngle_rad, m.distance_m, observer.height_m);
+    }
     const SunSettings& sun = scenario_.environment.sun;
     if (sun.fromEphemeris) {
-        Observer observer;
-        observer.latitude_deg = w.latitude_deg;
-        observer.longitude_deg = w.longitude_deg;
         const CelestialPosition p = SunPosition(s.utc, observer);
         s.sun.azimuth_rad = p.azimuth_rad;
         s.sun.elevation_rad = p.altitude_rad;
@@ -99,6 +110,7 @@ SceneState World::Compose(const FrameState& f) const {
     s.time_s = f.time_s;
     s.utc = f.utc;
     s.sun = f.sun;
+    s.moon = f.moon;
     s.eyepoint = f.eyepoint;
     for (size_t i = 0; i < scenario_.entities.size(); ++i) {
         const EntitySettings& e = scenario_.entities[i];

@@ -30,6 +30,16 @@ struct SunState {
     double illuminance_lux = 0.0;  // on a surface normal to the sun
 };
 
+// The moon as the observer sees it (always from the ephemeris and the scenario clock).
+struct MoonState {
+    glm::dvec3 direction{0.0, 0.0, -1.0};  // unit ENU vector toward the moon (apparent)
+    double elevation_rad = -0.5 * 3.14159265358979323846;
+    double azimuth_rad = 0.0;
+    double illuminance_lux = 0.0;  // direct, on a surface normal to the moon, at the ground
+    double phaseAngle_rad = 3.14159265358979323846;  // sun–moon–observer; 0 full, π new
+    double distance_m = 3.844e8;                     // observer to the moon's centre
+};
+
 // The part of a frame's scene that changes with time: what the host of a run publishes to the
 // channel renderers (scene/world's static content — meshes, materials — each builds itself).
 struct FrameState {
@@ -37,6 +47,7 @@ struct FrameState {
     double time_s = 0.0;  // simulated seconds since frame 0
     UtcTime utc;
     SunState sun;
+    MoonState moon;
     Pose eyepoint;
     std::vector<Pose> entityPoses;  // one per scenario entity, in scenario order
 };
@@ -47,6 +58,7 @@ struct SceneState {
     double time_s = 0.0;  // simulated seconds since frame 0
     UtcTime utc;
     SunState sun;
+    MoonState moon;
     Pose eyepoint;
     std::vector<EntityState> entities;
 };

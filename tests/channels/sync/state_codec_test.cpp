@@ -20,6 +20,12 @@ scene::FrameState Sample(size_t entities) {
     s.sun.elevation_rad = -0.0123;
     s.sun.azimuth_rad = 5.1;
     s.sun.illuminance_lux = 1234.5678;
+    s.moon.direction = {-0.3, 0.5, 0.81240384046359604};
+    s.moon.elevation_rad = 0.9484;
+    s.moon.azimuth_rad = 2.7;
+    s.moon.illuminance_lux = 0.2345;
+    s.moon.phaseAngle_rad = 0.321;
+    s.moon.distance_m = 3.7e8;
     s.eyepoint.position_m = {1e-300, -0.0, 2.0};
     s.eyepoint.worldFromBody = glm::dmat3(0.6, 0.8, 0, -0.8, 0.6, 0, 0, 0, 1);
     for (size_t i = 0; i < entities; ++i) {
@@ -45,6 +51,12 @@ TEST(StateCodec, RoundTripIsBitExact) {
         for (int k = 0; k < 3; ++k) EXPECT_TRUE(SameBits(d.sun.direction[k], s.sun.direction[k]));
         EXPECT_TRUE(SameBits(d.sun.illuminance_lux, s.sun.illuminance_lux));
         EXPECT_TRUE(SameBits(d.sun.elevation_rad, s.sun.elevation_rad));
+        for (int k = 0; k < 3; ++k) EXPECT_TRUE(SameBits(d.moon.direction[k], s.moon.direction[k]));
+        EXPECT_TRUE(SameBits(d.moon.elevation_rad, s.moon.elevation_rad));
+        EXPECT_TRUE(SameBits(d.moon.azimuth_rad, s.moon.azimuth_rad));
+        EXPECT_TRUE(SameBits(d.moon.illuminance_lux, s.moon.illuminance_lux));
+        EXPECT_TRUE(SameBits(d.moon.phaseAngle_rad, s.moon.phaseAngle_rad));
+        EXPECT_TRUE(SameBits(d.moon.distance_m, s.moon.distance_m));
         EXPECT_TRUE(SameBits(d.eyepoint.position_m.y, s.eyepoint.position_m.y));  // −0.0 kept
         EXPECT_EQ(d.eyepoint.worldFromBody, s.eyepoint.worldFromBody);
         ASSERT_EQ(d.entityPoses.size(), entities);

@@ -40,6 +40,15 @@ Scenario BaseScenario() {
     return sc;
 }
 
+// The observer the world uses for BaseScenario: its place and the eyepoint's height.
+Observer BaseObserver() {
+    Observer obs;
+    obs.latitude_deg = 33.2;
+    obs.longitude_deg = -117.4;
+    obs.height_m = 2.0;
+    return obs;
+}
+
 TEST(World, EntitiesAndEyepointMoveAtConstantVelocityAlongTheirHeading) {
     const World world(BaseScenario());
     const FrameState f = world.Advance(50);
@@ -94,9 +103,7 @@ TEST(World, EphemerisSunFollowsTheClockAndSets) {
     sc.world.timeScale = 60.0;  // a minute per frame at 1 Hz
     sc.world.frameRate_hz = 1.0;
     const World world(sc);
-    Observer obs;
-    obs.latitude_deg = 33.2;
-    obs.longitude_deg = -117.4;
+    const Observer obs = BaseObserver();
     double previous = M_PI;
     for (int64_t frame = 0; frame < 40; frame += 3) {
         const FrameState f = world.Advance(frame);
@@ -108,6 +115,36 @@ TEST(World, EphemerisSunFollowsTheClockAndSets) {
         // No direct sun once the upper limb (0.27°) is below the apparent horizon.
         EXPECT_EQ(f.sun.illuminance_lux > 0.0, p.altitude_rad > -0.2666 * M_PI / 180) << frame;
     }
+}
+
+TEST(World, MoonFollowsTheEphemerisWithItsPhaseAndLight) {
+    // 2026-06-22 02:35 UTC at 33.2° N: the moon near first quarter (new moon 2026-06-15), high
+    // in the south at sunset, setting about five hours later.
+    Scenario sc = BaseScenario();
+    sc.world.timeScale = 600.0;  // ten minutes per frame at 1 Hz
+    sc.world.frameRate_hz = 1.0;
+    const World world(sc);
+    const Observer obs = BaseObserver();
+    bool sawUp = false, sawDown = false;
+    for (int64_t frame = 0; frame < 40; frame += 2) {
+        const FrameState f = world.Advance(frame);
+        const CelestialPosition m = MoonPosition(f.utc, obs);
+        EXPECT_NEAR(f.moon.elevation_rad, m.altitude_rad, 1e-12);
+        EXPECT_NEAR(glm::length(f.moon.direction - m.direction), 0.0, 1e-12);
+        EXPECT_NEAR(f.moon.distance_m, m.distance_m, 1.0);
+        const double k = MoonPhase(f.utc, obs).illuminatedFraction;
+        EXPECT_NEAR((1.0 + std::cos(f.moon.phaseAngle_rad)) / 2.0, k, 1e-9);
+        EXPECT_GT(k, 0.2);  // a week after new moon, waxing over the 6.5 h
+        EXPECT_LT(k, 0.7);
+        // Moonlight only while the disc is up; a crescent high up gives ~0.01–0.05 lx.
+        EXPECT_EQ(f.moon.illuminance_lux > 0.0, m.altitude_rad > -0.259 * M_PI / 180) << frame;
+        EXPECT_LT(f.moon.illuminance_lux, 0.1);
+        (f.moon.illuminance_lux > 0.0 ? sawUp : sawDown) = true;
+        // The composed scene state carries the same moon.
+        EXPECT_EQ(world.Compose(f).moon.direction, f.moon.direction);
+    }
+    EXPECT_TRUE(sawUp);
+    EXPECT_TRUE(sawDown);  // it sets during the 6.5 h
 }
 
 TEST(World, ComposeRejectsAStateOfAnotherScenario) {

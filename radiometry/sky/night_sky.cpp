@@ -1,0 +1,54 @@
+// Krisciunas & Schaefer (1991) night-sky and moonlit-sky luminance.
+#include "radiometry/sky/night_sky.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace seasense::radiometry {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+// Mean lunar semidiameter 15.54' (Meeus, "Astronomical Algorithms" ch. 55, at 384 400 km).
+constexpr double kMoonSemidiameter_rad = 15.54 / 60.0 * kDeg;
+constexpr double kMeanMoonDistance_m = 3.844e8;
+
+}  // namespace
+
+double ScatteringAirMass(double zenith_rad) {
+    const double s = std::sin(std::clamp(zenith_rad, 0.0, 0.5 * std::numbers::pi));
+    return 1.0 / std::sqrt(1.0 - 0.96 * s * s);
+}
+
+double DarkSkyLuminance_cdm2(double zenith_rad, double k, double zenithLuminance_cdm2) {
+    const double X = ScatteringAirMass(zenith_rad);
+    return zenithLuminance_cdm2 * std::pow(10.0, -0.4 * k * (X - 1.0)) * X;
+}
+
+double MoonlitSkyLuminance_cdm2(double skyZenith_rad, double moonZenith_rad, double separation_rad,
+                                double phaseAngle_rad, double moonDistance_m, double k) {
+    const double moonAltitude_rad = 0.5 * std::numbers::pi - moonZenith_rad;
+    if (moonAltitude_rad <= -kMoonSemidiameter_rad) return 0.0;
+    const double visible = std::min(1.0, 0.5 * (1.0 + moonAltitude_rad / kMoonSemidiameter_rad));
+    const double rho_deg = std::max(separation_rad / kDeg, 0.25);  // inside the disc: its edge
+    const double c = std::cos(separation_rad);
+    const double fRayleigh = std::pow(10.0, 5.36) * (1.06 + c * c);
+    const double fMie =
+        rho_deg >= 10.0 ? std::pow(10.0, 6.15 - rho_deg / 40.0) : 6.2e7 / (rho_deg * rho_deg);
+    const double a_deg = std::abs(phaseAngle_rad) / kDeg;
+    const double iStar =
+        std::pow(10.0, -0.4 * (3.84 + 0.026 * a_deg + 4e-9 * a_deg * a_deg * a_deg * a_deg));
+    const double r = kMeanMoonDistance_m / moonDistance_m;
+    const double Xm = ScatteringAirMass(moonZenith_rad);
+    const double X = ScatteringAirMass(skyZenith_rad);
+    const double B_nL = (fRayleigh + fMie) * iStar * r * r * std::pow(10.0, -0.4 * k * Xm) *
+                        (1.0 - std::pow(10.0, -0.4 * k * X));
+    return visible * B_nL * kNanoLambert_cdm2;
+}
+
+double SurfaceBrightnessV_magPerArcsec2(double luminance_cdm2) {
+    const double B_nL = luminance_cdm2 / kNanoLambert_cdm2;
+    return (20.7233 - std::log(B_nL / 34.08)) / 0.92104;
+}
+
+}  // namespace seasense::radiometry
