@@ -10,6 +10,7 @@
 
 #include "scene/config/config.h"
 #include "scene/core/time.h"
+#include "scene/sky/lightning.h"
 
 namespace seasense::scene {
 
@@ -68,6 +69,8 @@ struct EnvironmentSettings {
     // built (scene does not depend on radiometry). Absent: the parsers' defaults.
     std::optional<ConfigValue> atmosphere;
     std::optional<ConfigValue> sea;
+    // environment.lightning: thunderstorm cells and bolt/stroke parameters (ReadLightningSettings).
+    std::optional<LightningSettings> lightning;
 };
 
 // A static mesh placed in the world. Positions are ENU metres at the model origin.

@@ -11,6 +11,7 @@
 #include "scene/config/config.h"
 #include "scene/config/digest.h"
 #include "scene/config/suggest.h"
+#include "scene/core/error.h"
 #include "scene/ocean/gerstner.h"
 
 namespace seasense::scene {
@@ -140,6 +141,14 @@ EnvironmentSettings ReadEnvironment(ConfigMap& map) {
                 env.windDirection_rad =
                     w.GetDouble("direction_deg", NumberRange::Any("deg")) * kRadPerDeg;
             });
+        }
+        if (std::optional<ConfigValue> lightning = e.Find("lightning")) {
+            env.lightning = ReadLightningSettings(*lightning);
+            try {
+                ValidateLightningSettings(*env.lightning);
+            } catch (const InputError& error) {
+                lightning->Fail(std::string("consistent lightning settings: ") + error.what());
+            }
         }
         env.atmosphere = e.Find("atmosphere");
         env.sea = e.Find("sea");

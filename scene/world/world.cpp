@@ -28,6 +28,9 @@ World::World(const Scenario& scenario) : scenario_(scenario), ocean_(scenario.en
             throw InputError(scenario_.file.string() + ": entity '" + e.name +
                              "' names unknown material '" + e.material + "'");
     }
+    if (scenario_.environment.lightning)
+        lightning_ = std::make_shared<const Lightning>(*scenario_.environment.lightning,
+                                                       scenario_.world.seed);
 }
 
 namespace {

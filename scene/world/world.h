@@ -11,6 +11,7 @@
 #include "scene/ocean/gerstner.h"
 #include "scene/scenario/scenario.h"
 #include "scene/sky/ephemeris.h"
+#include "scene/sky/lightning.h"
 
 namespace seasense::scene {
 
@@ -79,6 +80,9 @@ class World {
 
     const Scenario& GetScenario() const { return scenario_; }
     const GerstnerOcean& Ocean() const { return ocean_; }
+    // The scenario's thunderstorms (environment.lightning), or nullptr. Flashes are pure
+    // functions of the scene time, so every channel sees the same ones.
+    const Lightning* GetLightning() const { return lightning_.get(); }
 
   private:
     Scenario scenario_;
@@ -86,6 +90,7 @@ class World {
     std::vector<std::shared_ptr<const TriangleMesh>> models_;  // one per entity
     // Half length (body y) and half beam (body x) of each entity's mesh, for riding the waves.
     std::vector<glm::dvec2> halfExtent_m_;
+    std::shared_ptr<const Lightning> lightning_;
 };
 
 }  // namespace seasense::scene

@@ -1,0 +1,32 @@
+// Lightning in the out-the-window channel: the bolts lit during a frame's exposure drawn into
+// the sky and in front of the scene, and the flash light they shed on it.
+#pragma once
+
+#include <glm/glm.hpp>
+
+#include "channels/camera/channel_camera.h"
+#include "channels/raster/rasterizer.h"
+#include "scene/core/image.h"
+#include "scene/sky/lightning.h"
+
+namespace seasense::channels {
+
+// The flash light of one frame at the eye.
+struct FlashLight {
+    double illuminance_lux = 0.0;         // on a surface facing the channels (sum of I/d²)
+    glm::dvec3 direction{0.0, 0.0, 1.0};  // unit ENU, illuminance-weighted toward the bolts
+    int flashes = 0;                      // flashes lit in the window
+};
+
+// Draws every flash lit during [t0_s, t1_s] (simulation seconds; the frame's exposure) into the
+// supersampled radiance image (rgb cd/m², white: equal components). The channel is optically
+// thin, so each element dl radiates isotropically with intensity I_l dl
+// (Lightning::MeanSegmentIntensity_cdPerM): it adds I_l dl exp(−β d) / (d² Ω) to the sample it
+// projects into, Ω that sample's solid angle, unless the visibility buffer holds something
+// nearer there. Elements are at most half a sample apart on screen. Returns the flash light at
+// the eye with the same extinction (Lightning::MeanIlluminance_lux).
+FlashLight DrawLightning(const ChannelCamera& camera, const VisibilityBuffer& vis,
+                         const scene::Lightning& lightning, double t0_s, double t1_s,
+                         double extinction_perM, Image& radiance);
+
+}  // namespace seasense::channels
