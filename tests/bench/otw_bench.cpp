@@ -103,18 +103,19 @@ void BM_OtwPresent(benchmark::State& state) {
         pipeline =
             std::make_unique<ChannelPipeline>(world, ch, out, ch.formats, DefaultOcioConfig());
     });
-    FrameRecord rec;
-    arena.execute([&] { rec = pipeline->Render(world.Advance(0)); });
     int w = 0, h = 0;
     sync::MosaicPreviewSize(ch.width, ch.height, w, h);
+    int64_t frame = 0;
     for (auto _ : state) {
+        // A new frame each time: the display transform runs once per rendered frame.
+        state.PauseTiming();
+        FrameRecord rec;
+        arena.execute([&] { rec = pipeline->Render(world.Advance(frame++)); });
+        state.ResumeTiming();
         arena.execute([&] {
             std::vector<uint8_t> rgb = pipeline->PreviewRgb8(w, h);
             benchmark::DoNotOptimize(rgb.data());
-            if (writeImages) {
-                FrameRecord r = rec;
-                pipeline->Write(r);
-            }
+            if (writeImages) pipeline->Write(rec);
         });
     }
     std::filesystem::remove_all(out);
