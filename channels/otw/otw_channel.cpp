@@ -301,8 +301,8 @@ struct BlockScratch {
     }
 };
 
-// Vertex positions and normals of the triangle last met in a sample row, as SSE (x, y, z, 0):
-// neighbouring samples mostly see the same triangle, so its six vertices are gathered once.
+// Vertex positions and normals of a triangle as SSE (x, y, z, 0), gathered once for the many
+// samples that see it.
 struct CachedTriangle {
     uint32_t prim = kNoPrimitive;
     int mesh = 0;
@@ -447,9 +447,9 @@ class BlockClassifier {
     }
 
   private:
-    // The cached triangle of sample row j, made to hold prim.
-    const CachedTriangle& Triangle(int j, uint32_t prim) {
-        CachedTriangle& tri = tri_[j];
+    // The cached triangle prim.
+    const CachedTriangle& Triangle(uint32_t prim) {
+        CachedTriangle& tri = tri_[prim % kTriangleCacheSize];
         if (tri.prim == prim) return tri;
         g_.Fetch(prim, tri);
         tri.shadowable = false;
@@ -500,7 +500,7 @@ class BlockClassifier {
     bool SeaTrianglePixel(int x0, uint32_t k, uint32_t prim) {
         const int n = g_.n, count = n * n;
         if (!DepthsClose(x0)) return false;
-        const CachedTriangle& tri = Triangle(0, prim);
+        const CachedTriangle& tri = Triangle(prim);
         float b1[kMaxSupersampling * kMaxSupersampling], b2[kMaxSupersampling * kMaxSupersampling];
         float b1Sum = 0.0f, b2Sum = 0.0f;
         for (int j = 0; j < n; ++j) {
@@ -546,7 +546,7 @@ class BlockClassifier {
             for (int i = 0; i < n; ++i) {
                 const size_t index = rowIndex_[j] + size_t(x0 + i);
                 const int s = j * n + i;
-                const CachedTriangle& tri = Triangle(j, g_.vis.primitive[index]);
+                const CachedTriangle& tri = Triangle(g_.vis.primitive[index]);
                 Interpolate(tri, g_.vis.b1[index], g_.vis.b2[index], p[s], nrm[s]);
                 shadowable |= tri.shadowable;
                 pSum = _mm_add_ps(pSum, p[s]);
@@ -604,7 +604,7 @@ class BlockClassifier {
             AddSky(k, sampleRow_[j] + (float(x) + 0.5f) * g_.colStep);
             return;
         }
-        const CachedTriangle& tri = Triangle(j, prim);
+        const CachedTriangle& tri = Triangle(prim);
         F4 p, nSum;
         Interpolate(tri, g_.vis.b1[index], g_.vis.b2[index], p, nSum);
         if (tri.mesh == 0) {
@@ -636,7 +636,10 @@ class BlockClassifier {
     const int y0_;                            // first sample row of the block
     glm::vec3 sampleRow_[kMaxSupersampling];  // RowBase of the pixel row's sample rows
     size_t rowIndex_[kMaxSupersampling];      // visibility index of their first sample
-    CachedTriangle tri_[kMaxSupersampling];   // per sample row
+    // Triangles last met, direct-mapped by primitive id: neighbouring samples mostly see the
+    // same few triangles (a strip's ids are consecutive), so each is gathered about once.
+    static constexpr uint32_t kTriangleCacheSize = 16;
+    CachedTriangle tri_[kTriangleCacheSize];
 };
 
 // Traces the block's shadow rays and stores the sun visibility of its sea and model entries;
