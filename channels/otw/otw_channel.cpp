@@ -12,6 +12,7 @@
 
 #include "radiometry/sky/analytic_sky.h"
 #include "radiometry/surface/fresnel.h"
+#include "scene/core/check.h"
 #include "scene/core/simd4.h"
 
 namespace seasense::channels {
@@ -40,14 +41,17 @@ struct RayBoxTest {
         // Components below 1e-20 count as parallel, as in OcclusionScene (no inf·0 below).
         for (int a = 0; a < 3; ++a) inverse[a] = Parallel(d[a]) ? 0.0f : 1.0f / d[a];
     }
-    bool MayHit(const glm::vec3& o) const {
+    // Whether a ray from o may meet the box grown by grow_m (≥ 0) on each side: also whether
+    // any ray from a point within grow_m of o per axis may meet the box itself.
+    bool MayHit(const glm::vec3& o, const glm::vec3& grow_m = glm::vec3(0.0f)) const {
         float t0 = 0.0f, t1 = std::numeric_limits<float>::infinity();
         for (int a = 0; a < 3; ++a) {
+            const float l = lo[a] - grow_m[a], h = hi[a] + grow_m[a];
             if (Parallel(direction[a])) {
-                if (o[a] < lo[a] || o[a] > hi[a]) return false;
+                if (o[a] < l || o[a] > h) return false;
                 continue;
             }
-            const float tA = (lo[a] - o[a]) * inverse[a], tB = (hi[a] - o[a]) * inverse[a];
+            const float tA = (l - o[a]) * inverse[a], tB = (h - o[a]) * inverse[a];
             t0 = std::max(t0, std::min(tA, tB));
             t1 = std::min(t1, std::max(tA, tB));
         }
@@ -99,25 +103,6 @@ void Normalize(size_t count, float* x, float* y, float* z) {
     }
 }
 
-// Four-lane RayBoxTest::MayHit: bit l of the result set when lane l may hit.
-int MayHit4(const RayBoxTest& box, F4 ox, F4 oy, F4 oz) {
-    const F4 o[3] = {ox, oy, oz};
-    F4 t0 = _mm_setzero_ps(), t1 = Set4(std::numeric_limits<float>::infinity());
-    F4 inside = _mm_castsi128_ps(_mm_set1_epi32(-1));
-    for (int a = 0; a < 3; ++a) {
-        if (RayBoxTest::Parallel(box.direction[a])) {
-            inside = _mm_and_ps(inside, _mm_and_ps(_mm_cmpge_ps(o[a], Set4(box.lo[a])),
-                                                   _mm_cmple_ps(o[a], Set4(box.hi[a]))));
-            continue;
-        }
-        const F4 tA = _mm_mul_ps(_mm_sub_ps(Set4(box.lo[a]), o[a]), Set4(box.inverse[a]));
-        const F4 tB = _mm_mul_ps(_mm_sub_ps(Set4(box.hi[a]), o[a]), Set4(box.inverse[a]));
-        t0 = _mm_max_ps(t0, _mm_min_ps(tA, tB));
-        t1 = _mm_min_ps(t1, _mm_max_ps(tA, tB));
-    }
-    return _mm_movemask_ps(_mm_and_ps(inside, _mm_cmple_ps(t0, t1)));
-}
-
 // Shadow-ray origin for surface point p with unit normal n: offset along the normal against
 // self-shadowing by 1 mm plus 32 float ulps of the largest coordinate (4e-6 relative), which
 // covers the rounding of positions rebuilt from float vertices and barycentrics. A larger
@@ -129,8 +114,11 @@ glm::vec3 ShadowRayOrigin(const glm::vec3& p, const glm::vec3& n) {
     return p + n * ShadowOffset_m(p);
 }
 
-// Tag of shadow-ray owners that are sea samples (indices into the sea arrays).
-constexpr uint32_t kSeaOwner = 1u << 31;
+// Step of the sun direction the sky table is built for: 0.01° in elevation and azimuth, so the
+// table's sun is within 0.0071° of the true one. That changes sky radiance by < 0.05 %
+// (computed in tests/radiometry/sky: analytic_sky_test, QuantizedSun…), a tenth of an 8-bit
+// display step; at the five-channel run's time scale (10) the table is rebuilt every ~7 frames.
+constexpr double kSkySunStep_rad = 0.01 * M_PI / 180.0;
 
 // Samples per shading chunk: the chunk's arrays stay in L1.
 constexpr size_t kChunk = 256;
@@ -240,47 +228,506 @@ struct SeaShading {
     }
 };
 
-// Per-thread scratch of the shading pass. Samples of a row block are sorted into sky, sea and
-// model lists so that each kind is shaded in a tight loop: sky and sea four lanes at a time in
-// structure-of-arrays chunks (the bulk of the frame), the few model samples one by one. The
-// sky and sea lists only grow (their used length is counted separately), so that a block
-// never zero-fills them.
+// Shading entries: an entry is one sample, or — tagged with kPixelEntry — all N×N samples of a
+// pixel (k is then the pixel's top-left sample), shaded once at the pixel's centre.
+//
+// Why pixel-rate shading is enough where a pixel sees one smooth surface: the detector
+// integrates radiance over the pixel's footprint (sensors/detector), and for radiance L that
+// is smooth across the pixel, shading at the centre (one-point midpoint rule) and the mean of
+// the N×N samples both estimate that integral to second order; they differ by about
+// (h²/24)(1 − 1/N²)·∇²L for pixel size h — a fraction of a percent of the sea's and sky's
+// radiance, whose variation is set by the sea mesh's normals (vertices 6 pixels apart) and a
+// sky table with texels a degree apart (measured against per-sample shading on the
+// five-channel run: README, Performance). Where the signal is not smooth inside a pixel —
+// edges between sky, sea and models, the sun's disc, depth jumps between waves — every
+// sample is shaded as before, and shadow edges keep per-sample sun visibility (the pixel
+// gets the lit fraction of its samples, which is exact because the sea's radiance is linear
+// in sun visibility).
+constexpr uint32_t kPixelEntry = 1u << 30;
+
+// Tag of shadow-ray owners that are sea entries (indices into the sea arrays).
+constexpr uint32_t kSeaOwner = 1u << 31;
+
+// Largest supersampling factor (scene/scenario accepts 1 … 8).
+constexpr int kMaxSupersampling = 8;
+
+// A pixel whose samples all see the sea is shaded at pixel rate only where the sea's radiance
+// is close to linear across it. Its nonlinearity is in the cosine c = n·v of the view angle
+// to the interpolated normal (Fresnel reflectance, the 1/(4c) of the glint, the elevation of
+// the reflected ray) and, for fog, in range. Shading the mean differs from the mean of the
+// shaded samples by about ½|L''|·Var(c) ≤ ⅛|L''|·Δc² for a spread Δc of c; requiring Δc ≤
+// 0.005 and Δc ≤ 0.1·c keeps that below 0.2 % even for the 1/c glint factor near grazing
+// incidence, and excludes wave crests hiding farther troughs (c jumps there) and back-facing
+// slopes (c ≤ 0). Depth within 10 % bounds fog's nonlinearity, exp(−βr) over a range span
+// of 0.1·r, to (0.1·βr)²/8 ≈ 0.1 % where fog is strong (βr ≈ 1). Measured on the
+// five-channel run against per-sample shading: README, Performance.
+constexpr float kMaxSeaPixelCosSpread = 0.005f;
+constexpr float kMaxSeaPixelRelativeCosSpread = 0.1f;
+constexpr float kMaxSeaPixelDepthRatio = 1.1f;
+
+// Per-thread scratch of the shading pass. The pixels of a row block are sorted into sky, sea
+// and model entries so that each kind is shaded in a tight loop: sky and sea four lanes at a
+// time in structure-of-arrays chunks (the bulk of the frame), the few model samples one by
+// one. The sky and sea lists only grow (their used length is counted separately), so that a
+// block never zero-fills them.
 struct BlockScratch {
-    std::vector<uint32_t> skyK, seaK, modelK;                     // sample index within the block
-    std::vector<float> skyX, skyY, skyZ;                          // view directions of sky samples
+    std::vector<uint32_t> skyK, seaK, modelK;                     // see kPixelEntry
+    std::vector<float> skyX, skyY, skyZ;                          // view directions of sky entries
     std::vector<float> seaPx, seaPy, seaPz, seaNx, seaNy, seaNz;  // unit normals
+    std::vector<float> seaLit;      // lit fraction of a sea entry's samples
+    std::vector<uint8_t> seaUnlit;  // samples of a sea entry found in shadow
     std::vector<glm::vec3> modelPosition, modelNormal;
     std::vector<int> modelMesh;
+    std::vector<uint8_t> modelLit;  // sun visibility of model samples
     std::vector<glm::vec3> origins;
-    std::vector<uint8_t> lit, vis;  // lit: sun visibility of model samples, by k
-    std::vector<float> seaLit;      // sun visibility of sea samples
-    // originOwner: sample index k of a model sample, or kSeaOwner | sea index.
+    // originOwner: model entry index, or kSeaOwner | sea entry index.
     std::vector<uint32_t> originOwner;
+    std::vector<uint8_t> vis;
+    size_t skyCount = 0, seaCount = 0;
     SeaChunk chunk{};  // zeroed: lanes past a chunk's end are computed, then dropped
 
-    // Makes the sky and sea lists hold at least n samples.
-    void Reserve(size_t n) {
-        if (skyK.size() >= n) return;
-        for (std::vector<float>* v :
-             {&skyX, &skyY, &skyZ, &seaPx, &seaPy, &seaPz, &seaNx, &seaNy, &seaNz})
-            v->resize(n);
-        skyK.resize(n), seaK.resize(n);
+    // Empties the lists and makes the sky and sea lists hold at least n entries.
+    void Reset(size_t n) {
+        if (skyK.size() < n) {
+            for (std::vector<float>* v :
+                 {&skyX, &skyY, &skyZ, &seaPx, &seaPy, &seaPz, &seaNx, &seaNy, &seaNz, &seaLit})
+                v->resize(n);
+            skyK.resize(n), seaK.resize(n), seaUnlit.resize(n);
+        }
+        skyCount = seaCount = 0;
+        modelK.clear(), modelPosition.clear(), modelNormal.clear(), modelMesh.clear();
+        modelLit.clear();
+        origins.clear(), originOwner.clear();
     }
 };
 
-// Vertex positions and normals of the triangle last met in a sample row, as SSE (x, y, z, 0):
-// neighbouring samples mostly see the same triangle, so its six vertices are gathered once.
+// Vertex positions and normals of a triangle as SSE (x, y, z, 0), gathered once for the many
+// samples that see it.
 struct CachedTriangle {
     uint32_t prim = kNoPrimitive;
     int mesh = 0;
     F4 p0 = _mm_setzero_ps(), p1 = p0, p2 = p0, n0 = p0, n1 = p0, n2 = p0;
+    bool shadowable = false;  // a shadow ray from some point of it may meet a caster
 };
 
 F4 Load3(const glm::vec3& v) { return _mm_setr_ps(v.x, v.y, v.z, 0.0f); }
+glm::vec3 Store3(F4 v) {
+    alignas(16) float f[4];
+    _mm_store_ps(f, v);
+    return {f[0], f[1], f[2]};
+}
+
+// a·b of (x, y, z, ·) vectors in glm::dot's order, (x + y) + z.
+float Dot3(F4 a, F4 b) {
+    const F4 m = _mm_mul_ps(a, b);
+    const F4 xy = _mm_add_ss(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(1, 1, 1, 1)));
+    return _mm_cvtss_f32(_mm_add_ss(xy, _mm_shuffle_ps(m, m, _MM_SHUFFLE(2, 2, 2, 2))));
+}
 
 // b0·a0 + b1·a1 + b2·a2 per component, in glm's order ((b0 a0 + b1 a1) + b2 a2).
 F4 Interpolate3(F4 b0, F4 b1, F4 b2, F4 a0, F4 a1, F4 a2) {
     return _mm_add_ps(_mm_add_ps(_mm_mul_ps(b0, a0), _mm_mul_ps(b1, a1)), _mm_mul_ps(b2, a2));
+}
+
+// Mesh m's primitives are [primitiveBase[m], primitiveBase[m + 1]); mesh 0 is the sea.
+struct MeshRef {
+    const glm::vec3* P;
+    const glm::vec3* N;
+    const uint32_t* I;
+};
+
+// One frame's visibility buffer, meshes and view rays.
+struct FrameGeometry {
+    const VisibilityBuffer& vis;
+    std::vector<MeshRef> meshes;
+    uint32_t firstModelPrimitive;
+    int width, sampleWidth, sampleHeight, n;  // pixels across, samples across and down, N
+    // View rays: direction = normalize(RowBase(ndcY) + x · colStep), x in samples from the
+    // left edge (camera axes scaled by the pinhole geometry), so sky needs no trigonometry.
+    glm::dmat3 R;
+    glm::dvec3 forward;
+    double tanH, tanV;
+    glm::vec3 colStep;
+
+    glm::vec3 RowBase(double ndcY) const {
+        return glm::vec3(forward + R * glm::dvec3(-tanH, 0.0, ndcY * tanV));
+    }
+    // Loads the vertices of primitive prim into tri.
+    void Fetch(uint32_t prim, CachedTriangle& tri) const {
+        int mesh = 0;
+        if (prim >= firstModelPrimitive) {
+            mesh = 1;
+            while (mesh + 1 < int(vis.primitiveBase.size()) &&
+                   prim >= vis.primitiveBase[size_t(mesh) + 1])
+                ++mesh;
+        }
+        const MeshRef& m = meshes[size_t(mesh)];
+        const uint32_t t = prim - vis.primitiveBase[size_t(mesh)];
+        const uint32_t i0 = m.I[3 * t], i1 = m.I[3 * t + 1], i2 = m.I[3 * t + 2];
+        tri.prim = prim, tri.mesh = mesh;
+        tri.p0 = Load3(m.P[i0]), tri.p1 = Load3(m.P[i1]), tri.p2 = Load3(m.P[i2]);
+        tri.n0 = Load3(m.N[i0]), tri.n1 = Load3(m.N[i1]), tri.n2 = Load3(m.N[i2]);
+    }
+};
+
+// Surface position and (unnormalized) interpolated normal at barycentrics (1 − b1 − b2, b1, b2)
+// of triangle tri.
+void Interpolate(const CachedTriangle& tri, float b1, float b2, F4& p, F4& nSum) {
+    const float b0 = 1.0f - b1 - b2;
+    const F4 w0 = Set4(b0), w1 = Set4(b1), w2 = Set4(b2);
+    p = Interpolate3(w0, w1, w2, tri.p0, tri.p1, tri.p2);
+    nSum = Interpolate3(w0, w1, w2, tri.n0, tri.n1, tri.n2);
+}
+
+// One frame's lighting and shading constants.
+struct FrameShading {
+    glm::vec3 eye, sunDir, sunE, sunL, skyE, downwelling;
+    F4 eye4;  // eye as (x, y, z, 0)
+    float cosSunRadius;
+    // A pixel whose centre ray is farther than the sun's radius plus the pixel's half diagonal
+    // from the sun has no sample in the disc: cos of that angle (with a factor 2 margin).
+    float cosNearSun;
+    float beta;
+    bool shadows;
+    const radiometry::AnalyticSky& sky;
+    const OcclusionScene& occlusion;
+    RayBoxTest casters;
+    SeaShading sea;
+    const std::vector<glm::dvec3>& reflectance;  // per entity
+
+    // Whether unnormalized direction d is within acos(cosNearSun) of the sun.
+    bool NearSun(const glm::vec3& d) const {
+        const float c = glm::dot(d, sunDir);
+        return c > 0.0f && c * c >= cosNearSun * cosNearSun * glm::dot(d, d);
+    }
+};
+
+// Pass 1 of a block of pixel rows [py0, py1): sorts its pixels into sky, sea and model
+// entries (pixel-rate where the pixel is uniform, else per sample) with surface positions
+// and normals, and collects the shadow rays that need tracing.
+class BlockClassifier {
+  public:
+    BlockClassifier(const FrameGeometry& g, const FrameShading& f, int py0, BlockScratch& sc)
+        : g_(g), f_(f), sc_(sc), y0_(py0 * g.n) {}
+
+    void Pixels(int py) {
+        const int n = g_.n, sw = g_.sampleWidth;
+        for (int j = 0; j < n; ++j) {
+            const int y = py * n + j;
+            sampleRow_[j] = g_.RowBase(1.0 - 2.0 * (y + 0.5) / g_.sampleHeight);
+            rowIndex_[j] = g_.vis.Index(0, y);
+        }
+        const glm::vec3 pixelRow = g_.RowBase(1.0 - 2.0 * (py * n + 0.5 * n) / g_.sampleHeight);
+        const uint32_t kRow = uint32_t(size_t(py * n - y0_) * size_t(sw));
+        const uint32_t* prim = g_.vis.primitive.data();
+        for (int px = 0; px < g_.width; ++px) {
+            const int x0 = px * n;
+            const uint32_t prim0 = prim[rowIndex_[0] + size_t(x0)];
+            bool same = true, allSea = true;
+            for (int j = 0; j < n; ++j) {
+                const uint32_t* row = prim + rowIndex_[j] + size_t(x0);
+                for (int i = 0; i < n; ++i) {
+                    same &= row[i] == prim0;
+                    allSea &= row[i] < g_.firstModelPrimitive;  // kNoPrimitive is not sea
+                }
+            }
+            const uint32_t k = kRow + uint32_t(x0);
+            if (same && prim0 == kNoPrimitive) {
+                const glm::vec3 d = pixelRow + (float(x0) + 0.5f * float(n)) * g_.colStep;
+                if (!f_.NearSun(d)) {
+                    AddSky(k | kPixelEntry, d);
+                    continue;
+                }
+            } else if (allSea && (same ? SeaTrianglePixel(x0, k, prim0) : SeaPixel(x0, k))) {
+                continue;
+            }
+            for (int j = 0; j < n; ++j)
+                for (int i = 0; i < n; ++i) Sample(x0 + i, j, k + uint32_t(j * sw + i));
+        }
+    }
+
+  private:
+    // The cached triangle prim.
+    const CachedTriangle& Triangle(uint32_t prim) {
+        CachedTriangle& tri = tri_[prim % kTriangleCacheSize];
+        if (tri.prim == prim) return tri;
+        g_.Fetch(prim, tri);
+        tri.shadowable = false;
+        if (f_.shadows) {
+            // Every shadow-ray origin on the triangle lies in its bounding box grown by the
+            // largest ShadowRayOrigin offset (with as much again for rounding): a ray from the
+            // box's centre that misses the caster box grown by that much cannot meet it from
+            // any of them (Minkowski sum). This settles most triangles at once.
+            const F4 lo = _mm_min_ps(_mm_min_ps(tri.p0, tri.p1), tri.p2);
+            const F4 hi = _mm_max_ps(_mm_max_ps(tri.p0, tri.p1), tri.p2);
+            const glm::vec3 l = Store3(lo), h = Store3(hi);
+            const float far = std::max({std::abs(l.x), std::abs(l.y), std::abs(l.z), std::abs(h.x),
+                                        std::abs(h.y), std::abs(h.z)});
+            tri.shadowable =
+                f_.casters.MayHit(0.5f * (l + h), 0.5f * (h - l) + (8e-6f * far + 2e-3f));
+        }
+        return tri;
+    }
+
+    // Whether depths of the pixel's samples are within kMaxSeaPixelDepthRatio.
+    bool DepthsClose(int x0) const {
+        float dMin = std::numeric_limits<float>::infinity(), dMax = 0.0f;
+        for (int j = 0; j < g_.n; ++j) {
+            const float* depth = g_.vis.depth.data() + rowIndex_[j] + size_t(x0);
+            for (int i = 0; i < g_.n; ++i)
+                dMin = std::min(dMin, depth[i]), dMax = std::max(dMax, depth[i]);
+        }
+        return dMax <= kMaxSeaPixelDepthRatio * dMin;
+    }
+
+    // Whether a spread cMax − cMin of n·(eye − p) over a pixel's samples, range = |eye − p|,
+    // allows pixel-rate shading (kMaxSeaPixelCosSpread).
+    static bool CosSpreadSmall(float cMin, float cMax, float range) {
+        const float spread = cMax - cMin;
+        return spread <= kMaxSeaPixelCosSpread * range &&
+               spread <= kMaxSeaPixelRelativeCosSpread * cMin;
+    }
+
+    void AddSky(uint32_t k, const glm::vec3& d) {
+        const size_t e = sc_.skyCount++;
+        sc_.skyK[e] = k;
+        sc_.skyX[e] = d.x, sc_.skyY[e] = d.y, sc_.skyZ[e] = d.z;
+    }
+
+    // The pixel with top-left sample x0, all of whose samples see sea triangle prim: shaded at
+    // pixel rate (at the mean barycentrics) unless depth or c = n·v vary too much across it
+    // (then returns false, nothing added). On one triangle c is linear in the barycentrics.
+    bool SeaTrianglePixel(int x0, uint32_t k, uint32_t prim) {
+        const int n = g_.n, count = n * n;
+        if (!DepthsClose(x0)) return false;
+        const CachedTriangle& tri = Triangle(prim);
+        float b1[kMaxSupersampling * kMaxSupersampling], b2[kMaxSupersampling * kMaxSupersampling];
+        float b1Sum = 0.0f, b2Sum = 0.0f;
+        for (int j = 0; j < n; ++j) {
+            const size_t index = rowIndex_[j] + size_t(x0);
+            for (int i = 0; i < n; ++i) {
+                b1[j * n + i] = g_.vis.b1[index + size_t(i)];
+                b2[j * n + i] = g_.vis.b2[index + size_t(i)];
+                b1Sum += b1[j * n + i];
+                b2Sum += b2[j * n + i];
+            }
+        }
+        // The mean (a power-of-two scale for N = 1, 2, 4: exact).
+        const float inv = 1.0f / float(count);
+        F4 p, nSum;
+        Interpolate(tri, b1Sum * inv, b2Sum * inv, p, nSum);
+        const F4 toEye = _mm_sub_ps(f_.eye4, p);
+        const float c0 = Dot3(tri.n0, toEye);
+        const float d1 = Dot3(tri.n1, toEye) - c0, d2 = Dot3(tri.n2, toEye) - c0;
+        float cMin = std::numeric_limits<float>::infinity(), cMax = -cMin;
+        for (int s = 0; s < count; ++s) {
+            const float c = c0 + b1[s] * d1 + b2[s] * d2;
+            cMin = std::min(cMin, c), cMax = std::max(cMax, c);
+        }
+        if (!CosSpreadSmall(cMin, cMax, std::sqrt(Dot3(toEye, toEye)))) return false;
+        const size_t e = AddSea(k | kPixelEntry, p, nSum);
+        if (tri.shadowable) {
+            F4 samples[kMaxSupersampling * kMaxSupersampling], unused;
+            for (int s = 0; s < count; ++s) Interpolate(tri, b1[s], b2[s], samples[s], unused);
+            SeaShadowRays(e, samples, count);
+        }
+        return true;
+    }
+
+    // As SeaTrianglePixel, for a pixel whose sea samples lie on different triangles: the
+    // samples' positions and normals are interpolated one by one and averaged.
+    bool SeaPixel(int x0, uint32_t k) {
+        const int n = g_.n, count = n * n;
+        if (!DepthsClose(x0)) return false;
+        F4 p[kMaxSupersampling * kMaxSupersampling], nrm[kMaxSupersampling * kMaxSupersampling];
+        F4 pSum = _mm_setzero_ps(), nSum = _mm_setzero_ps();
+        bool shadowable = false;
+        for (int j = 0; j < n; ++j) {
+            for (int i = 0; i < n; ++i) {
+                const size_t index = rowIndex_[j] + size_t(x0 + i);
+                const int s = j * n + i;
+                const CachedTriangle& tri = Triangle(g_.vis.primitive[index]);
+                Interpolate(tri, g_.vis.b1[index], g_.vis.b2[index], p[s], nrm[s]);
+                shadowable |= tri.shadowable;
+                pSum = _mm_add_ps(pSum, p[s]);
+                nSum = _mm_add_ps(nSum, nrm[s]);
+            }
+        }
+        const F4 mean = _mm_mul_ps(pSum, Set4(1.0f / float(count)));
+        const F4 toEye = _mm_sub_ps(f_.eye4, mean);
+        float cMin = std::numeric_limits<float>::infinity(), cMax = -cMin;
+        for (int s = 0; s < count; ++s) {
+            const float c = Dot3(nrm[s], toEye);
+            cMin = std::min(cMin, c), cMax = std::max(cMax, c);
+        }
+        if (!CosSpreadSmall(cMin, cMax, std::sqrt(Dot3(toEye, toEye)))) return false;
+        const size_t e = AddSea(k | kPixelEntry, mean, nSum);
+        if (shadowable) SeaShadowRays(e, p, count);
+        return true;
+    }
+
+    // A lit sea entry at position p with normal nSum (normalized here); returns its index.
+    size_t AddSea(uint32_t k, F4 p, F4 nSum) {
+        // glm::normalize: v · (1 / √(v·v)).
+        const F4 inv = _mm_div_ss(Set4(1.0f), _mm_sqrt_ss(_mm_set_ss(Dot3(nSum, nSum))));
+        alignas(16) float pf[4], nf[4];
+        _mm_store_ps(pf, p);
+        _mm_store_ps(nf, _mm_mul_ps(nSum, _mm_shuffle_ps(inv, inv, 0)));
+        const size_t e = sc_.seaCount++;
+        sc_.seaK[e] = k;
+        sc_.seaPx[e] = pf[0], sc_.seaPy[e] = pf[1], sc_.seaPz[e] = pf[2];
+        sc_.seaNx[e] = nf[0], sc_.seaNy[e] = nf[1], sc_.seaNz[e] = nf[2];
+        sc_.seaLit[e] = 1.0f;
+        sc_.seaUnlit[e] = 0;
+        return e;
+    }
+
+    // Shadow rays of sea entry e, one per sample at positions samples[0..count), offset along
+    // the entry's normal.
+    void SeaShadowRays(size_t e, const F4* samples, int count) {
+        const glm::vec3 nrm(sc_.seaNx[e], sc_.seaNy[e], sc_.seaNz[e]);
+        for (int s = 0; s < count; ++s) {
+            const glm::vec3 origin = ShadowRayOrigin(Store3(samples[s]), nrm);
+            if (f_.casters.MayHit(origin) && f_.occlusion.MayOcclude(origin, f_.sunDir, 1e30f)) {
+                sc_.origins.push_back(origin);
+                sc_.originOwner.push_back(kSeaOwner | uint32_t(e));
+            }
+        }
+    }
+
+    // One sample (x, row j of the pixel row) shaded on its own.
+    void Sample(int x, int j, uint32_t k) {
+        const size_t index = rowIndex_[j] + size_t(x);
+        const uint32_t prim = g_.vis.primitive[index];
+        if (prim == kNoPrimitive) {
+            // View direction, normalized in the sky pass.
+            AddSky(k, sampleRow_[j] + (float(x) + 0.5f) * g_.colStep);
+            return;
+        }
+        const CachedTriangle& tri = Triangle(prim);
+        F4 p, nSum;
+        Interpolate(tri, g_.vis.b1[index], g_.vis.b2[index], p, nSum);
+        if (tri.mesh == 0) {
+            const size_t e = AddSea(k, p, nSum);
+            if (tri.shadowable) SeaShadowRays(e, &p, 1);
+            return;
+        }
+        const glm::vec3 position = Store3(p);
+        glm::vec3 nrm = glm::normalize(Store3(nSum));
+        if (glm::dot(nrm, f_.eye - position) < 0.0f) nrm = -nrm;
+        const size_t e = sc_.modelK.size();
+        sc_.modelK.push_back(k);
+        sc_.modelPosition.push_back(position);
+        sc_.modelNormal.push_back(nrm);
+        sc_.modelMesh.push_back(tri.mesh);
+        sc_.modelLit.push_back(1);
+        if (tri.shadowable) {
+            const glm::vec3 o = ShadowRayOrigin(position, nrm);
+            if (f_.casters.MayHit(o) && f_.occlusion.MayOcclude(o, f_.sunDir, 1e30f)) {
+                sc_.origins.push_back(o);
+                sc_.originOwner.push_back(uint32_t(e));
+            }
+        }
+    }
+
+    const FrameGeometry& g_;
+    const FrameShading& f_;
+    BlockScratch& sc_;
+    const int y0_;                            // first sample row of the block
+    glm::vec3 sampleRow_[kMaxSupersampling];  // RowBase of the pixel row's sample rows
+    size_t rowIndex_[kMaxSupersampling];      // visibility index of their first sample
+    // Triangles last met, direct-mapped by primitive id: neighbouring samples mostly see the
+    // same few triangles (a strip's ids are consecutive), so each is gathered about once.
+    static constexpr uint32_t kTriangleCacheSize = 16;
+    CachedTriangle tri_[kTriangleCacheSize];
+};
+
+// Traces the block's shadow rays and stores the sun visibility of its sea and model entries;
+// returns the number of rays traced.
+uint64_t TraceSunVisibility(const FrameShading& f, int n, BlockScratch& sc) {
+    if (sc.origins.empty()) return 0;
+    sc.vis.resize(sc.origins.size());
+    f.occlusion.DirectionalVisibility(sc.origins, f.sunDir, 0.0f, sc.vis);
+    for (size_t r = 0; r < sc.origins.size(); ++r) {
+        const uint32_t owner = sc.originOwner[r];
+        if (owner & kSeaOwner)
+            sc.seaUnlit[owner & ~kSeaOwner] += sc.vis[r] ? 0 : 1;
+        else
+            sc.modelLit[owner] = sc.vis[r];
+    }
+    for (size_t e = 0; e < sc.seaCount; ++e) {
+        if (sc.seaUnlit[e] == 0) continue;
+        const int samples = (sc.seaK[e] & kPixelEntry) ? n * n : 1;
+        sc.seaLit[e] = float(samples - sc.seaUnlit[e]) / float(samples);
+    }
+    return sc.origins.size();
+}
+
+// Writes radiance rgb to the sample(s) of entry k; out is the block's first sample row.
+void Splat(float* out, uint32_t k, int sampleWidth, int n, float r, float g, float b) {
+    if (!(k & kPixelEntry)) {
+        float* o = out + 3 * size_t(k);
+        o[0] = r, o[1] = g, o[2] = b;
+        return;
+    }
+    k &= ~kPixelEntry;
+    for (int j = 0; j < n; ++j) {
+        float* o = out + 3 * (size_t(k) + size_t(j) * size_t(sampleWidth));
+        for (int i = 0; i < n; ++i) o[3 * i] = r, o[3 * i + 1] = g, o[3 * i + 2] = b;
+    }
+}
+
+// Sky radiance of the block's sky entries, with the sun's disc.
+void ShadeSky(const FrameShading& f, const FrameGeometry& g, BlockScratch& sc, float* out) {
+    for (size_t c = 0; c < sc.skyCount; c += kChunk) {
+        const size_t count = std::min(kChunk, sc.skyCount - c);
+        float *dx = &sc.skyX[c], *dy = &sc.skyY[c], *dz = &sc.skyZ[c];
+        Normalize(count, dx, dy, dz);
+        SeaChunk& ch = sc.chunk;
+        f.sky.LookUp(count, dx, dy, dz, ch.skyR, ch.skyG, ch.skyB);
+        for (size_t i = 0; i < count; ++i) {
+            glm::vec3 L(ch.skyR[i], ch.skyG[i], ch.skyB[i]);
+            // Pixel entries are never near the sun (BlockClassifier): the test is per sample.
+            if (glm::dot(glm::vec3(dx[i], dy[i], dz[i]), f.sunDir) >= f.cosSunRadius) L += f.sunL;
+            Splat(out, sc.skyK[c + i], g.sampleWidth, g.n, L.r, L.g, L.b);
+        }
+    }
+}
+
+// Sea radiance of the block's sea entries (SeaShading).
+void ShadeSea(const FrameShading& f, const FrameGeometry& g, BlockScratch& sc, float* out) {
+    for (size_t c = 0; c < sc.seaCount; c += kChunk) {
+        const size_t count = std::min(kChunk, sc.seaCount - c);
+        SeaChunk& ch = sc.chunk;
+        std::copy_n(&sc.seaLit[c], count, ch.sunVis);
+        f.sea.Shade(count, &sc.seaPx[c], &sc.seaPy[c], &sc.seaPz[c], &sc.seaNx[c], &sc.seaNy[c],
+                    &sc.seaNz[c], ch);
+        for (size_t i = 0; i < count; ++i)
+            Splat(out, sc.seaK[c + i], g.sampleWidth, g.n, ch.outR[i], ch.outG[i], ch.outB[i]);
+    }
+}
+
+// Model radiance, sample by sample (a small fraction of the frame): Lambertian under sun
+// (shadowed), sky and light reflected by the sea; Koschmieder fog.
+void ShadeModels(const FrameShading& f, const FrameGeometry& g, const BlockScratch& sc,
+                 float* out) {
+    for (size_t i = 0; i < sc.modelK.size(); ++i) {
+        const glm::vec3 p = sc.modelPosition[i], nrm = sc.modelNormal[i];
+        const glm::vec3 toEye = f.eye - p;
+        const float range = glm::length(toEye);
+        const glm::vec3 v = toEye / range;
+        const float sunVis = float(sc.modelLit[i]);
+        const glm::vec3 rho(f.reflectance[size_t(sc.modelMesh[i]) - 1]);
+        const glm::vec3 E = f.sunE * std::max(glm::dot(nrm, f.sunDir), 0.0f) * sunVis +
+                            f.skyE * (0.5f * (1.0f + nrm.z)) +
+                            kSeaAlbedo * f.downwelling * (0.5f * (1.0f - nrm.z));
+        glm::vec3 L = rho * E * float(1.0 / M_PI);
+        // Koschmieder: the horizon sky is the airlight a long path converges to.
+        const float t = std::exp(-f.beta * range);
+        const glm::vec3 horizon = f.sky.HorizonLookUp(-v);
+        L = L * t + horizon * (1.0f - t);
+        Splat(out, sc.modelK[i], g.sampleWidth, g.n, L.r, L.g, L.b);
+    }
 }
 
 }  // namespace
@@ -308,8 +755,9 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     const Clock::time_point t2 = Clock::now();
     const ChannelCamera& cam = geometry_.Camera();
     const int sw = cam.SampleWidth(), sh = cam.SampleHeight();
+    const int n = cam.supersampling;
+    CHECK(n >= 1 && n <= kMaxSupersampling);
     const scene::OceanMesh& ocean = geometry_.Ocean();
-    const std::vector<scene::TriangleMesh>& entityMeshes = geometry_.EntityMeshes();
     const VisibilityBuffer& vis = geometry_.Visibility();
     const OcclusionScene& occlusion = geometry_.Occlusion();
     const ViewFrameStats& view = geometry_.Stats();
@@ -321,235 +769,90 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     stats_.oceanTriangles = view.oceanTriangles;
     stats_.modelTriangles = view.modelTriangles;
 
-    if (!sky_ || skySun_ != state.sun.direction || skySunLux_ != state.sun.illuminance_lux) {
-        sky_ = std::make_unique<radiometry::AnalyticSky>(
-            state.sun.direction, state.sun.illuminance_lux, env.sky.turbidity);
-        skySun_ = state.sun.direction;
-        skySunLux_ = state.sun.illuminance_lux;
+    // The sky table (~2.6 ms to build) follows the sun rounded to kSkySunStep_rad, so an
+    // ephemeris sun that moves every frame rebuilds it only every few frames; the sun itself
+    // (disc, glint, direct light) stays exact.
+    const glm::dvec3 skySun =
+        radiometry::QuantizeSunDirection(state.sun.direction, kSkySunStep_rad);
+    if (!sky_ || skySun_ != skySun) {
+        sky_ = std::make_unique<radiometry::AnalyticSky>(skySun, state.sun.illuminance_lux,
+                                                         env.sky.turbidity);
+        skySun_ = skySun;
     }
     const radiometry::AnalyticSky& sky = *sky_;
     const glm::vec3 sunDir(state.sun.direction);
-    const glm::vec3 sunE(sky.SunIlluminance());
-    const glm::vec3 sunL(sky.SunRadiance());
+    const glm::dvec3 sunIlluminance =
+        radiometry::SunIlluminanceRgb(state.sun.direction, state.sun.illuminance_lux);
+    const glm::vec3 sunE(sunIlluminance);
     const glm::vec3 skyE(sky.HorizontalSkyIlluminance());
     // Downwelling irradiance on the sea surface (lx): direct sun on a level surface plus sky.
     const glm::vec3 downwelling = sunE * std::max(sunDir.z, 0.0f) + skyE;
-    const float cosSunRadius = float(std::cos(radiometry::kSunAngularRadius_rad));
     const float beta = float(ExtinctionFromVisibility(env.visibility_m));
-    const float slopeVar = CoxMunkSlopeVariance(env.windSpeed_mps);
     static const radiometry::FresnelTable fresnel(radiometry::kSeaWaterIndexVisible);
     const glm::vec3 eye(cam.worldFromCamera.position_m);
-    const bool shadows = settings_.shadows && !occlusion.Empty() && sunDir.z > 0.0f;
+
+    FrameGeometry g{vis,
+                    {},
+                    vis.primitiveBase.size() > 1 ? vis.primitiveBase[1] : kNoPrimitive,
+                    cam.width,
+                    sw,
+                    sh,
+                    n,
+                    cam.worldFromCamera.worldFromBody,
+                    cam.worldFromCamera.worldFromBody * glm::dvec3(0.0, 1.0, 0.0),
+                    cam.TanHalfH(),
+                    cam.TanHalfV(),
+                    glm::vec3(0.0f)};
+    g.colStep = glm::vec3(g.R * glm::dvec3(2.0 * g.tanH / sw, 0.0, 0.0));
+    g.meshes.push_back({ocean.positions.data(), ocean.normals.data(), ocean.indices.data()});
+    for (const scene::TriangleMesh& m : geometry_.EntityMeshes())
+        g.meshes.push_back({m.positions.data(), m.normals.data(), m.indices.data()});
+
+    // Pixel size on the image plane at unit distance bounds the angle between a pixel's
+    // centre ray and its samples' (the plane is at least that far from the eye).
+    const double pixelTan = n * (2.0 * g.tanH / sw + 2.0 * g.tanV / sh);
+    const FrameShading f{eye,
+                         sunDir,
+                         sunE,
+                         glm::vec3(sunIlluminance / radiometry::SunDiscSolidAngle_sr()),
+                         skyE,
+                         downwelling,
+                         Load3(eye),
+                         float(std::cos(radiometry::kSunAngularRadius_rad)),
+                         float(std::cos(radiometry::kSunAngularRadius_rad + pixelTan)),
+                         beta,
+                         settings_.shadows && !occlusion.Empty() && sunDir.z > 0.0f,
+                         sky,
+                         occlusion,
+                         RayBoxTest(geometry_.CasterMin(), geometry_.CasterMax(), sunDir),
+                         SeaShading{eye, sunDir, sunE, downwelling, beta,
+                                    CoxMunkSlopeVariance(env.windSpeed_mps), fresnel, sky},
+                         reflectance_};
 
     if (radiance.width != sw || radiance.height != sh || radiance.channels != 3)
         radiance = Image(sw, sh, 3);
-    constexpr int kRowsPerBlock = 8;
-    const int blocks = (sh + kRowsPerBlock - 1) / kRowsPerBlock;
+    // Blocks of about eight sample rows (whole pixel rows); every pixel is shaded on its own,
+    // so the result does not depend on the partition or the thread count.
+    const int pixelRowsPerBlock = std::max(1, 8 / n);
+    const int blocks = (cam.height + pixelRowsPerBlock - 1) / pixelRowsPerBlock;
     std::vector<uint64_t> blockRays(size_t(blocks), 0);
-    // View rays: direction = normalize(rowBase + x · colStep) (camera axes scaled by the
-    // pinhole geometry), so sky samples need no trigonometry.
-    const glm::dmat3& R = cam.worldFromCamera.worldFromBody;
-    const double tanH = cam.TanHalfH(), tanV = cam.TanHalfV();
-    const glm::vec3 colStep(R * glm::dvec3(2.0 * tanH / sw, 0.0, 0.0));
-    const glm::dvec3 forward = R * glm::dvec3(0.0, 1.0, 0.0);
-
     // Per-thread scratch (see BlockScratch), created on the first frame.
     if (!scratch_) scratch_ = std::make_unique<ShadeScratch>();
     tbb::enumerable_thread_specific<BlockScratch>& scratch = scratch_->perThread;
 
-    // Mesh m's primitives are [primitiveBase[m], primitiveBase[m + 1]); mesh 0 is the sea.
-    struct MeshRef {
-        const glm::vec3* P;
-        const glm::vec3* N;
-        const uint32_t* I;
-    };
-    std::vector<MeshRef> meshRefs;
-    meshRefs.push_back({ocean.positions.data(), ocean.normals.data(), ocean.indices.data()});
-    for (const scene::TriangleMesh& m : entityMeshes)
-        meshRefs.push_back({m.positions.data(), m.normals.data(), m.indices.data()});
-    const uint32_t firstModelPrimitive =
-        vis.primitiveBase.size() > 1 ? vis.primitiveBase[1] : kNoPrimitive;
-
-    const SeaShading seaShading{eye, sunDir, sunE, downwelling, beta, slopeVar, fresnel, sky};
-
-    const RayBoxTest casters(geometry_.CasterMin(), geometry_.CasterMax(), sunDir);
-
     tbb::parallel_for(0, blocks, [&](int block) {
-        const int y0 = block * kRowsPerBlock, y1 = std::min(sh, y0 + kRowsPerBlock);
-        const size_t n = size_t(y1 - y0) * size_t(sw);
-        BlockScratch& sc = scratch.local();
-        sc.Reserve(n);
-        sc.modelK.clear(), sc.modelPosition.clear(), sc.modelNormal.clear(), sc.modelMesh.clear();
-        sc.lit.assign(n, 1);
-        sc.origins.clear();
-        sc.originOwner.clear();
-
-        glm::vec3 rowBase[kRowsPerBlock];
-        for (int y = y0; y < y1; ++y) {
-            const double ndcY = 1.0 - 2.0 * (y + 0.5) / sh;
-            rowBase[y - y0] = glm::vec3(forward + R * glm::dvec3(-tanH, 0.0, ndcY * tanV));
-        }
-
-        // Pass 1: sort samples by kind; surface position and normal.
-        size_t skyCount = 0, seaCount = 0;
-        CachedTriangle tri;
-        for (int y = y0; y < y1; ++y) {
-            const size_t rowIdx = vis.Index(0, y);
-            const uint32_t* primRow = vis.primitive.data() + rowIdx;
-            const float* b1Row = vis.b1.data() + rowIdx;
-            const float* b2Row = vis.b2.data() + rowIdx;
-            const uint32_t kRow = uint32_t(size_t(y - y0) * size_t(sw));
-            for (int x = 0; x < sw; ++x) {
-                const uint32_t k = kRow + uint32_t(x);
-                const uint32_t prim = primRow[x];
-                if (prim == kNoPrimitive) {
-                    // View direction, normalized in the sky pass.
-                    const glm::vec3 d = rowBase[y - y0] + (float(x) + 0.5f) * colStep;
-                    sc.skyK[skyCount] = k;
-                    sc.skyX[skyCount] = d.x, sc.skyY[skyCount] = d.y, sc.skyZ[skyCount] = d.z;
-                    ++skyCount;
-                    continue;
-                }
-                if (prim != tri.prim) {
-                    int mesh = 0;
-                    if (prim >= firstModelPrimitive) {
-                        mesh = 1;
-                        while (mesh + 1 < int(vis.primitiveBase.size()) &&
-                               prim >= vis.primitiveBase[size_t(mesh) + 1])
-                            ++mesh;
-                    }
-                    const MeshRef& m = meshRefs[size_t(mesh)];
-                    const uint32_t t = prim - vis.primitiveBase[size_t(mesh)];
-                    const uint32_t i0 = m.I[3 * t], i1 = m.I[3 * t + 1], i2 = m.I[3 * t + 2];
-                    tri.prim = prim, tri.mesh = mesh;
-                    tri.p0 = Load3(m.P[i0]), tri.p1 = Load3(m.P[i1]), tri.p2 = Load3(m.P[i2]);
-                    tri.n0 = Load3(m.N[i0]), tri.n1 = Load3(m.N[i1]), tri.n2 = Load3(m.N[i2]);
-                }
-                const float b1 = b1Row[x], b2 = b2Row[x], b0 = 1.0f - b1 - b2;
-                const F4 w0 = Set4(b0), w1 = Set4(b1), w2 = Set4(b2);
-                alignas(16) float p[4], nSum[4];
-                _mm_store_ps(p, Interpolate3(w0, w1, w2, tri.p0, tri.p1, tri.p2));
-                _mm_store_ps(nSum, Interpolate3(w0, w1, w2, tri.n0, tri.n1, tri.n2));
-                if (tri.mesh == 0) {
-                    // Normalized, and shadow origins found, four lanes at a time below.
-                    sc.seaK[seaCount] = k;
-                    sc.seaPx[seaCount] = p[0], sc.seaPy[seaCount] = p[1], sc.seaPz[seaCount] = p[2];
-                    sc.seaNx[seaCount] = nSum[0], sc.seaNy[seaCount] = nSum[1];
-                    sc.seaNz[seaCount] = nSum[2];
-                    ++seaCount;
-                    continue;
-                }
-                const glm::vec3 position(p[0], p[1], p[2]);
-                glm::vec3 nrm = glm::normalize(glm::vec3(nSum[0], nSum[1], nSum[2]));
-                if (glm::dot(nrm, eye - position) < 0.0f) nrm = -nrm;
-                sc.modelK.push_back(k);
-                sc.modelPosition.push_back(position);
-                sc.modelNormal.push_back(nrm);
-                sc.modelMesh.push_back(tri.mesh);
-                if (shadows) {
-                    const glm::vec3 o = ShadowRayOrigin(position, nrm);
-                    if (casters.MayHit(o) && occlusion.MayOcclude(o, sunDir, 1e30f)) {
-                        sc.origins.push_back(o);
-                        sc.originOwner.push_back(k);
-                    }
-                }
-            }
-        }
-        sc.seaLit.assign(seaCount, 1.0f);
-        Normalize(seaCount, sc.seaNx.data(), sc.seaNy.data(), sc.seaNz.data());
-        if (shadows) {
-            // Sea shadow-ray origins: ShadowRayOrigin and the caster prefilter, four lanes
-            // wide; the few candidates go through MayOcclude.
-            for (size_t i = 0; i < seaCount; i += 4) {
-                const size_t lanes = std::min<size_t>(4, seaCount - i);
-                const F4 px = LoadLanes(&sc.seaPx[i], lanes, eye.x);
-                const F4 py = LoadLanes(&sc.seaPy[i], lanes, eye.y);
-                const F4 pz = LoadLanes(&sc.seaPz[i], lanes, eye.z);
-                // ShadowOffset_m, four lanes.
-                const F4 maxAbs = _mm_max_ps(_mm_max_ps(Abs4(px), Abs4(py)), Abs4(pz));
-                const F4 offset = _mm_add_ps(_mm_mul_ps(Set4(4e-6f), maxAbs), Set4(1e-3f));
-                alignas(16) float o[3][4];
-                _mm_store_ps(
-                    o[0], _mm_add_ps(px, _mm_mul_ps(LoadLanes(&sc.seaNx[i], lanes, 0.0f), offset)));
-                _mm_store_ps(
-                    o[1], _mm_add_ps(py, _mm_mul_ps(LoadLanes(&sc.seaNy[i], lanes, 0.0f), offset)));
-                _mm_store_ps(
-                    o[2], _mm_add_ps(pz, _mm_mul_ps(LoadLanes(&sc.seaNz[i], lanes, 1.0f), offset)));
-                int hit = MayHit4(casters, _mm_load_ps(o[0]), _mm_load_ps(o[1]), _mm_load_ps(o[2]));
-                hit &= (1 << lanes) - 1;
-                for (; hit != 0; hit &= hit - 1) {
-                    const int l = __builtin_ctz(unsigned(hit));
-                    const glm::vec3 origin(o[0][l], o[1][l], o[2][l]);
-                    if (occlusion.MayOcclude(origin, sunDir, 1e30f)) {
-                        sc.origins.push_back(origin);
-                        sc.originOwner.push_back(kSeaOwner | uint32_t(i + size_t(l)));
-                    }
-                }
-            }
-        }
-        if (!sc.origins.empty()) {
-            sc.vis.resize(sc.origins.size());
-            occlusion.DirectionalVisibility(sc.origins, sunDir, 0.0f, sc.vis);
-            for (size_t r = 0; r < sc.origins.size(); ++r) {
-                const uint32_t owner = sc.originOwner[r];
-                if (owner & kSeaOwner)
-                    sc.seaLit[owner & ~kSeaOwner] = float(sc.vis[r]);
-                else
-                    sc.lit[owner] = sc.vis[r];
-            }
-            blockRays[size_t(block)] = sc.origins.size();
-        }
-
+        const int py0 = block * pixelRowsPerBlock;
+        const int py1 = std::min(cam.height, py0 + pixelRowsPerBlock);
+        BlockScratch& s = scratch.local();
+        s.Reset(size_t(py1 - py0) * size_t(n) * size_t(sw));
+        BlockClassifier classify(g, f, py0, s);
+        for (int py = py0; py < py1; ++py) classify.Pixels(py);
+        blockRays[size_t(block)] = TraceSunVisibility(f, n, s);
         // The block's rows are contiguous in the image: sample k is at out + 3k.
-        float* out = radiance.At(0, y0);
-
-        // Pass 2a: sky samples.
-        for (size_t c = 0; c < skyCount; c += kChunk) {
-            const size_t count = std::min(kChunk, skyCount - c);
-            float *dx = &sc.skyX[c], *dy = &sc.skyY[c], *dz = &sc.skyZ[c];
-            Normalize(count, dx, dy, dz);
-            SeaChunk& ch = sc.chunk;
-            sky.LookUp(count, dx, dy, dz, ch.skyR, ch.skyG, ch.skyB);
-            for (size_t i = 0; i < count; ++i) {
-                glm::vec3 L(ch.skyR[i], ch.skyG[i], ch.skyB[i]);
-                if (glm::dot(glm::vec3(dx[i], dy[i], dz[i]), sunDir) >= cosSunRadius) L += sunL;
-                float* o = out + 3 * size_t(sc.skyK[c + i]);
-                o[0] = L.r, o[1] = L.g, o[2] = L.b;
-            }
-        }
-
-        // Pass 2b: sea samples.
-        for (size_t c = 0; c < seaCount; c += kChunk) {
-            const size_t count = std::min(kChunk, seaCount - c);
-            SeaChunk& ch = sc.chunk;
-            std::copy_n(&sc.seaLit[c], count, ch.sunVis);
-            seaShading.Shade(count, &sc.seaPx[c], &sc.seaPy[c], &sc.seaPz[c], &sc.seaNx[c],
-                             &sc.seaNy[c], &sc.seaNz[c], ch);
-            for (size_t i = 0; i < count; ++i) {
-                float* o = out + 3 * size_t(sc.seaK[c + i]);
-                o[0] = ch.outR[i], o[1] = ch.outG[i], o[2] = ch.outB[i];
-            }
-        }
-
-        // Pass 2c: model samples (a small fraction of the frame).
-        for (size_t i = 0; i < sc.modelK.size(); ++i) {
-            const glm::vec3 p = sc.modelPosition[i], nrm = sc.modelNormal[i];
-            const glm::vec3 toEye = eye - p;
-            const float range = glm::length(toEye);
-            const glm::vec3 v = toEye / range;
-            const float sunVis = float(sc.lit[sc.modelK[i]]);
-            const glm::vec3 rho(reflectance_[size_t(sc.modelMesh[i]) - 1]);
-            const glm::vec3 E = sunE * std::max(glm::dot(nrm, sunDir), 0.0f) * sunVis +
-                                skyE * (0.5f * (1.0f + nrm.z)) +
-                                kSeaAlbedo * downwelling * (0.5f * (1.0f - nrm.z));
-            glm::vec3 L = rho * E * float(1.0 / M_PI);
-            // Koschmieder: the horizon sky is the airlight a long path converges to.
-            const float t = std::exp(-beta * range);
-            const glm::vec3 horizon = sky.HorizonLookUp(-v);
-            L = L * t + horizon * (1.0f - t);
-            float* o = out + 3 * size_t(sc.modelK[i]);
-            o[0] = L.r, o[1] = L.g, o[2] = L.b;
-        }
+        float* out = radiance.At(0, py0 * n);
+        ShadeSky(f, g, s, out);
+        ShadeSea(f, g, s, out);
+        ShadeModels(f, g, s, out);
     });
     for (uint64_t r : blockRays) stats_.shadowRays += r;
     stats_.shadeMs = Ms(t2, Clock::now());

@@ -47,10 +47,10 @@ class OtwChannel {
     scene::ChannelSettings settings_;
     ViewGeometry geometry_;
     std::vector<glm::dvec3> reflectance_;  // per entity
-    // The sky depends only on the sun and turbidity: rebuilt when they change.
+    // The sky table depends only on the sun's direction and turbidity: rebuilt when the
+    // quantized sun direction changes.
     std::unique_ptr<radiometry::AnalyticSky> sky_;
     glm::dvec3 skySun_{0.0};
-    double skySunLux_ = -1.0;
     std::unique_ptr<ShadeScratch> scratch_;
     OtwFrameStats stats_;
 };

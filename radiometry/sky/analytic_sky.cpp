@@ -84,6 +84,22 @@ glm::dvec3 HorizontalIntegral(const RadianceFn& radiance) {
 
 }  // namespace
 
+glm::dvec3 SunIlluminanceRgb(const glm::dvec3& sunDirection, double sunIlluminance_lux) {
+    const glm::dvec3 d = glm::normalize(sunDirection);
+    return glm::dvec3(d.z > -kSunAngularRadius_rad ? sunIlluminance_lux : 0.0);
+}
+
+double SunDiscSolidAngle_sr() { return 2.0 * M_PI * (1.0 - std::cos(kSunAngularRadius_rad)); }
+
+glm::dvec3 QuantizeSunDirection(const glm::dvec3& sunDirection, double step_rad) {
+    const glm::dvec3 d = glm::normalize(sunDirection);
+    const double elevation = std::asin(std::clamp(d.z, -1.0, 1.0));
+    const double azimuth = std::atan2(d.x, d.y);  // clockwise from north (ENU: x east)
+    const double e = step_rad * std::round(elevation / step_rad);
+    const double a = step_rad * std::round(azimuth / step_rad);
+    return {std::cos(e) * std::sin(a), std::cos(e) * std::cos(a), std::sin(e)};
+}
+
 AnalyticSky::AnalyticSky(const glm::dvec3& sunDirection, double sunIlluminance_lux, double T)
     : AnalyticSky(SkyConditions{
           .sunDirection = sunDirection, .sunIlluminance_lux = sunIlluminance_lux, .turbidity = T}) {
@@ -129,10 +145,8 @@ AnalyticSky::AnalyticSky(const SkyConditions& c)
 
     // The sun: white (D65, equal Rec.709 RGB) at the given illuminance; disc solid angle
     // 2π(1 − cos r).
-    const double sunSolidAngle = 2.0 * M_PI * (1.0 - std::cos(kSunAngularRadius_rad));
-    const double sunUp = sunDir_.z > -kSunAngularRadius_rad ? 1.0 : 0.0;
-    sunIlluminanceRgb_ = glm::dvec3(sunIlluminance_lux * sunUp);
-    sunRadiance_ = sunIlluminanceRgb_ / sunSolidAngle;
+    sunIlluminanceRgb_ = SunIlluminanceRgb(sunDir_, sunIlluminance_lux);
+    sunRadiance_ = sunIlluminanceRgb_ / SunDiscSolidAngle_sr();
 
     // Daylight scale: Preetham's dome integrated over the hemisphere against the measured
     // clear-sky diffuse illuminance at the sun's altitude.

@@ -31,6 +31,17 @@ struct SkyConditions {
     double moonDistance_m = 3.844e8;
 };
 
+// Illuminance (lx, Rec.709 RGB; D65 white, so equal components) of the sun on a plane normal
+// to it: sunIlluminance_lux while the top of the disc is above the horizon, else 0.
+glm::dvec3 SunIlluminanceRgb(const glm::dvec3& sunDirection, double sunIlluminance_lux);
+// Solid angle of the sun's disc, sr: 2π(1 − cos r).
+double SunDiscSolidAngle_sr();
+
+// sunDirection (unit ENU) with its elevation and azimuth rounded to multiples of step_rad: a
+// pure function of the direction, so that a sky table built for the result can be reused
+// while the sun moves less than a step. The result is at most step_rad / √2 from the input.
+glm::dvec3 QuantizeSunDirection(const glm::dvec3& sunDirection, double step_rad);
+
 class AnalyticSky {
   public:
     // The daylight part has Preetham's distribution (shape and chromaticity) for the sun at

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <vector>
 
 #include "radiometry/color/rec709.h"
@@ -42,6 +43,42 @@ TEST(AnalyticSky, BrightestNearTheSunAndDimmerAwayFromIt) {
     EXPECT_GT(Y(0, 33), Y(0, 60));
     EXPECT_GT(Y(0, 33), Y(180, 33));
     EXPECT_GT(Y(0, 33), Y(90, 33));
+}
+
+TEST(AnalyticSky, QuantizedSunIsWithinHalfAStepAndChangesTheSkyByLessThanItsBound) {
+    // The OTW channel builds its sky table for the sun rounded to 0.01° in elevation and
+    // azimuth. Moving the sun by δ changes the Perez distribution through γ (circumsolar
+    // slope |d ln F/dγ| ≤ |D|·C/(1 + C) ≈ 2.3 rad⁻¹ for T = 3.5) and the zenith luminance
+    // through tan χ (|d ln Y_z/dθ_s| ≤ ~3.5 rad⁻¹ near sunset, Preetham et al. 1999, A.2): a
+    // relative change of about 6 rad⁻¹ · δ, δ ≤ 0.0071° = 1.2e-4 rad, i.e. < 0.1 %, a tenth of
+    // an 8-bit display step. Checked here over the sky for sun elevations from the horizon to
+    // 85° and azimuths that are not on the grid.
+    const double step = 0.01 * M_PI / 180.0;
+    double worst = 0.0;
+    for (int e = 0; e <= 85; e += 5) {
+        const double el = (e + 0.0043) * M_PI / 180.0, az = (291.0 + 0.0047 * e) * M_PI / 180.0;
+        const glm::dvec3 sun{std::cos(el) * std::sin(az), std::cos(el) * std::cos(az),
+                             std::sin(el)};
+        const glm::dvec3 q = QuantizeSunDirection(sun, step);
+        EXPECT_NEAR(glm::length(q), 1.0, 1e-12);
+        EXPECT_LE(std::acos(std::min(1.0, glm::dot(q, sun))), step / std::sqrt(2.0) + 1e-12);
+        const AnalyticSky exact(sun, 1e5, 3.5), quantized(q, 1e5, 3.5);
+        for (int j = 0; j <= 90; ++j) {
+            for (int i = 0; i < 360; i += 2) {
+                const double a = i * M_PI / 180.0, b = j * M_PI / 180.0;
+                const glm::dvec3 d{std::cos(b) * std::sin(a), std::cos(b) * std::cos(a),
+                                   std::sin(b)};
+                const double y0 = LuminanceRec709(exact.Radiance(d));
+                const double y1 = LuminanceRec709(quantized.Radiance(d));
+                worst = std::max(worst, std::abs(y1 - y0) / y0);
+            }
+        }
+        const double E0 = LuminanceRec709(exact.HorizontalSkyIlluminance());
+        const double E1 = LuminanceRec709(quantized.HorizontalSkyIlluminance());
+        worst = std::max(worst, std::abs(E1 - E0) / E0);
+    }
+    std::printf("largest relative sky luminance change: %.3g\n", worst);
+    EXPECT_LT(worst, 1e-3);
 }
 
 TEST(AnalyticSky, TableLookupMatchesDirectEvaluationAwayFromTheSun) {
