@@ -207,7 +207,7 @@ void OceanSurface::Fill(OceanSurfaceFrame& frame, double t, bool withVelocity) c
     frame.significantHeight_m_ = summary_.significantHeight_m;
     frame.hasFft_ = fft_ != nullptr;
     frame.maxHeight_m_ = frame.maxHorizontal_m_ = 0.0;
-    frame.textures_.clear();
+    if (!fft_) frame.textures_.clear();  // else rebuilt in place, reusing the buffers
     if (fft_) {
         fft_->Synthesize(t, frame.fft_, withVelocity);
         frame.BuildTextures();
