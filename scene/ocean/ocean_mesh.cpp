@@ -133,11 +133,12 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
         const double radius = radii[size_t(j)];
         const double drop = CurvatureDrop_m(radius);
         const float fp = footprint[size_t(j)];
+        const FftFilter filter = frame.Filter(fp);
         for (int i = 0; i < columns; ++i) {
             const double rx = radius * sinAz[size_t(i)], ry = radius * cosAz[size_t(i)];
             const size_t v = size_t(j) * size_t(columns) + size_t(i);
             GeometrySums s{};
-            frame.AccumulateFft(req.eye_m.x + rx, req.eye_m.y + ry, fp, s);
+            frame.AccumulateFft(req.eye_m.x + rx, req.eye_m.y + ry, filter, s);
             if (gerstner) local.Accumulate(float(rx), float(ry), fp, s.data());
             out.positions[v] = glm::vec3(float(req.eye_m.x + rx + double(s[kTermDispX])),
                                          float(req.eye_m.y + ry + double(s[kTermDispY])),

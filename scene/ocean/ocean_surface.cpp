@@ -56,19 +56,6 @@ void AddBilinear(const Texture& c, int level, double x0, double y0, float weight
 
 }  // namespace
 
-glm::vec3 GeometryNormal(const GeometrySums& s) {
-    const float a = 1.0f + s[kTermDispXX], d = 1.0f + s[kTermDispYY], b = s[kTermDispXY];
-    glm::vec3 n = glm::cross(glm::vec3(a, b, s[kTermSlopeX]), glm::vec3(b, d, s[kTermSlopeY]));
-    const float len = glm::length(n);
-    n = len > 0.0f ? n / len : glm::vec3(0.0f, 0.0f, 1.0f);
-    return n.z < 0.0f ? -n : n;  // folded surface: keep the normal upward
-}
-
-float GeometryJacobian(const GeometrySums& s) {
-    const float a = 1.0f + s[kTermDispXX], d = 1.0f + s[kTermDispYY], b = s[kTermDispXY];
-    return a * d - b * b;
-}
-
 // ---- frame ------------------------------------------------------------------------------------
 
 void OceanSurfaceFrame::BuildTextures() {
@@ -151,17 +138,27 @@ OceanSample OceanSurfaceFrame::SampleAt(double x, double y, glm::dvec2* rest) co
     return s;
 }
 
-void OceanSurfaceFrame::AccumulateFft(double x0, double y0, float footprint_m,
-                                      GeometrySums& sums) const {
-    for (const CascadeTexture& c : textures_) {
-        const int top = int(c.levels.size()) - 1;
+FftFilter OceanSurfaceFrame::Filter(float footprint_m) const {
+    FftFilter f;
+    CHECK(textures_.size() <= size_t(FftFilter::kMaxCascades));
+    for (size_t c = 0; c < textures_.size(); ++c) {
+        const CascadeTexture& t = textures_[c];
+        const int top = int(t.levels.size()) - 1;
         float lod =
-            footprint_m > float(c.texel_m) ? std::log2(footprint_m / float(c.texel_m)) : 0.0f;
+            footprint_m > float(t.texel_m) ? std::log2(footprint_m / float(t.texel_m)) : 0.0f;
         lod = std::min(lod, float(top));
-        const int l0 = int(lod);
-        const float f = lod - float(l0);
-        AddBilinear(c, l0, x0, y0, 1.0f - f, sums);
-        if (f > 0.0f) AddBilinear(c, l0 + 1, x0, y0, f, sums);
+        f.level[c] = int(lod);
+        f.frac[c] = lod - float(f.level[c]);
+    }
+    return f;
+}
+
+void OceanSurfaceFrame::AccumulateFft(double x0, double y0, const FftFilter& filter,
+                                      GeometrySums& sums) const {
+    for (size_t c = 0; c < textures_.size(); ++c) {
+        const float f = filter.frac[c];
+        AddBilinear(textures_[c], filter.level[c], x0, y0, 1.0f - f, sums);
+        if (f > 0.0f) AddBilinear(textures_[c], filter.level[c] + 1, x0, y0, f, sums);
     }
 }
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <memory>
@@ -32,9 +33,30 @@ enum GeometryTerm : int {
 };
 using GeometrySums = std::array<float, kGeometryTerms>;
 
-// Upward unit normal and Jacobian determinant from geometry sums (single precision, for meshes).
-glm::vec3 GeometryNormal(const GeometrySums& s);
-float GeometryJacobian(const GeometrySums& s);
+// Upward unit normal from geometry sums (single precision, for meshes): the cross product of the
+// tangents (1 + Dxx, Dxy, ηx) and (Dxy, 1 + Dyy, ηy).
+inline glm::vec3 GeometryNormal(const GeometrySums& s) {
+    const float a = 1.0f + s[kTermDispXX], d = 1.0f + s[kTermDispYY], b = s[kTermDispXY];
+    const float sx = s[kTermSlopeX], sy = s[kTermSlopeY];
+    glm::vec3 n(b * sy - sx * d, sx * b - a * sy, a * d - b * b);
+    const float len2 = glm::dot(n, n);
+    n = len2 > 0.0f ? n * (1.0f / std::sqrt(len2)) : glm::vec3(0.0f, 0.0f, 1.0f);
+    return n.z < 0.0f ? -n : n;  // folded surface: keep the normal upward
+}
+
+// Determinant of the horizontal Jacobian [[1 + Dxx, Dxy], [Dxy, 1 + Dyy]].
+inline float GeometryJacobian(const GeometrySums& s) {
+    const float a = 1.0f + s[kTermDispXX], d = 1.0f + s[kTermDispYY], b = s[kTermDispXY];
+    return a * d - b * b;
+}
+
+// The mip levels a footprint reads in each FFT cascade (see OceanSurfaceFrame::AccumulateFft):
+// level[c] with weight 1 − frac[c] and level[c] + 1 with weight frac[c].
+struct FftFilter {
+    static constexpr int kMaxCascades = 8;
+    std::array<int, kMaxCascades> level{};
+    std::array<float, kMaxCascades> frac{};
+};
 
 // The surface at one instant: an immutable snapshot once made by OceanSurface.
 class OceanSurfaceFrame {
@@ -59,7 +81,12 @@ class OceanSurfaceFrame {
     // footprint (trilinear between levels, box-filtered 2×2 mips), so a mesh with vertices
     // `footprint` apart does not alias waves shorter than it can hold. A footprint at or below a
     // cascade's grid spacing reads its full-resolution field (the same surface as Terms).
-    void AccumulateFft(double x0, double y0, float footprint_m, GeometrySums& sums) const;
+    void AccumulateFft(double x0, double y0, float footprint_m, GeometrySums& sums) const {
+        AccumulateFft(x0, y0, Filter(footprint_m), sums);
+    }
+    // The same with the levels of a footprint resolved once (e.g. per mesh ring).
+    FftFilter Filter(float footprint_m) const;
+    void AccumulateFft(double x0, double y0, const FftFilter& filter, GeometrySums& sums) const;
 
     // Unit upward normal of the surface at rest position (x0, y0) (world m) band-limited to a
     // footprint (m), FFT cascades and Gerstner waves together: for shading finer than the mesh
