@@ -7,6 +7,7 @@
 #include <string>
 
 #include "channels/cli/capture.h"
+#include "channels/cli/query_ocean.h"
 #include "channels/cli/query_sky.h"
 #include "channels/cli/run.h"
 #include "scene/core/check.h"
@@ -137,6 +138,19 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     querySky->add_flag("--json", sky.json, "Print JSON instead of text");
 
+    seasense::channels::QueryOceanOptions sea;
+    CLI::App* queryOcean = query->add_subcommand(
+        "ocean",
+        "The sea surface of a scenario at one world point (ENU metres) and instant, as drawn:\n"
+        "height, normal, orbital velocity, Jacobian and foam coverage, water depth, and the\n"
+        "sea's significant height, dominant wave period, direction, phase and group speed.");
+    queryOcean->add_option("--config", sea.config, "Scenario YAML file")->required();
+    queryOcean->add_option("--x", sea.x_m, "East coordinate, m")->required();
+    queryOcean->add_option("--y", sea.y_m, "North coordinate, m")->required();
+    queryOcean->add_option("--time", sea.time,
+                           "Instant, ISO-8601 UTC (default: the scenario's world.start_utc)");
+    queryOcean->add_flag("--json", sea.json, "Print JSON instead of text");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -156,6 +170,8 @@ int main(int argc, char** argv) {
             return seasense::channels::RunChannelRenderer(chan);
         } else if (querySky->parsed()) {
             seasense::channels::RunQuerySky(sky);
+        } else if (queryOcean->parsed()) {
+            seasense::channels::RunQueryOcean(sea);
         }
         return 0;
     } catch (const seasense::InputError& e) {

@@ -139,14 +139,16 @@ void ViewGeometry::Update(const scene::SceneState& state) {
         return std::chrono::duration<double, std::milli>(b - a).count();
     };
     const Clock::time_point t0 = Clock::now();
-    // Sea mesh for this view: vertices kOceanVertexSpacing_px apart on screen.
+    // The sea surface at the frame time (shared with every other user of this time), then its
+    // mesh for this view: vertices kOceanVertexSpacing_px apart on screen.
+    oceanFrame_ = world_.Ocean().At(state.time_s);
+    const scene::OceanSurfaceFrame& sea = *oceanFrame_;
+    const Clock::time_point tSea = Clock::now();
     scene::OceanMeshRequest req;
     req.eye_m = cam.worldFromCamera.position_m;
-    req.time_s = state.time_s;
     req.angularStep_rad = kOceanVertexSpacing_px * cam.hfov_rad / double(cam.width);
     FrustumAzimuthSector(cam, 20.0 * M_PI / 180.0, req.azimuthMin_rad, req.azimuthMax_rad);
-    const scene::GerstnerOcean& sea = world_.Ocean();
-    req.minRange_m = NearestVisibleSeaRange_m(cam, sea.MaxAmplitude_m(), sea.MaxHorizontal_m());
+    req.minRange_m = NearestVisibleSeaRange_m(cam, sea.MaxHeight_m(), sea.MaxHorizontal_m());
     scene::BuildOceanMesh(sea, req, ocean_);
 
     std::vector<RasterMesh> meshes;
@@ -160,7 +162,8 @@ void ViewGeometry::Update(const scene::SceneState& state) {
 
     stats_ = {};
     stats_.raster = rasterizer_.Stats();
-    stats_.meshMs = Ms(t0, t1);
+    stats_.oceanMs = Ms(t0, tSea);
+    stats_.meshMs = Ms(tSea, t1);
     stats_.rasterMs = Ms(t1, t2);
     stats_.oceanTriangles = ocean_.indices.size() / 3;
     for (const scene::TriangleMesh& m : worldMeshes_) stats_.modelTriangles += m.TriangleCount();

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "channels/camera/channel_camera.h"
@@ -18,6 +19,7 @@ namespace seasense::channels {
 struct ViewFrameStats {
     uint64_t oceanTriangles = 0;
     uint64_t modelTriangles = 0;
+    double oceanMs = 0.0;   // sea surface synthesis for the frame time (0 when already made)
     double meshMs = 0.0;    // sea mesh for the view
     double rasterMs = 0.0;  // visibility buffer
     RasterStats raster;
@@ -38,6 +40,8 @@ class ViewGeometry {
     // the (i−1)-th entity.
     const VisibilityBuffer& Visibility() const { return vis_; }
     const scene::OceanMesh& Ocean() const { return ocean_; }
+    // The sea surface of the last frame (the mesh's source; DetailNormal for shading).
+    const scene::OceanSurfaceFrame& OceanFrame() const { return *oceanFrame_; }
     // Entity meshes in the world frame (ENU metres) at the last frame's poses.
     const std::vector<scene::TriangleMesh>& EntityMeshes() const { return worldMeshes_; }
     const OcclusionScene& Occlusion() const { return occlusion_; }
@@ -61,6 +65,7 @@ class ViewGeometry {
     std::vector<uint32_t> occlusionIds_;            // Embree geometry of each entity
     glm::vec3 casterMin_{0.0f}, casterMax_{0.0f};
     scene::OceanMesh ocean_;
+    std::shared_ptr<const scene::OceanSurfaceFrame> oceanFrame_;
     VisibilityBuffer vis_;
     ViewFrameStats stats_;
 };

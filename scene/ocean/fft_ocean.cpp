@@ -66,52 +66,46 @@ std::complex<double> GaussianPair(uint64_t seed, size_t cascade, int mx, int my)
     return {r * std::cos(kTwoPi * u2), r * std::sin(kTwoPi * u2)};
 }
 
-// Upward unit normal from the tangents ∂P/∂x0 and ∂P/∂y0.
-glm::dvec3 UpwardNormal(const glm::dvec3& tx, const glm::dvec3& ty) {
-    glm::dvec3 n = glm::cross(tx, ty);
-    const double len = glm::length(n);
-    n = len > 0.0 ? n / len : glm::dvec3(0.0, 0.0, 1.0);
-    return n.z < 0.0 ? -n : n;  // folded surface: keep the normal upward
-}
-
 }  // namespace
 
 // ---- settings ---------------------------------------------------------------------------------
 
-SpectralOceanSettings ReadSpectralOceanSettings(const ConfigValue& value,
+SpectralOceanSettings ReadSpectralOceanSettings(ConfigMap& map,
                                                 const SpectralOceanSettings& defaults) {
     SpectralOceanSettings s = defaults;
-    ReadMap(value, [&](ConfigMap& map) {
-        s.sea = ReadSeaStateSettings(map, defaults.sea);
-        if (std::optional<ConfigMap> fft = map.FindMap("fft")) {
-            FftOceanSettings& f = s.fft;
-            if (const std::optional<ConfigValue> grid = fft->Find("grid_size")) {
-                f.gridSize = int(grid->AsInt(16, 2048));
-                if (!IsPowerOfTwo(f.gridSize))
-                    grid->Fail("a power of two in [16, 2048] (e.g. 128, 256, 512)");
-            }
-            if (const std::optional<ConfigValue> sizes = fft->Find("patch_sizes_m")) {
-                f.patchSizes_m.clear();
-                for (const ConfigValue& item : sizes->AsList(1, 8, "numbers (m)")) {
-                    const double l = item.AsDouble(NumberRange::OpenClosed(0.0, 1.0e5, "m"));
-                    if (!f.patchSizes_m.empty() && !(l < f.patchSizes_m.back() &&
-                                                     f.patchSizes_m.back() / l < 0.5 * f.gridSize))
-                        item.Fail("a patch size below " + FormatNumber(f.patchSizes_m.back()) +
-                                  " m and above " +
-                                  FormatNumber(f.patchSizes_m.back() / (0.5 * f.gridSize)) +
-                                  " m (decreasing, ratio below grid_size / 2)");
-                    f.patchSizes_m.push_back(l);
-                }
-            }
-            f.cascadeCount = int(fft->GetInt("cascades", 1, 8, f.cascadeCount));
-            f.choppiness =
-                fft->GetDouble("choppiness", NumberRange::Closed(0.0, 10.0), f.choppiness);
-            f.seed = uint64_t(
-                fft->GetInt("seed", 0, std::numeric_limits<int64_t>::max(), int64_t(f.seed)));
-            fft->Finish();
+    s.sea = ReadSeaStateSettings(map, defaults.sea);
+    if (std::optional<ConfigMap> fft = map.FindMap("fft")) {
+        FftOceanSettings& f = s.fft;
+        if (const std::optional<ConfigValue> grid = fft->Find("grid_size")) {
+            f.gridSize = int(grid->AsInt(16, 2048));
+            if (!IsPowerOfTwo(f.gridSize))
+                grid->Fail("a power of two in [16, 2048] (e.g. 128, 256, 512)");
         }
-    });
+        if (const std::optional<ConfigValue> sizes = fft->Find("patch_sizes_m")) {
+            f.patchSizes_m.clear();
+            for (const ConfigValue& item : sizes->AsList(1, 8, "numbers (m)")) {
+                const double l = item.AsDouble(NumberRange::OpenClosed(0.0, 1.0e5, "m"));
+                if (!f.patchSizes_m.empty() &&
+                    !(l < f.patchSizes_m.back() && f.patchSizes_m.back() / l < 0.5 * f.gridSize))
+                    item.Fail("a patch size below " + FormatNumber(f.patchSizes_m.back()) +
+                              " m and above " +
+                              FormatNumber(f.patchSizes_m.back() / (0.5 * f.gridSize)) +
+                              " m (decreasing, ratio below grid_size / 2)");
+                f.patchSizes_m.push_back(l);
+            }
+        }
+        f.cascadeCount = int(fft->GetInt("cascades", 1, 8, f.cascadeCount));
+        f.choppiness = fft->GetDouble("choppiness", NumberRange::Closed(0.0, 10.0), f.choppiness);
+        f.seed =
+            uint64_t(fft->GetInt("seed", 0, std::numeric_limits<int64_t>::max(), int64_t(f.seed)));
+        fft->Finish();
+    }
     return s;
+}
+
+SpectralOceanSettings ReadSpectralOceanSettings(const ConfigValue& value,
+                                                const SpectralOceanSettings& defaults) {
+    return ReadMap(value, [&](ConfigMap& map) { return ReadSpectralOceanSettings(map, defaults); });
 }
 
 std::vector<double> DefaultPatchSizes(const WaveSpectrum& spectrum, int cascadeCount) {
@@ -231,17 +225,20 @@ FftOceanFrame FftOcean::Synthesize(double t) const {
     return frame;
 }
 
-void FftOcean::Synthesize(double t, FftOceanFrame& frame) const {
+void FftOcean::Synthesize(double t, FftOceanFrame& frame, bool withRates) const {
     CHECK(std::isfinite(t));
     const size_t cascadeCount = modes_.size();
+    const int planeCount =
+        withRates ? FftOceanFrame::kPlanes : FftOceanFrame::kPlanes - FftOceanFrame::kRatePlanes;
     frame.n_ = n_;
     frame.choppiness_ = choppiness_;
     frame.t_s_ = t;
+    frame.hasRates_ = withRates;
     frame.cascades_.resize(cascadeCount);
     for (size_t c = 0; c < cascadeCount; ++c) {
         FftOceanFrame::Cascade& fc = frame.cascades_[c];
         fc.patch_m = bands_[c].patch_m;
-        for (int p = 0; p < FftOceanFrame::kPlanes; ++p) {
+        for (int p = 0; p < planeCount; ++p) {
             fc.spectrum[p].create(n_, n_, CV_32FC2);
             fc.scratch[p].create(n_, n_, CV_32FC2);
             fc.field[p].create(n_, n_, CV_32FC2);
@@ -261,13 +258,13 @@ void FftOcean::Synthesize(double t, FftOceanFrame& frame) const {
         for (int iy = row0; iy < row1; ++iy) {
             // Rows outside the band (|my| > maxRow) are never read by the transform.
             if (std::min(iy, n_ - iy) > maxRow_[c]) continue;
-            std::array<C*, FftOceanFrame::kPlanes> out;
-            for (int p = 0; p < FftOceanFrame::kPlanes; ++p) out[p] = planes[p].ptr<C>(iy);
+            std::array<C*, FftOceanFrame::kPlanes> out{};
+            for (int p = 0; p < planeCount; ++p) out[p] = planes[p].ptr<C>(iy);
             for (int ix = 0; ix < n_; ++ix) {
                 const size_t i = size_t(iy) * size_t(n_) + size_t(ix);
                 const C a = m.h0[i], b = m.h0MinusConj[i];
                 if (a == C(0.0f) && b == C(0.0f)) {
-                    for (int p = 0; p < FftOceanFrame::kPlanes; ++p) out[p][ix] = C(0.0f);
+                    for (int p = 0; p < planeCount; ++p) out[p][ix] = C(0.0f);
                     continue;
                 }
                 // e^{−iωt} with the phase reduced in double so float keeps it at any time.
@@ -276,8 +273,6 @@ void FftOcean::Synthesize(double t, FftOceanFrame& frame) const {
                 const float cs = std::cos(float(phase)), sn = std::sin(float(phase));
                 const C e(cs, -sn), ec(cs, sn);
                 const C h = a * e + b * ec;
-                // ∂h/∂t = −iω (h0 e^{−iωt} − conj(h0(−k)) e^{iωt}).
-                const C ht = -i1 * float(m.omega[i]) * (a * e - b * ec);
                 const float kx = m.kx[i], ky = m.ky[i], q = m.chop[i];
                 // Choppy displacement D = Σ i k̂ coth(kh) h e^{ik·x}: toward the crests, the
                 // linear-theory surface orbit (Tessendorf's −i with his time sign convention).
@@ -285,11 +280,14 @@ void FftOcean::Synthesize(double t, FftOceanFrame& frame) const {
                 const C dxx = -(kx * kx * q) * h, dyy = -(ky * ky * q) * h;
                 const C dxy = -(kx * ky * q) * h;
                 const C sx = i1 * kx * h, sy = i1 * ky * h;
-                const C dxt = i1 * (kx * q) * ht, dyt = i1 * (ky * q) * ht;
                 out[0][ix] = h + i1 * dx;
                 out[1][ix] = dy + i1 * sx;
                 out[2][ix] = sy + i1 * dxx;
                 out[3][ix] = dyy + i1 * dxy;
+                if (!withRates) continue;
+                // ∂h/∂t = −iω (h0 e^{−iωt} − conj(h0(−k)) e^{iωt}).
+                const C ht = -i1 * float(m.omega[i]) * (a * e - b * ec);
+                const C dxt = i1 * (kx * q) * ht, dyt = i1 * (ky * q) * ht;
                 out[4][ix] = ht + i1 * dxt;
                 out[5][ix] = dyt;
             }
@@ -300,10 +298,10 @@ void FftOcean::Synthesize(double t, FftOceanFrame& frame) const {
     //    passes of 1-D row transforms around a transpose: the rows outside the cascade's band
     //    are zero and skipped in the first pass, and row transforms avoid OpenCV's slower
     //    column pass. The field is left transposed (row index x, column index y).
-    tbb::parallel_for(0, int(cascadeCount) * FftOceanFrame::kPlanes, [&](int task) {
-        const size_t c = size_t(task / FftOceanFrame::kPlanes);
+    tbb::parallel_for(0, int(cascadeCount) * planeCount, [&](int task) {
+        const size_t c = size_t(task / planeCount);
         FftOceanFrame::Cascade& fc = frame.cascades_[c];
-        const int p = task % FftOceanFrame::kPlanes;
+        const int p = task % planeCount;
         const int m = maxRow_[c];
         constexpr int kFlags = cv::DFT_INVERSE | cv::DFT_COMPLEX_OUTPUT | cv::DFT_ROWS;
         cv::Mat& rows = fc.scratch[p];
@@ -322,12 +320,20 @@ void FftOcean::Synthesize(double t, FftOceanFrame& frame) const {
 float FftOceanFrame::Field(size_t cascade, OceanField field, int ix, int iy) const {
     CHECK(cascade < cascades_.size() && ix >= 0 && ix < n_ && iy >= 0 && iy < n_);
     const int f = int(field);
+    CHECK_MSG(hasRates_ || f / 2 < kPlanes - kRatePlanes, "rate field of a geometry-only frame");
     const cv::Vec2f v = cascades_[cascade].field[f / 2].at<cv::Vec2f>(ix, iy);  // transposed
     return v[f % 2];
 }
 
-OceanSample FftOceanFrame::Evaluate(double x0, double y0) const {
+const cv::Mat& FftOceanFrame::FieldPlane(size_t cascade, int plane) const {
+    CHECK(cascade < cascades_.size() && plane >= 0 && plane < kPlanes);
+    CHECK_MSG(hasRates_ || plane < kPlanes - kRatePlanes, "rate plane of a geometry-only frame");
+    return cascades_[cascade].field[size_t(plane)];
+}
+
+SurfaceTerms FftOceanFrame::Terms(double x0, double y0) const {
     CHECK_MSG(!cascades_.empty(), "FftOceanFrame used before FftOcean::Synthesize filled it");
+    const int planes = hasRates_ ? kPlanes : kPlanes - kRatePlanes;
     std::array<double, 2 * kPlanes> sum{};
     for (const Cascade& c : cascades_) {
         // Grid node j lies at j L / N; bilinear weights within the periodic cell.
@@ -339,7 +345,7 @@ OceanSample FftOceanFrame::Evaluate(double x0, double y0) const {
         const int ix1 = (ix0 + 1) & (n_ - 1), iy1 = (iy0 + 1) & (n_ - 1);
         const double w00 = (1 - wx) * (1 - wy), w10 = wx * (1 - wy), w01 = (1 - wx) * wy,
                      w11 = wx * wy;
-        for (int p = 0; p < kPlanes; ++p) {
+        for (int p = 0; p < planes; ++p) {
             // Fields are stored transposed: row ix, column iy.
             const cv::Mat& m = c.field[p];
             const cv::Vec2f* r0 = m.ptr<cv::Vec2f>(ix0);
@@ -351,17 +357,17 @@ OceanSample FftOceanFrame::Evaluate(double x0, double y0) const {
     }
     const auto f = [&](OceanField field) { return sum[size_t(field)]; };
     const double l = choppiness_;
-    const double a = 1.0 + l * f(OceanField::DispXX), d = 1.0 + l * f(OceanField::DispYY);
-    const double b = l * f(OceanField::DispXY);
-    OceanSample s;
-    s.position = {x0 + l * f(OceanField::DispX), y0 + l * f(OceanField::DispY),
-                  f(OceanField::Height)};
-    s.normal = UpwardNormal({a, b, f(OceanField::SlopeX)}, {b, d, f(OceanField::SlopeY)});
-    s.velocity_mps = {l * f(OceanField::DispXRate), l * f(OceanField::DispYRate),
-                      f(OceanField::HeightRate)};
-    s.jacobian = a * d - b * b;
-    s.minEigenvalue = 0.5 * (a + d) - std::sqrt(0.25 * (a - d) * (a - d) + b * b);
-    return s;
+    SurfaceTerms t;
+    t.displacement = {l * f(OceanField::DispX), l * f(OceanField::DispY), f(OceanField::Height)};
+    t.dxx = l * f(OceanField::DispXX);
+    t.dyy = l * f(OceanField::DispYY);
+    t.dxy = l * f(OceanField::DispXY);
+    t.sx = f(OceanField::SlopeX);
+    t.sy = f(OceanField::SlopeY);
+    t.velocity_mps = hasRates_ ? glm::dvec3(l * f(OceanField::DispXRate),
+                                            l * f(OceanField::DispYRate), f(OceanField::HeightRate))
+                               : glm::dvec3(std::numeric_limits<double>::quiet_NaN());
+    return t;
 }
 
 OceanSample FftOceanFrame::SampleAt(double x, double y) const {

@@ -12,30 +12,19 @@
 #include <vector>
 
 #include "scene/config/config.h"
+#include "scene/ocean/ocean_settings.h"
 #include "scene/ocean/sea_state.h"
 #include "scene/ocean/spectrum.h"
+#include "scene/ocean/surface_terms.h"
 
 namespace seasense::scene {
-
-struct FftOceanSettings {
-    int gridSize = 256;  // N × N modes per cascade, a power of two in [16, 2048]
-    // Patch side lengths (m), strictly decreasing, each ratio of neighbours in (1, N/2). Empty:
-    // chosen from the spectrum by DefaultPatchSizes with cascadeCount patches.
-    std::vector<double> patchSizes_m;
-    int cascadeCount = 2;     // 1–8, used when patchSizes_m is empty
-    double choppiness = 1.0;  // λ ≥ 0: 1 displaces surface points by their linear-theory orbits
-    uint64_t seed = 1;        // phases and amplitudes
-};
-
-// The spectral ocean section of a scenario: sea conditions plus synthesis.
-struct SpectralOceanSettings {
-    SeaStateSettings sea;
-    FftOceanSettings fft;
-};
 
 // Reads a mapping with the sea keys of ReadSeaStateSettings and an optional
 // fft: {grid_size, patch_sizes_m, cascades, choppiness, seed}; unknown keys are errors.
 SpectralOceanSettings ReadSpectralOceanSettings(const ConfigValue& value,
+                                                const SpectralOceanSettings& defaults = {});
+// The same keys from a mapping being read (the caller may read more keys and calls Finish).
+SpectralOceanSettings ReadSpectralOceanSettings(ConfigMap& map,
                                                 const SpectralOceanSettings& defaults = {});
 
 // Patch sizes for a spectrum (m): the largest max(250 m, 10 peak wavelengths) so the peak is
@@ -61,15 +50,6 @@ enum class OceanField : int {
 };
 inline constexpr int kOceanFieldCount = 11;
 
-// The ocean surface at a rest position, world ENU metres.
-struct OceanSample {
-    glm::dvec3 position{0.0};          // displaced surface point
-    glm::dvec3 normal{0.0, 0.0, 1.0};  // unit, upward
-    glm::dvec3 velocity_mps{0.0};      // of the surface particle (orbital velocity)
-    double jacobian = 1.0;             // det ∂(x, y)/∂(x0, y0); < 0 where the surface folds
-    double minEigenvalue = 1.0;        // smaller eigenvalue of ∂(x, y)/∂(x0, y0)
-};
-
 // The synthesized fields of all cascades at one instant (an immutable snapshot once filled).
 // The surface is the sum over cascades of each periodic field, sampled bilinearly.
 class FftOceanFrame {
@@ -79,13 +59,23 @@ class FftOceanFrame {
     double PatchSize_m(size_t cascade) const { return cascades_[cascade].patch_m; }
     int GridSize() const { return n_; }
     double Choppiness() const { return choppiness_; }
+    // Whether the rate fields (HeightRate, DispXRate, DispYRate) were synthesized.
+    bool HasRates() const { return hasRates_; }
 
     // Field value at grid node (ix, iy) of a cascade, which lies at rest position
     // (ix, iy) · L / N (periodic).
     float Field(size_t cascade, OceanField field, int ix, int iy) const;
+    // Plane p of a cascade: N × N CV_32FC2, transposed (row ix, column iy), field 2p in the
+    // real and field 2p + 1 in the imaginary part (before the choppiness factor).
+    const cv::Mat& FieldPlane(size_t cascade, int plane) const;
 
+    // Displacement and derivatives at rest position (x0, y0) (world metres), choppiness applied,
+    // cascades sampled bilinearly. The velocity is NaN when the rates were not synthesized.
+    SurfaceTerms Terms(double x0, double y0) const;
     // Surface at rest position (x0, y0) (world metres).
-    OceanSample Evaluate(double x0, double y0) const;
+    OceanSample Evaluate(double x0, double y0) const {
+        return MakeOceanSample(x0, y0, Terms(x0, y0));
+    }
 
     // Surface drawn above the world point (x, y): the rest position whose displaced horizontal
     // position is (x, y) is found by fixed-point iteration, so HeightAt answers with the
@@ -93,9 +83,11 @@ class FftOceanFrame {
     OceanSample SampleAt(double x, double y) const;
     double HeightAt(double x, double y) const { return SampleAt(x, y).position.z; }
 
+    static constexpr int kPlanes = 6;      // two real fields per complex transform
+    static constexpr int kRatePlanes = 2;  // the last two planes hold the rates
+
   private:
     friend class FftOcean;
-    static constexpr int kPlanes = 6;  // two real fields per complex transform
     struct Cascade {
         double patch_m = 0.0;
         std::array<cv::Mat, kPlanes> spectrum, scratch;  // CV_32FC2 work space
@@ -106,6 +98,7 @@ class FftOceanFrame {
     int n_ = 0;
     double choppiness_ = 0.0;
     double t_s_ = 0.0;
+    bool hasRates_ = true;
 };
 
 // The wavenumber band a cascade synthesizes: modes with kMin ≤ |k| < kMax (rad/m).
@@ -127,8 +120,9 @@ class FftOcean {
     FftOcean(const Density& density, double depth_m, const FftOceanSettings& settings);
 
     // Fields at time t_s (seconds) into frame, reusing its buffers. Thread-parallel (oneTBB);
-    // the result is bit-identical for any thread count.
-    void Synthesize(double t_s, FftOceanFrame& frame) const;
+    // the result is bit-identical for any thread count. Without rates the three time-derivative
+    // fields are skipped (a third less work: rendering needs only the geometry).
+    void Synthesize(double t_s, FftOceanFrame& frame, bool withRates = true) const;
     FftOceanFrame Synthesize(double t_s) const;
 
     std::span<const CascadeBand> Cascades() const { return bands_; }

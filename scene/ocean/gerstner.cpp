@@ -51,29 +51,40 @@ template <class Real>
 struct WaveSum {
     Real dx = 0, dy = 0, z = 0;
     Real dxdx = 1, dxdy = 0, dydy = 1, dzdx = 0, dzdy = 0;
+    Real vx = 0, vy = 0, vz = 0;  // ∂/∂t, filled when angular frequencies are given
 };
 
 // Σ over waves of the Gerstner displacement at rest offset (x, y), where wave i has phase
-// k_i (d_i · (x, y)) + phase_i; shared by the double query path and the float mesh path.
+// k_i (d_i · (x, y)) + phase_i; shared by the double query path and the float mesh path. With
+// a footprint s > 0 (m) each wave is weighted by FootprintWeight (band-limited sampling); with
+// omega, the velocity ∂P/∂t for phases advancing as −ω t is summed too.
 template <class Real>
 WaveSum<Real> SumWaves(size_t n, const Real* dirX, const Real* dirY, const Real* k,
                        const Real* amplitude, const Real* horizontal, const Real* phase, Real x,
-                       Real y) {
+                       Real y, Real footprint = 0, const Real* omega = nullptr) {
     WaveSum<Real> w;
     for (size_t i = 0; i < n; ++i) {
+        const Real weight = footprint > Real(0) ? GerstnerFootprintWeight(k[i], footprint) : 1;
+        if (weight <= Real(0)) continue;
         const Real theta = k[i] * (dirX[i] * x + dirY[i] * y) + phase[i];
         const Real s = std::sin(theta), c = std::cos(theta);
-        const Real h = horizontal[i];
+        const Real h = weight * horizontal[i], a = weight * amplitude[i];
         w.dx -= dirX[i] * h * s;
         w.dy -= dirY[i] * h * s;
-        w.z += amplitude[i] * c;
+        w.z += a * c;
         const Real hkc = h * k[i] * c;
         w.dxdx -= dirX[i] * dirX[i] * hkc;
         w.dxdy -= dirX[i] * dirY[i] * hkc;
         w.dydy -= dirY[i] * dirY[i] * hkc;
-        const Real aks = amplitude[i] * k[i] * s;
+        const Real aks = a * k[i] * s;
         w.dzdx -= dirX[i] * aks;
         w.dzdy -= dirY[i] * aks;
+        if (omega) {
+            // θ = ... − ω t: ∂(−sin θ)/∂t = ω cos θ, ∂(cos θ)/∂t = ω sin θ.
+            w.vx += dirX[i] * h * omega[i] * c;
+            w.vy += dirY[i] * h * omega[i] * c;
+            w.vz += a * omega[i] * s;
+        }
     }
     return w;
 }
@@ -103,6 +114,24 @@ SurfaceSample GerstnerOcean::Evaluate(double x0, double y0, double t) const {
     return out;
 }
 
+SurfaceTerms GerstnerOcean::Terms(double x0, double y0, double t, double footprint_m) const {
+    const size_t n = k_.size();
+    double phase[kMaxWaves];
+    for (size_t i = 0; i < n; ++i) phase[i] = phase_[i] - omega_[i] * t;
+    const WaveSum<double> w =
+        SumWaves(n, dirX_.data(), dirY_.data(), k_.data(), amplitude_.data(), horizontal_.data(),
+                 phase, x0, y0, footprint_m, omega_.data());
+    SurfaceTerms out;
+    out.displacement = {w.dx, w.dy, w.z};
+    out.dxx = w.dxdx - 1.0;
+    out.dyy = w.dydy - 1.0;
+    out.dxy = w.dxdy;
+    out.sx = w.dzdx;
+    out.sy = w.dzdy;
+    out.velocity_mps = {w.vx, w.vy, w.vz};
+    return out;
+}
+
 GerstnerOcean::LocalFrame GerstnerOcean::Local(double ox, double oy, double t) const {
     LocalFrame f;
     for (size_t i = 0; i < k_.size(); ++i) {
@@ -115,6 +144,15 @@ GerstnerOcean::LocalFrame GerstnerOcean::Local(double ox, double oy, double t) c
         f.phase0_.push_back(float(std::remainder(phase, 2.0 * M_PI)));
     }
     return f;
+}
+
+void GerstnerOcean::LocalFrame::Accumulate(float rx, float ry, float footprint_m,
+                                           float sums[8]) const {
+    const WaveSum<float> w =
+        SumWaves(k_.size(), dirX_.data(), dirY_.data(), k_.data(), amplitude_.data(),
+                 horizontal_.data(), phase0_.data(), rx, ry, footprint_m);
+    const float terms[8] = {w.z, w.dx, w.dy, w.dzdx, w.dzdy, w.dxdx - 1.0f, w.dydy - 1.0f, w.dxdy};
+    for (int i = 0; i < 8; ++i) sums[i] += terms[i];
 }
 
 void GerstnerOcean::LocalFrame::Evaluate(float rx, float ry, glm::vec3& position, glm::vec3& normal,

@@ -5,6 +5,7 @@
 #include <glm/glm.hpp>
 #include <vector>
 
+#include "scene/ocean/surface_terms.h"
 #include "scene/scenario/scenario.h"
 
 namespace seasense::scene {
@@ -22,6 +23,15 @@ double DispersionOmega(double k_radpm, double depth_m);
 // Phase speed ω/k and group speed ½ c (1 + 2kh / sinh 2kh), m/s.
 double PhaseSpeed(double k_radpm, double depth_m);
 double GroupSpeed(double k_radpm, double depth_m);
+
+// Weight of a wave of wavenumber k (rad/m) on a surface sampled with footprint s (m): 1 for
+// wavelengths 2π/k ≥ 4 s, 0 at and below the Nyquist wavelength 2 s, linear in between, so that
+// sampling at spacing s does not alias it (and the wave fades in smoothly as s shrinks).
+template <class Real>
+Real GerstnerFootprintWeight(Real k_radpm, Real footprint_m) {
+    const Real w = Real(3.141592653589793) / (k_radpm * footprint_m) - Real(1);
+    return w < Real(0) ? Real(0) : w > Real(1) ? Real(1) : w;
+}
 
 // A displaced surface point: the horizontal rest position x0 = (x, y) in the world ENU frame
 // moves to position; normal is the unit upward surface normal there.
@@ -46,6 +56,10 @@ class GerstnerOcean {
     double HeightAt(double x, double y, double t_s) const;
     SurfaceSample SampleAt(double x, double y, double t_s) const;
 
+    // Displacement, derivatives and velocity at rest position (x0, y0) at time t_s, each wave
+    // weighted by GerstnerFootprintWeight for footprint_m > 0 (0: unfiltered).
+    SurfaceTerms Terms(double x0, double y0, double t_s, double footprint_m = 0.0) const;
+
     // Single-precision evaluation for mesh building, relative to a local origin: the
     // per-wave phase of the origin and of time is reduced modulo 2π in double once, so float
     // keeps ~1e-4 rad of phase anywhere within tens of km of the origin at any time.
@@ -54,6 +68,9 @@ class GerstnerOcean {
         // Position (relative to the origin, m), normal and Jacobian at rest offset (rx, ry).
         void Evaluate(float rx, float ry, glm::vec3& position, glm::vec3& normal,
                       float& jacobian) const;
+        // Adds the band-limited terms at rest offset (rx, ry) for footprint_m (0: unfiltered)
+        // to sums = {η, Dx, Dy, ∂η/∂x, ∂η/∂y, ∂Dx/∂x, ∂Dy/∂y, ∂Dx/∂y}.
+        void Accumulate(float rx, float ry, float footprint_m, float sums[8]) const;
 
       private:
         friend class GerstnerOcean;
@@ -62,6 +79,11 @@ class GerstnerOcean {
     LocalFrame Local(double originX, double originY, double t_s) const;
 
     size_t WaveCount() const { return k_.size(); }
+    double Wavenumber_radpm(size_t i) const { return k_[i]; }
+    double Omega_radps(size_t i) const { return omega_[i]; }
+    double Amplitude_m(size_t i) const { return amplitude_[i]; }
+    // Direction of travel as an azimuth from north, clockwise (rad).
+    double Direction_rad(size_t i) const { return std::atan2(dirX_[i], dirY_[i]); }
     // Largest |elevation| the waves can reach: Σ A_i (m).
     double MaxAmplitude_m() const { return maxAmplitude_m_; }
     // Largest horizontal displacement the waves can cause: Σ Q A / tanh(kh) (m).

@@ -1,5 +1,28 @@
-// Polar-grid sea mesh: a grid centred on the eye gives a screen-uniform vertex density from the
-// eye to the horizon as one mesh, so there are no level-of-detail seams to stitch.
+// Camera-dependent sea mesh: a polar grid around the eye with world-fixed azimuths, sampling the
+// surface band-limited to the local vertex spacing.
+//
+// Why a polar grid rather than clipmap rings or a projected grid. The sea is seen at grazing
+// angles from low eyepoints (2 m: the horizon is 5 km away), where a patch of sea is compressed
+// on screen radially by h/r relative to tangentially. A grid centred on the eye whose rings each
+// subtend about the same angle gives a screen-uniform vertex density from the eye to the
+// horizon: the spacing grows continuously with range (a continuous level of detail), so there
+// are no level boundaries at all — nothing to stitch, no T-junctions, no cracks, and no level
+// switches to pop (geomorphing has nothing to blend). Clipmap rings (Losasso & Hoppe 2004) keep
+// square cells whose world size doubles per level; at a 2 m eye height their radial sampling is
+// r/h times finer than the screen needs. For the same tangential density (a 640-pixel 60° view,
+// vertices ~6 pixels apart, a 100° sector with margins) ten rings of 128 × 128 cells from 6 m to
+// 5 km hold about 3 · 128² · 100/360 ≈ 14 k vertices each, ~140 k in all, against ~31 k for this
+// grid (BM_OceanLodMesh) — and the CPU rasterizer pays per triangle. A projected grid (Johanson
+// 2004) is screen-uniform too but its vertices move with every camera rotation and it handles the
+// curved horizon poorly.
+//
+// The price of an eye-centred grid is that vertices move over the surface as the eye moves. The
+// surface each vertex samples is therefore band-limited to the vertex spacing (the FFT cascades
+// through box-filtered mip chains, Gerstner waves faded out before their Nyquist wavelength), so
+// re-sampling a smooth field at shifted points changes it little: the distant sea does not
+// shimmer. Rotation moves nothing: azimuths are multiples of 2π / circleSegments, fixed in the
+// world, and the ring radii depend only on eye height, wave height and angular step, not on
+// where the view looks; contiguous channels with equal angular steps get identical vertices.
 #include "scene/ocean/ocean_mesh.h"
 
 #include <tbb/parallel_for.h>
@@ -23,47 +46,66 @@ double CurvatureDrop_m(double r) {
     return r * r / (R + std::sqrt(R * R - r * r));
 }
 
-void BuildOceanMesh(const GerstnerOcean& ocean, const OceanMeshRequest& req, OceanMesh& out) {
-    CHECK(req.angularStep_rad > 0.0);
-    const double amplitude = ocean.MaxAmplitude_m();
-    const double eyeHeight = std::max(req.eye_m.z, 0.05);
-    // Crests up to `amplitude` high stay visible until the two horizon distances add up.
-    const double maxRange = HorizonDistance_m(eyeHeight) + HorizonDistance_m(amplitude) + 100.0;
-    // Heights seen from the eye: foreshortening uses the eye's height above the lowest trough.
-    const double hEff = eyeHeight + amplitude;
-    const double dphi = req.angularStep_rad;
-
-    std::vector<double> radii;
-    if (!(req.minRange_m < maxRange)) {  // nothing visible (also catches NaN)
-        out.positions.clear();
-        out.normals.clear();
-        out.jacobian.clear();
-        out.indices.clear();
-        out.rings = out.segments = 0;
-        out.fullCircle = false;
-        return;
-    }
-    double r;
-    if (req.minRange_m > 0.0) {
-        r = req.minRange_m;
-    } else {
-        // A centre vertex under the eye, then rings from well inside the nearest water.
-        radii.push_back(0.0);
-        r = std::max(0.05, 0.25 * hEff);
-    }
-    while (r < maxRange) {
+std::vector<double> OceanMeshRadii(double eyeHeight_m, double significantHeight_m, double dphi,
+                                   double maxRange_m) {
+    CHECK(dphi > 0.0);
+    // Foreshortening uses the eye's height above a typical trough (half the significant height).
+    const double hEff = std::max(eyeHeight_m, 0.05) + 0.5 * significantHeight_m;
+    std::vector<double> radii{0.0};  // a centre vertex under the eye
+    double r = std::max(0.05, 0.25 * hEff);
+    while (r < maxRange_m) {
         radii.push_back(r);
         const double step = std::min(r * dphi * std::max(1.0, r / hEff), 8.0 * r * dphi);
         r += std::max(step, 1e-3);
     }
-    radii.push_back(maxRange);
+    radii.push_back(maxRange_m);
+    return radii;
+}
 
-    const bool full = req.azimuthMax_rad - req.azimuthMin_rad >= 2.0 * M_PI - 1e-9;
-    const double span = full ? 2.0 * M_PI : req.azimuthMax_rad - req.azimuthMin_rad;
-    CHECK(span > 0.0);
-    const int segments = std::max(3, int(std::ceil(span / dphi)));
+void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req, OceanMesh& out) {
+    CHECK(req.angularStep_rad > 0.0);
+    const double eyeHeight = std::max(req.eye_m.z, 0.05);
+    // Crests up to the highest stay visible until the two horizon distances add up.
+    const double maxRange =
+        HorizonDistance_m(eyeHeight) + HorizonDistance_m(frame.MaxHeight_m()) + 100.0;
+    if (!(req.minRange_m < maxRange)) {  // nothing visible (also catches NaN)
+        out = OceanMesh{};
+        return;
+    }
+    // World-fixed azimuths: a whole number of segments around the circle.
+    const int circle = std::max(8, int(std::ceil(2.0 * M_PI / req.angularStep_rad)));
+    const double dphi = 2.0 * M_PI / circle;
+    int first = 0, segments = circle;
+    bool full = req.azimuthMax_rad - req.azimuthMin_rad >= 2.0 * M_PI - 1e-9;
+    if (!full) {
+        CHECK(req.azimuthMax_rad > req.azimuthMin_rad);
+        first = int(std::floor(req.azimuthMin_rad / dphi));
+        segments = std::max(1, int(std::ceil(req.azimuthMax_rad / dphi)) - first);
+        if (segments >= circle) {
+            full = true;
+            first = 0;
+            segments = circle;
+        }
+    }
     const int columns = full ? segments : segments + 1;  // the full circle wraps its last column
+
+    // Rings: the fixed sequence, from the last ring at or inside the nearest visible range.
+    std::vector<double> all =
+        OceanMeshRadii(req.eye_m.z, frame.SignificantHeight_m(), dphi, maxRange);
+    size_t j0 = 0;
+    while (j0 + 1 < all.size() && all[j0 + 1] <= req.minRange_m) ++j0;
+    std::vector<double> radii(all.begin() + std::ptrdiff_t(j0), all.end());
     const int rings = int(radii.size());
+    CHECK(rings >= 2);
+    // Footprint of a ring: the larger of its tangential spacing and its radial spacing to
+    // either neighbour in the full sequence (so it does not depend on the nearest range).
+    std::vector<float> footprint(radii.size());
+    for (size_t j = 0; j < radii.size(); ++j) {
+        const size_t a = j + j0;
+        const double inner = a > 0 ? all[a] - all[a - 1] : 0.0;
+        const double outer = a + 1 < all.size() ? all[a + 1] - all[a] : inner;
+        footprint[j] = float(std::max({all[a] * dphi, inner, outer}));
+    }
 
     // The index buffer depends only on the grid's shape: rebuilt when that changes.
     const bool sameShape = out.rings == rings && out.segments == segments &&
@@ -71,28 +113,38 @@ void BuildOceanMesh(const GerstnerOcean& ocean, const OceanMeshRequest& req, Oce
     out.rings = rings;
     out.segments = segments;
     out.fullCircle = full;
+    out.circleSegments = circle;
+    out.firstColumn = first;
+    out.radii_m = radii;
+    out.footprint_m = footprint;
     std::vector<double> sinAz(static_cast<size_t>(columns)), cosAz(static_cast<size_t>(columns));
     for (int i = 0; i < columns; ++i) {
-        const double az = req.azimuthMin_rad + span * double(i) / double(segments);
+        const double az = dphi * double(first + i);
         sinAz[size_t(i)] = std::sin(az);
         cosAz[size_t(i)] = std::cos(az);
     }
     out.positions.resize(size_t(rings) * size_t(columns));
     out.normals.resize(out.positions.size());
     out.jacobian.resize(out.positions.size());
-    const GerstnerOcean::LocalFrame local = ocean.Local(req.eye_m.x, req.eye_m.y, req.time_s);
+    const GerstnerOcean::LocalFrame local =
+        frame.Gerstner().Local(req.eye_m.x, req.eye_m.y, frame.Time_s());
+    const bool gerstner = frame.Gerstner().WaveCount() > 0;
     tbb::parallel_for(0, rings, [&](int j) {
         const double radius = radii[size_t(j)];
         const double drop = CurvatureDrop_m(radius);
+        const float fp = footprint[size_t(j)];
+        const FftFilter filter = frame.Filter(fp);
         for (int i = 0; i < columns; ++i) {
-            const float rx = float(radius * sinAz[size_t(i)]);
-            const float ry = float(radius * cosAz[size_t(i)]);
+            const double rx = radius * sinAz[size_t(i)], ry = radius * cosAz[size_t(i)];
             const size_t v = size_t(j) * size_t(columns) + size_t(i);
-            glm::vec3 p;
-            local.Evaluate(rx, ry, p, out.normals[v], out.jacobian[v]);
-            out.positions[v] =
-                glm::vec3(float(req.eye_m.x + double(p.x)), float(req.eye_m.y + double(p.y)),
-                          float(double(p.z) - drop));
+            GeometrySums s{};
+            frame.AccumulateFft(req.eye_m.x + rx, req.eye_m.y + ry, filter, s);
+            if (gerstner) local.Accumulate(float(rx), float(ry), fp, s.data());
+            out.positions[v] = glm::vec3(float(req.eye_m.x + rx + double(s[kTermDispX])),
+                                         float(req.eye_m.y + ry + double(s[kTermDispY])),
+                                         float(double(s[kTermHeight]) - drop));
+            out.normals[v] = GeometryNormal(s);
+            out.jacobian[v] = GeometryJacobian(s);
         }
     });
 

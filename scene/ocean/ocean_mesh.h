@@ -1,12 +1,12 @@
-// View-dependent sea-surface mesh: a polar grid around the eyepoint out past the horizon,
-// displaced by the wave model and dropped by the Earth's curvature.
+// View-dependent sea-surface mesh: a polar grid around the eyepoint out past the horizon, the
+// surface band-limited to the vertex spacing, dropped by the Earth's curvature.
 #pragma once
 
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <vector>
 
-#include "scene/ocean/gerstner.h"
+#include "scene/ocean/ocean_surface.h"
 
 namespace seasense::scene {
 
@@ -26,7 +26,6 @@ struct OceanMeshRequest {
     double azimuthMin_rad = 0.0;    // sector of azimuths to cover (clockwise from north);
     double azimuthMax_rad = 0.0;    // max − min ≥ 2π means the full circle
     double angularStep_rad = 0.01;  // target angle between neighbouring vertices seen from the eye
-    double time_s = 0.0;
     // No sea nearer than this can be seen (e.g. below the view): the grid starts here rather
     // than under the eye. +∞ means no sea is visible at all (an empty mesh).
     double minRange_m = 0.0;
@@ -37,16 +36,28 @@ struct OceanMesh {
     std::vector<glm::vec3> normals;    // unit, world
     std::vector<float> jacobian;       // surface folding measure (< 0 folded)
     std::vector<uint32_t> indices;     // counter-clockwise seen from above
+    // Ring j, column i is vertex j · (segments + !fullCircle) + i. Column i lies at azimuth
+    // (firstColumn + i) · 2π / circleSegments: azimuths are fixed in the world.
     int rings = 0;
     int segments = 0;
     bool fullCircle = false;
+    int circleSegments = 0;
+    int firstColumn = 0;
+    std::vector<double> radii_m;     // rest-position radius of each ring
+    std::vector<float> footprint_m;  // per ring: the sampling footprint the surface is filtered to
 };
 
-// Builds the mesh for one view. Rings are spaced so that each step subtends about
-// angularStep seen from the eye: geometric near the eye, growing as r²/h where grazing
-// foreshortening compresses them, capped at 8× the tangential spacing so waves stay sampled,
-// out to the horizon distance of eye height plus the highest crest. Parallel over rings with
-// oneTBB; deterministic.
-void BuildOceanMesh(const GerstnerOcean& ocean, const OceanMeshRequest& request, OceanMesh& out);
+// Rest-position radii of the rings for an eye height above the mean sea (m), the waves'
+// significant height (m) and an angular step (rad), out to maxRange_m (the last ring): a centre
+// vertex, then rings spaced so that each step subtends about the angular step seen from the eye
+// — geometric near the eye, growing as r²/h where grazing foreshortening compresses them,
+// capped at 8× the tangential spacing. A function of these arguments only.
+std::vector<double> OceanMeshRadii(double eyeHeight_m, double significantHeight_m,
+                                   double angularStep_rad, double maxRange_m);
+
+// Builds the mesh for one view from a surface frame (see ocean_mesh.cpp for the choice of a
+// polar grid). Parallel over rings with oneTBB; bit-identical for any thread count.
+void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& request,
+                    OceanMesh& out);
 
 }  // namespace seasense::scene

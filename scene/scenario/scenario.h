@@ -11,6 +11,7 @@
 #include "scene/config/config.h"
 #include "scene/core/time.h"
 #include "scene/sky/lightning.h"
+#include "scene/ocean/ocean_settings.h"
 
 namespace seasense::scene {
 
@@ -52,9 +53,16 @@ struct GerstnerWaveSettings {
     double phase_rad = 0.0;
 };
 
+// The sea surface: Gerstner waves alone, or the spectral (FFT) sea with the Gerstner waves (a few
+// long swells, say) added to it.
 struct OceanSettings {
     std::vector<GerstnerWaveSettings> waves;
     double depth_m = 1.0e4;  // water depth for dispersion ω² = g k tanh(k h)
+    // Set: the spectral model (its depth is depth_m, its seed world.seed unless fft.seed).
+    std::optional<SpectralOceanSettings> spectral;
+    // Foam coverage reported by queries rises from 0 where the Jacobian's smaller eigenvalue is
+    // this value to 1 where the surface folds (eigenvalue 0); in (0, 1).
+    double foamThreshold = 0.3;
 };
 
 struct EnvironmentSettings {

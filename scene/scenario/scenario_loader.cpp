@@ -12,6 +12,7 @@
 #include "scene/config/digest.h"
 #include "scene/config/suggest.h"
 #include "scene/core/error.h"
+#include "scene/ocean/fft_ocean.h"
 #include "scene/ocean/gerstner.h"
 
 namespace seasense::scene {
@@ -106,7 +107,32 @@ GerstnerWaveSettings ReadWave(const ConfigValue& value) {
     return wave;
 }
 
-EnvironmentSettings ReadEnvironment(ConfigMap& map) {
+// environment.ocean.spectral: the sea keys and fft of ReadSpectralOceanSettings; the wind
+// defaults to environment.wind, the seed to world.seed, the depth is environment.ocean.depth_m.
+SpectralOceanSettings ReadSpectralOcean(const ConfigValue& value, const EnvironmentSettings& env,
+                                        double depth_m, uint64_t seed) {
+    SpectralOceanSettings defaults;
+    defaults.sea.spectrum.windSpeed_mps = env.windSpeed_mps;
+    defaults.sea.spectrum.windDirection_rad = env.windDirection_rad;
+    defaults.sea.spectrum.depth_m = depth_m;
+    defaults.fft.seed = seed;
+    SpectralOceanSettings s = ReadMap(value, [&](ConfigMap& m) {
+        if (const std::optional<ConfigValue> depth = m.Find("depth_m"))
+            depth->Fail("no depth_m here (the water depth is environment.ocean.depth_m)");
+        return ReadSpectralOceanSettings(m, defaults);
+    });
+    // The spectrum checks the combination of values (e.g. a height with no wind to shape it).
+    try {
+        const WaveSpectrum spectrum(ResolveSeaState(s.sea));
+    } catch (const ConfigError&) {
+        throw;
+    } catch (const InputError& e) {
+        value.Fail("a sea the spectrum model accepts", e.what());
+    }
+    return s;
+}
+
+EnvironmentSettings ReadEnvironment(ConfigMap& map, const WorldSettings& world) {
     EnvironmentSettings env;
     ReadMap(map.Require("environment", "a mapping"), [&](ConfigMap& e) {
         const ConfigValue sunValue =
@@ -155,8 +181,19 @@ EnvironmentSettings ReadEnvironment(ConfigMap& map) {
         ReadMap(e.Require("ocean", "a mapping"), [&](ConfigMap& ocean) {
             env.ocean.depth_m =
                 ocean.GetDouble("depth_m", NumberRange::Positive("m"), env.ocean.depth_m);
-            for (const ConfigValue& wave : ocean.GetList("waves", 1, kMaxWaves, "waves"))
-                env.ocean.waves.push_back(ReadWave(wave));
+            // Spectral sea with optional Gerstner waves added, or Gerstner waves alone.
+            if (const std::optional<ConfigValue> spectral = ocean.Find("spectral")) {
+                env.ocean.spectral =
+                    ReadSpectralOcean(*spectral, env, env.ocean.depth_m, world.seed);
+                if (const std::optional<ConfigValue> waves = ocean.Find("waves"))
+                    for (const ConfigValue& wave : waves->AsList(0, kMaxWaves, "waves"))
+                        env.ocean.waves.push_back(ReadWave(wave));
+            } else {
+                for (const ConfigValue& wave : ocean.GetList("waves", 1, kMaxWaves, "waves"))
+                    env.ocean.waves.push_back(ReadWave(wave));
+            }
+            env.ocean.foamThreshold = ocean.GetDouble("foam_threshold", NumberRange::Open(0.0, 1.0),
+                                                      env.ocean.foamThreshold);
         });
     });
     return env;
@@ -359,7 +396,7 @@ Scenario LoadScenario(const std::filesystem::path& file) {
 
     ReadMap(document.root, [&](ConfigMap& root) {
         scenario.world = ReadWorld(root);
-        scenario.environment = ReadEnvironment(root);
+        scenario.environment = ReadEnvironment(root, scenario.world);
 
         const std::filesystem::path materialFile =
             FindMaterialFile(root, folder, document.root.Location());

@@ -81,6 +81,7 @@ FrameState World::Advance(int64_t frame) const {
 
     const EyepointSettings& eye = scenario_.eyepoint;
     s.eyepoint = MovingPose(eye.position_m, eye.attitude, eye.speed_mps, s.time_s);
+    std::shared_ptr<const OceanSurfaceFrame> sea;  // made on first use: only riders need it
     for (size_t i = 0; i < scenario_.entities.size(); ++i) {
         const EntitySettings& e = scenario_.entities[i];
         Pose pose = MovingPose(e.position_m, e.attitude, e.speed_mps, s.time_s);
@@ -89,7 +90,8 @@ FrameState World::Advance(int64_t frame) const {
             // heights under bow/stern and the beam ends (body y forward, x to starboard).
             const glm::dvec3 fwd = pose.worldFromBody[1], right = pose.worldFromBody[0];
             const glm::dvec2 half = halfExtent_m_[i];
-            const auto h = [&](const glm::dvec3& p) { return ocean_.HeightAt(p.x, p.y, s.time_s); };
+            if (!sea) sea = ocean_.At(s.time_s);
+            const auto h = [&](const glm::dvec3& p) { return sea->HeightAt(p.x, p.y); };
             const glm::dvec3 o = pose.position_m;
             const double bow = h(o + fwd * half.y), stern = h(o - fwd * half.y);
             const double stbd = h(o + right * half.x), port = h(o - right * half.x);

@@ -8,7 +8,7 @@
 
 #include "scene/core/frames.h"
 #include "scene/models/triangle_mesh.h"
-#include "scene/ocean/gerstner.h"
+#include "scene/ocean/ocean_surface.h"
 #include "scene/scenario/scenario.h"
 #include "scene/sky/ephemeris.h"
 #include "scene/sky/lightning.h"
@@ -79,14 +79,15 @@ class World {
     SceneState State(int64_t frame) const { return Compose(Advance(frame)); }
 
     const Scenario& GetScenario() const { return scenario_; }
-    const GerstnerOcean& Ocean() const { return ocean_; }
     // The scenario's thunderstorms (environment.lightning), or nullptr. Flashes are pure
     // functions of the scene time, so every channel sees the same ones.
     const Lightning* GetLightning() const { return lightning_.get(); }
+    // The sea surface (Gerstner or spectral), frames cached per time.
+    const OceanSurface& Ocean() const { return ocean_; }
 
   private:
     Scenario scenario_;
-    GerstnerOcean ocean_;
+    OceanSurface ocean_;
     std::vector<std::shared_ptr<const TriangleMesh>> models_;  // one per entity
     // Half length (body y) and half beam (body x) of each entity's mesh, for riding the waves.
     std::vector<glm::dvec2> halfExtent_m_;

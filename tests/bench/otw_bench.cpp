@@ -139,12 +139,14 @@ void BM_OceanMesh(benchmark::State& state) {
     req.eye_m = cam.worldFromCamera.position_m;
     req.angularStep_rad = 6.0 * cam.hfov_rad / double(cam.width);
     FrustumAzimuthSector(cam, 20.0 * M_PI / 180.0, req.azimuthMin_rad, req.azimuthMax_rad);
-    req.minRange_m = NearestVisibleSeaRange_m(cam, world.Ocean().MaxAmplitude_m(),
-                                              world.Ocean().MaxHorizontal_m());
+    double t = 0.0;
+    const auto sea0 = world.Ocean().At(t);
+    req.minRange_m = NearestVisibleSeaRange_m(cam, sea0->MaxHeight_m(), sea0->MaxHorizontal_m());
     scene::OceanMesh mesh;
     for (auto _ : state) {
-        arena.execute([&] { scene::BuildOceanMesh(world.Ocean(), req, mesh); });
-        req.time_s += 1.0 / 30.0;
+        const auto sea = world.Ocean().At(t);
+        arena.execute([&] { scene::BuildOceanMesh(*sea, req, mesh); });
+        t += 1.0 / 30.0;
     }
     state.counters["vertices"] = double(mesh.positions.size());
 }

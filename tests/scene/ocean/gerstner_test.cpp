@@ -5,8 +5,6 @@
 
 #include <cmath>
 
-#include "scene/ocean/ocean_mesh.h"
-
 namespace seasense::scene {
 namespace {
 
@@ -145,41 +143,6 @@ TEST(Gerstner, SinglePrecisionLocalFrameMatchesDoubleEvaluationFarFromTheOrigin)
         EXPECT_NEAR(glm::dot(glm::dvec3(n), ref.normal), 1.0, 1e-4);
         EXPECT_NEAR(jac, ref.jacobian, 1e-3);
     }
-}
-
-TEST(OceanMesh, HorizonDistancesMatchEarthGeometry) {
-    // √(2 R h): 2 m → ≈ 5.05 km, 300 m → ≈ 61.8 km (issue 3 quotes ~5 km and ~62 km).
-    EXPECT_NEAR(HorizonDistance_m(2.0), 5048.0, 5.0);
-    EXPECT_NEAR(HorizonDistance_m(300.0), 61827.0, 30.0);
-    // Sag of a sphere at 10 km: r² / 2R = 7.85 m.
-    EXPECT_NEAR(CurvatureDrop_m(10000.0), 1e8 / (2.0 * kEarthRadius_m), 1e-4);
-}
-
-TEST(OceanMesh, CoversTheSectorOutPastTheHorizonWithUpwardFaces) {
-    const GerstnerOcean o(OneWave(30.0, 0.3, 0.8, 1e4));
-    OceanMeshRequest req;
-    req.eye_m = {10.0, 20.0, 5.0};
-    req.azimuthMin_rad = -0.5;
-    req.azimuthMax_rad = 0.7;
-    req.angularStep_rad = 0.01;
-    OceanMesh m;
-    BuildOceanMesh(o, req, m);
-    double farthest = 0.0;
-    for (const glm::vec3& p : m.positions)
-        farthest = std::max(farthest, std::hypot(p.x - 10.0, p.y - 20.0));
-    EXPECT_GT(farthest, HorizonDistance_m(5.0));
-    // Every non-degenerate triangle faces up (counter-clockwise seen from above).
-    size_t up = 0, total = 0;
-    for (size_t t = 0; t < m.indices.size(); t += 3) {
-        const glm::dvec3 a(m.positions[m.indices[t]]), b(m.positions[m.indices[t + 1]]),
-            c(m.positions[m.indices[t + 2]]);
-        const double nz = glm::cross(b - a, c - a).z;
-        if (std::abs(nz) < 1e-9) continue;
-        ++total;
-        up += nz > 0.0;
-    }
-    EXPECT_GT(total, 1000u);
-    EXPECT_EQ(up, total);
 }
 
 }  // namespace

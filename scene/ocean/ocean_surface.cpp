@@ -1,0 +1,333 @@
+// Ocean surface frames: FFT fields repacked into mip chains for band-limited lookups, Gerstner
+// waves, the inverse-displacement query, a per-time frame cache and the sea's statistics.
+#include "scene/ocean/ocean_surface.h"
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <numbers>
+
+#include "scene/core/check.h"
+#include "scene/ocean/sea_state.h"
+
+namespace seasense::scene {
+namespace {
+
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// Fixed-point iterations of the inverse displacement and their tolerance (m).
+constexpr int kMaxInverseIterations = 64;
+constexpr double kInverseTolerance_m = 1e-9;
+// Frames kept by OceanSurface::At: the current frame time and the one before, so the host's
+// wave riding and a renderer's mesh of one frame share a synthesis.
+constexpr size_t kCachedFrames = 2;
+
+// Bilinear lookup of mip level `level` of a cascade texture at rest position (x0, y0), weighted
+// by `weight`, added to sums. Texel i of level l is centred on the mean of the nodes it averages,
+// (i 2^l + (2^l − 1)/2) Δ, hence the half-texel shifts.
+template <class Texture>
+void AddBilinear(const Texture& c, int level, double x0, double y0, float weight,
+                 GeometrySums& sums) {
+    const int n = c.n >> level;
+    const double texel = c.texel_m * double(1 << level);
+    const double u = (x0 + 0.5 * c.texel_m) / texel - 0.5;
+    const double v = (y0 + 0.5 * c.texel_m) / texel - 0.5;
+    const double fu = std::floor(u), fv = std::floor(v);
+    const float wx = float(u - fu), wy = float(v - fv);
+    // Power-of-two periodic wrap; two's complement makes the mask right for negative indices.
+    const int i0 = int(int64_t(fu) & (n - 1)), j0 = int(int64_t(fv) & (n - 1));
+    const int i1 = (i0 + 1) & (n - 1), j1 = (j0 + 1) & (n - 1);
+    const auto* t = c.levels[size_t(level)].data();
+    const GeometrySums& a = t[size_t(i0) * size_t(n) + size_t(j0)].v;
+    const GeometrySums& b = t[size_t(i1) * size_t(n) + size_t(j0)].v;
+    const GeometrySums& d = t[size_t(i0) * size_t(n) + size_t(j1)].v;
+    const GeometrySums& e = t[size_t(i1) * size_t(n) + size_t(j1)].v;
+    const float w00 = weight * (1.0f - wx) * (1.0f - wy), w10 = weight * wx * (1.0f - wy);
+    const float w01 = weight * (1.0f - wx) * wy, w11 = weight * wx * wy;
+    for (int k = 0; k < kGeometryTerms; ++k)
+        sums[size_t(k)] +=
+            w00 * a[size_t(k)] + w10 * b[size_t(k)] + w01 * d[size_t(k)] + w11 * e[size_t(k)];
+}
+
+}  // namespace
+
+// ---- frame ------------------------------------------------------------------------------------
+
+void OceanSurfaceFrame::BuildTextures() {
+    const size_t cascades = fft_.CascadeCount();
+    const int n = fft_.GridSize();
+    const float l = float(fft_.Choppiness());
+    const int levelCount = std::countr_zero(unsigned(n)) + 1;
+    textures_.resize(cascades);
+    maxHeight_m_ = maxHorizontal_m_ = 0.0;
+    for (size_t c = 0; c < cascades; ++c) {
+        CascadeTexture& tex = textures_[c];
+        tex.patch_m = fft_.PatchSize_m(c);
+        tex.texel_m = tex.patch_m / n;
+        tex.n = n;
+        tex.levels.resize(size_t(levelCount));
+        for (int lv = 0; lv < levelCount; ++lv)
+            tex.levels[size_t(lv)].resize(size_t(n >> lv) * size_t(n >> lv));
+        // Level 0 from the transposed planes (row ix): {η, Dx}, {Dy, ηx}, {ηy, Dxx}, {Dyy, Dxy}.
+        std::vector<float> rowHeight(static_cast<size_t>(n)), rowHorizontal(static_cast<size_t>(n));
+        const cv::Mat* p[4];
+        for (int q = 0; q < 4; ++q) p[q] = &fft_.FieldPlane(c, q);
+        std::vector<Texel>& level0 = tex.levels[0];
+        tbb::parallel_for(0, n, [&](int ix) {
+            const cv::Vec2f* r0 = p[0]->ptr<cv::Vec2f>(ix);
+            const cv::Vec2f* r1 = p[1]->ptr<cv::Vec2f>(ix);
+            const cv::Vec2f* r2 = p[2]->ptr<cv::Vec2f>(ix);
+            const cv::Vec2f* r3 = p[3]->ptr<cv::Vec2f>(ix);
+            Texel* out = level0.data() + size_t(ix) * size_t(n);
+            float maxH = 0.0f, maxD2 = 0.0f;
+            for (int iy = 0; iy < n; ++iy) {
+                out[iy].v = {r0[iy][0], l * r0[iy][1], l * r1[iy][0], r1[iy][1],
+                             r2[iy][0], l * r2[iy][1], l * r3[iy][0], l * r3[iy][1]};
+                maxH = std::max(maxH, std::abs(r0[iy][0]));
+                maxD2 = std::max(maxD2, out[iy].v[kTermDispX] * out[iy].v[kTermDispX] +
+                                            out[iy].v[kTermDispY] * out[iy].v[kTermDispY]);
+            }
+            rowHeight[size_t(ix)] = maxH;
+            rowHorizontal[size_t(ix)] = std::sqrt(maxD2);
+        });
+        // The bilinear surface never exceeds its nodes; the cascades' maxima bound the sum.
+        maxHeight_m_ += *std::max_element(rowHeight.begin(), rowHeight.end());
+        maxHorizontal_m_ += *std::max_element(rowHorizontal.begin(), rowHorizontal.end());
+        for (int lv = 1; lv < levelCount; ++lv) {
+            const int m = n >> lv;
+            const std::vector<Texel>& fine = tex.levels[size_t(lv - 1)];
+            std::vector<Texel>& coarse = tex.levels[size_t(lv)];
+            tbb::parallel_for(0, m, [&](int i) {
+                for (int j = 0; j < m; ++j) {
+                    const size_t f = size_t(2 * i) * size_t(2 * m) + size_t(2 * j);
+                    const size_t g = f + size_t(2 * m);
+                    for (int k = 0; k < kGeometryTerms; ++k)
+                        coarse[size_t(i) * size_t(m) + size_t(j)].v[size_t(k)] =
+                            0.25f * ((fine[f].v[size_t(k)] + fine[f + 1].v[size_t(k)]) +
+                                     (fine[g].v[size_t(k)] + fine[g + 1].v[size_t(k)]));
+                }
+            });
+        }
+    }
+}
+
+SurfaceTerms OceanSurfaceFrame::Terms(double x0, double y0) const {
+    SurfaceTerms t = gerstner_.Terms(x0, y0, t_s_);
+    if (hasFft_) t += fft_.Terms(x0, y0);
+    return t;
+}
+
+OceanSample OceanSurfaceFrame::SampleAt(double x, double y, glm::dvec2* rest) const {
+    // Fixed-point iteration x0 ← x0 + (x − P_h(x0)); a contraction while the horizontal map is
+    // not folded (eigenvalues of ∂P_h/∂x0 in (0, 2)).
+    double x0 = x, y0 = y;
+    OceanSample s = Evaluate(x0, y0);
+    for (int iter = 0; iter < kMaxInverseIterations; ++iter) {
+        const double ex = x - s.position.x, ey = y - s.position.y;
+        if (ex * ex + ey * ey < kInverseTolerance_m * kInverseTolerance_m) break;
+        x0 += ex;
+        y0 += ey;
+        s = Evaluate(x0, y0);
+    }
+    if (rest) *rest = {x0, y0};
+    return s;
+}
+
+FftFilter OceanSurfaceFrame::Filter(float footprint_m) const {
+    FftFilter f;
+    CHECK(textures_.size() <= size_t(FftFilter::kMaxCascades));
+    for (size_t c = 0; c < textures_.size(); ++c) {
+        const CascadeTexture& t = textures_[c];
+        const int top = int(t.levels.size()) - 1;
+        float lod =
+            footprint_m > float(t.texel_m) ? std::log2(footprint_m / float(t.texel_m)) : 0.0f;
+        lod = std::min(lod, float(top));
+        f.level[c] = int(lod);
+        f.frac[c] = lod - float(f.level[c]);
+    }
+    return f;
+}
+
+void OceanSurfaceFrame::AccumulateFft(double x0, double y0, const FftFilter& filter,
+                                      GeometrySums& sums) const {
+    for (size_t c = 0; c < textures_.size(); ++c) {
+        const float f = filter.frac[c];
+        AddBilinear(textures_[c], filter.level[c], x0, y0, 1.0f - f, sums);
+        if (f > 0.0f) AddBilinear(textures_[c], filter.level[c] + 1, x0, y0, f, sums);
+    }
+}
+
+glm::vec3 OceanSurfaceFrame::DetailNormal(double x0, double y0, float footprint_m) const {
+    GeometrySums sums{};
+    AccumulateFft(x0, y0, footprint_m, sums);
+    if (gerstner_.WaveCount() > 0) {
+        const SurfaceTerms g = gerstner_.Terms(x0, y0, t_s_, footprint_m);
+        sums[kTermSlopeX] += float(g.sx);
+        sums[kTermSlopeY] += float(g.sy);
+        sums[kTermDispXX] += float(g.dxx);
+        sums[kTermDispYY] += float(g.dyy);
+        sums[kTermDispXY] += float(g.dxy);
+    }
+    return GeometryNormal(sums);
+}
+
+// ---- surface ----------------------------------------------------------------------------------
+
+struct OceanSurface::Cache {
+    std::mutex mutex;
+    std::vector<std::shared_ptr<OceanSurfaceFrame>> frames;  // oldest first
+};
+
+OceanSurface::OceanSurface(const OceanSettings& settings)
+    : settings_(settings), gerstner_(settings), cache_(std::make_unique<Cache>()) {
+    if (settings_.spectral) {
+        SpectrumSettings sea = ResolveSeaState(settings_.spectral->sea);
+        sea.depth_m = settings_.depth_m;  // one water depth for every wave
+        spectrum_ = std::make_unique<const WaveSpectrum>(sea);
+        fft_ = std::make_unique<const FftOcean>(*spectrum_, settings_.spectral->fft);
+    }
+    Summarize();
+}
+
+OceanSurface::~OceanSurface() = default;
+OceanSurface::OceanSurface(OceanSurface&&) noexcept = default;
+OceanSurface& OceanSurface::operator=(OceanSurface&&) noexcept = default;
+
+void OceanSurface::Fill(OceanSurfaceFrame& frame, double t, bool withVelocity) const {
+    frame.t_s_ = t;
+    frame.gerstner_ = gerstner_;
+    frame.significantHeight_m_ = summary_.significantHeight_m;
+    frame.hasFft_ = fft_ != nullptr;
+    frame.maxHeight_m_ = frame.maxHorizontal_m_ = 0.0;
+    if (!fft_) frame.textures_.clear();  // else rebuilt in place, reusing the buffers
+    if (fft_) {
+        fft_->Synthesize(t, frame.fft_, withVelocity);
+        frame.BuildTextures();
+    }
+    frame.maxHeight_m_ += gerstner_.MaxAmplitude_m();
+    frame.maxHorizontal_m_ += gerstner_.MaxHorizontal_m();
+}
+
+std::shared_ptr<const OceanSurfaceFrame> OceanSurface::At(double t) const {
+    CHECK(std::isfinite(t));
+    std::lock_guard<std::mutex> lock(cache_->mutex);
+    std::vector<std::shared_ptr<OceanSurfaceFrame>>& frames = cache_->frames;
+    for (const std::shared_ptr<OceanSurfaceFrame>& f : frames)
+        if (std::bit_cast<uint64_t>(f->t_s_) == std::bit_cast<uint64_t>(t)) return f;
+    std::shared_ptr<OceanSurfaceFrame> frame;
+    if (frames.size() >= kCachedFrames) {
+        // Reuse the oldest frame's buffers when no one else holds it.
+        if (frames.front().use_count() == 1) frame = std::move(frames.front());
+        frames.erase(frames.begin());
+    }
+    if (!frame) frame = std::make_shared<OceanSurfaceFrame>();
+    // Isolated: while this thread waits inside the synthesis' parallel loops it must not pick
+    // up an outer task that could ask for a frame and block on the held lock.
+    tbb::this_task_arena::isolate([&] { Fill(*frame, t, false); });
+    frames.push_back(frame);
+    return frame;
+}
+
+std::shared_ptr<const OceanSurfaceFrame> OceanSurface::AtWithVelocity(double t) const {
+    CHECK(std::isfinite(t));
+    auto frame = std::make_shared<OceanSurfaceFrame>();
+    Fill(*frame, t, true);
+    return frame;
+}
+
+double OceanSurface::FoamCoverage(const OceanSample& s) const {
+    return std::clamp(1.0 - s.minEigenvalue / settings_.foamThreshold, 0.0, 1.0);
+}
+
+OceanPointQuery OceanSurface::Query(double x, double y, double t) const {
+    const std::shared_ptr<const OceanSurfaceFrame> frame = AtWithVelocity(t);
+    OceanPointQuery q;
+    q.surface = frame->SampleAt(x, y, &q.rest_m);
+    q.waterDepth_m = settings_.depth_m;
+    q.foamCoverage = FoamCoverage(q.surface);
+    return q;
+}
+
+void OceanSurface::Summarize() {
+    SeaSummary s;
+    s.spectral = fft_ != nullptr;
+    s.depth_m = settings_.depth_m;
+    s.peakPeriod_s = s.peakWavelength_m = s.dominantDirection_rad = kNaN;
+    s.phaseSpeed_mps = s.groupSpeed_mps = kNaN;
+    s.windSpeed_mps = s.windDirection_rad = kNaN;
+    double variance = 0.0;
+    for (size_t i = 0; i < gerstner_.WaveCount(); ++i)
+        variance += 0.5 * gerstner_.Amplitude_m(i) * gerstner_.Amplitude_m(i);
+    if (fft_) variance += fft_->ModeVariance_m2();
+    s.significantHeight_m = 4.0 * std::sqrt(variance);
+
+    double omega = 0.0, k = 0.0;
+    if (spectrum_) {
+        s.windSpeed_mps = spectrum_->Settings().windSpeed_mps;
+        s.windDirection_rad = spectrum_->Settings().windDirection_rad;
+        if (spectrum_->Variance_m2() > 0.0) {
+            // Peak of S(ω): a log-spaced scan (0.15 % steps), then golden-section refinement.
+            constexpr int kSteps = 6000;
+            const double lo = 0.01, ratio = std::pow(100.0 / lo, 1.0 / kSteps);
+            int best = 0;
+            double bestS = -1.0, w = lo;
+            for (int i = 0; i <= kSteps; ++i, w *= ratio) {
+                const double v = spectrum_->DensityOmega(w);
+                if (v > bestS) bestS = v, best = i;
+            }
+            double a = lo * std::pow(ratio, best - 1), b = lo * std::pow(ratio, best + 1);
+            const double phi = 0.5 * (std::sqrt(5.0) - 1.0);
+            for (int it = 0; it < 60; ++it) {
+                const double c = b - phi * (b - a), d = a + phi * (b - a);
+                if (spectrum_->DensityOmega(c) >= spectrum_->DensityOmega(d))
+                    b = d;
+                else
+                    a = c;
+            }
+            omega = 0.5 * (a + b);
+            k = WavenumberForOmega(omega, settings_.depth_m);
+            // Direction of travel where the directional spectrum at the peak is largest: a scan
+            // in 0.25° steps refined by the parabola through the best three.
+            constexpr int kAngles = 1440;
+            const auto density = [&](double az) {
+                return spectrum_->DensityK(k * std::sin(az), k * std::cos(az));
+            };
+            int bestA = 0;
+            double bestD = -1.0;
+            for (int i = 0; i < kAngles; ++i) {
+                const double v = density(kTwoPi * i / kAngles);
+                if (v > bestD) bestD = v, bestA = i;
+            }
+            const double h = kTwoPi / kAngles, az = h * bestA;
+            const double fm = density(az - h), f0 = bestD, fp = density(az + h);
+            const double curvature = fm - 2.0 * f0 + fp;
+            const double shift = curvature < 0.0 ? 0.5 * (fm - fp) / curvature : 0.0;
+            s.dominantDirection_rad = std::remainder(az + std::clamp(shift, -1.0, 1.0) * h, kTwoPi);
+            if (s.dominantDirection_rad < 0.0) s.dominantDirection_rad += kTwoPi;
+        }
+    } else if (gerstner_.WaveCount() > 0) {
+        size_t best = 0;
+        for (size_t i = 1; i < gerstner_.WaveCount(); ++i)
+            if (gerstner_.Amplitude_m(i) > gerstner_.Amplitude_m(best)) best = i;
+        if (gerstner_.Amplitude_m(best) > 0.0) {
+            omega = gerstner_.Omega_radps(best);
+            k = gerstner_.Wavenumber_radpm(best);
+            s.dominantDirection_rad = std::remainder(gerstner_.Direction_rad(best), kTwoPi);
+            if (s.dominantDirection_rad < 0.0) s.dominantDirection_rad += kTwoPi;
+        }
+    }
+    if (omega > 0.0 && k > 0.0) {
+        s.peakPeriod_s = kTwoPi / omega;
+        s.peakWavelength_m = kTwoPi / k;
+        s.phaseSpeed_mps = omega / k;
+        s.groupSpeed_mps = GroupSpeed(k, settings_.depth_m);
+    }
+    summary_ = s;
+}
+
+}  // namespace seasense::scene

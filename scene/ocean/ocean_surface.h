@@ -1,0 +1,205 @@
+// The sea surface of a scenario at any instant: FFT cascades (with band-limited lookups through
+// mip chains of their fields) plus Gerstner waves, committed once per frame time and shared by
+// the view meshes, the wave-riding entities and the truthful queries.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "scene/ocean/fft_ocean.h"
+#include "scene/ocean/gerstner.h"
+#include "scene/ocean/spectrum.h"
+#include "scene/ocean/surface_terms.h"
+#include "scene/scenario/scenario.h"
+
+namespace seasense::scene {
+
+// Geometry sums as the mesh builder accumulates them, in this order.
+enum GeometryTerm : int {
+    kTermHeight,  // η, m
+    kTermDispX,   // Dx, m
+    kTermDispY,   // Dy, m
+    kTermSlopeX,  // ∂η/∂x0
+    kTermSlopeY,  // ∂η/∂y0
+    kTermDispXX,  // ∂Dx/∂x0
+    kTermDispYY,  // ∂Dy/∂y0
+    kTermDispXY,  // ∂Dx/∂y0
+    kGeometryTerms
+};
+using GeometrySums = std::array<float, kGeometryTerms>;
+
+// Upward unit normal from geometry sums (single precision, for meshes): the cross product of the
+// tangents (1 + Dxx, Dxy, ηx) and (Dxy, 1 + Dyy, ηy).
+inline glm::vec3 GeometryNormal(const GeometrySums& s) {
+    const float a = 1.0f + s[kTermDispXX], d = 1.0f + s[kTermDispYY], b = s[kTermDispXY];
+    const float sx = s[kTermSlopeX], sy = s[kTermSlopeY];
+    glm::vec3 n(b * sy - sx * d, sx * b - a * sy, a * d - b * b);
+    const float len2 = glm::dot(n, n);
+    n = len2 > 0.0f ? n * (1.0f / std::sqrt(len2)) : glm::vec3(0.0f, 0.0f, 1.0f);
+    return n.z < 0.0f ? -n : n;  // folded surface: keep the normal upward
+}
+
+// Determinant of the horizontal Jacobian [[1 + Dxx, Dxy], [Dxy, 1 + Dyy]].
+inline float GeometryJacobian(const GeometrySums& s) {
+    const float a = 1.0f + s[kTermDispXX], d = 1.0f + s[kTermDispYY], b = s[kTermDispXY];
+    return a * d - b * b;
+}
+
+// The mip levels a footprint reads in each FFT cascade (see OceanSurfaceFrame::AccumulateFft):
+// level[c] with weight 1 − frac[c] and level[c] + 1 with weight frac[c].
+struct FftFilter {
+    static constexpr int kMaxCascades = 8;
+    std::array<int, kMaxCascades> level{};
+    std::array<float, kMaxCascades> frac{};
+};
+
+// The surface at one instant: an immutable snapshot once made by OceanSurface.
+class OceanSurfaceFrame {
+  public:
+    double Time_s() const { return t_s_; }
+
+    // Unfiltered surface (all FFT modes, all Gerstner waves) at rest position (x0, y0), world m,
+    // double precision. Velocity is NaN in frames made without velocities (OceanSurface::At).
+    SurfaceTerms Terms(double x0, double y0) const;
+    OceanSample Evaluate(double x0, double y0) const {
+        return MakeOceanSample(x0, y0, Terms(x0, y0));
+    }
+
+    // The surface drawn above world point (x, y): the rest position whose displaced horizontal
+    // position is (x, y), found by fixed-point iteration (a contraction while the surface does
+    // not fold), written to rest if given.
+    OceanSample SampleAt(double x, double y, glm::dvec2* rest = nullptr) const;
+    double HeightAt(double x, double y) const { return SampleAt(x, y).position.z; }
+
+    // Adds the FFT part of the surface at rest position (x0, y0), band-limited to a sampling
+    // footprint (m), to sums: each cascade is read from the mip level whose texel matches the
+    // footprint (trilinear between levels, box-filtered 2×2 mips), so a mesh with vertices
+    // `footprint` apart does not alias waves shorter than it can hold. A footprint at or below a
+    // cascade's grid spacing reads its full-resolution field (the same surface as Terms).
+    void AccumulateFft(double x0, double y0, float footprint_m, GeometrySums& sums) const {
+        AccumulateFft(x0, y0, Filter(footprint_m), sums);
+    }
+    // The same with the levels of a footprint resolved once (e.g. per mesh ring).
+    FftFilter Filter(float footprint_m) const;
+    void AccumulateFft(double x0, double y0, const FftFilter& filter, GeometrySums& sums) const;
+
+    // Unit upward normal of the surface at rest position (x0, y0) (world m) band-limited to a
+    // footprint (m), FFT cascades and Gerstner waves together: for shading finer than the mesh
+    // (per sample, with the sample's footprint on the sea), seed 001's normal-map idea.
+    glm::vec3 DetailNormal(double x0, double y0, float footprint_m) const;
+
+    // The Gerstner part (possibly without waves) and, for the spectral model, the FFT fields.
+    const GerstnerOcean& Gerstner() const { return gerstner_; }
+    const FftOceanFrame* Fft() const { return hasFft_ ? &fft_ : nullptr; }
+
+    // Bounds over the whole surface at this instant: largest |η| and largest horizontal
+    // displacement (m), for view culling and the horizon.
+    double MaxHeight_m() const { return maxHeight_m_; }
+    double MaxHorizontal_m() const { return maxHorizontal_m_; }
+    // Significant wave height of the sea (time-independent; for mesh spacing choices), m.
+    double SignificantHeight_m() const { return significantHeight_m_; }
+
+  private:
+    friend class OceanSurface;
+    struct Texel {
+        GeometrySums v;  // choppiness applied
+    };
+    // One cascade's geometry fields as a mip chain: level l has (N >> l)² texels, texel (i, j)
+    // averaging the 2^l × 2^l full-resolution nodes from (i, j) · 2^l, stored at i (N >> l) + j.
+    struct CascadeTexture {
+        double patch_m = 0.0;
+        double texel_m = 0.0;  // L / N
+        int n = 0;
+        std::vector<std::vector<Texel>> levels;
+    };
+    void BuildTextures();
+
+    double t_s_ = 0.0;
+    GerstnerOcean gerstner_;
+    bool hasFft_ = false;
+    FftOceanFrame fft_;
+    std::vector<CascadeTexture> textures_;
+    double maxHeight_m_ = 0.0;
+    double maxHorizontal_m_ = 0.0;
+    double significantHeight_m_ = 0.0;
+};
+
+// Statistics of the sea (time-independent).
+struct SeaSummary {
+    bool spectral = false;
+    // 4 √(variance of the drawn surface): the synthesized modes' variance plus A²/2 per Gerstner
+    // wave, m.
+    double significantHeight_m = 0.0;
+    // The dominant wave: for the spectral model the peak of the frequency spectrum (wind sea and
+    // swell) and the direction of travel where the directional spectrum peaks at that frequency;
+    // for Gerstner waves alone the wave of largest amplitude. NaN for a flat sea.
+    double peakPeriod_s = 0.0;
+    double peakWavelength_m = 0.0;
+    double dominantDirection_rad = 0.0;  // of travel, azimuth from north clockwise
+    double phaseSpeed_mps = 0.0;         // ω/k of the dominant wave at the depth
+    double groupSpeed_mps = 0.0;         // ½ c (1 + 2kh / sinh 2kh)
+    double depth_m = 0.0;                // still-water depth
+    // The wind the spectral sea was made from (NaN for Gerstner waves alone).
+    double windSpeed_mps = 0.0;
+    double windDirection_rad = 0.0;  // toward, azimuth from north clockwise
+};
+
+// What a query at a world point answers.
+struct OceanPointQuery {
+    OceanSample surface;        // the particle drawn above (x, y): position.z is the height
+    glm::dvec2 rest_m{0.0};     // its rest position
+    double waterDepth_m = 0.0;  // still-water depth (seabed below mean sea level)
+    // Foam coverage in [0, 1]: an instantaneous whitecap indicator from the horizontal
+    // Jacobian, 0 where its smaller eigenvalue is at or above the scenario's foam_threshold τ,
+    // rising linearly to 1 where the surface folds (eigenvalue ≤ 0): 1 − λ_min / τ, clamped.
+    double foamCoverage = 0.0;
+};
+
+class OceanSurface {
+  public:
+    // Throws InputError for invalid spectral settings.
+    explicit OceanSurface(const OceanSettings& settings);
+    ~OceanSurface();
+    OceanSurface(OceanSurface&&) noexcept;
+    OceanSurface& operator=(OceanSurface&&) noexcept;
+
+    // The surface at time t_s (seconds since frame 0), without velocities. Frames are cached
+    // (the two most recent times), so every user of one frame time shares one synthesis;
+    // thread-safe; the result is bit-identical for any thread count.
+    std::shared_ptr<const OceanSurfaceFrame> At(double t_s) const;
+    // The surface at t_s with surface velocities (a fresh synthesis, not cached).
+    std::shared_ptr<const OceanSurfaceFrame> AtWithVelocity(double t_s) const;
+
+    double HeightAt(double x, double y, double t_s) const { return At(t_s)->HeightAt(x, y); }
+
+    // Height, normal, orbital velocity, foam and depth at world point (x, y) at time t_s.
+    OceanPointQuery Query(double x, double y, double t_s) const;
+    // Foam coverage (OceanPointQuery::foamCoverage) of a sample.
+    double FoamCoverage(const OceanSample& sample) const;
+
+    const SeaSummary& Summary() const { return summary_; }
+    const OceanSettings& Settings() const { return settings_; }
+    bool Spectral() const { return fft_ != nullptr; }
+    const WaveSpectrum* Spectrum() const { return spectrum_.get(); }
+    const FftOcean* Fft() const { return fft_.get(); }
+    const GerstnerOcean& Gerstner() const { return gerstner_; }
+
+  private:
+    void Fill(OceanSurfaceFrame& frame, double t_s, bool withVelocity) const;
+    void Summarize();
+
+    OceanSettings settings_;
+    GerstnerOcean gerstner_;
+    std::unique_ptr<const WaveSpectrum> spectrum_;
+    std::unique_ptr<const FftOcean> fft_;
+    SeaSummary summary_;
+    struct Cache;
+    std::unique_ptr<Cache> cache_;
+};
+
+}  // namespace seasense::scene

@@ -1,0 +1,115 @@
+// The sea mesh as the channels rasterize it: watertight (every view ray that must meet the sea
+// does, in any attitude and as the eye moves), and contiguous channels share their vertices.
+#include "channels/view/view_geometry.h"
+
+#include <gtest/gtest.h>
+#include <tbb/task_arena.h>
+
+#include <cmath>
+#include <numbers>
+
+namespace seasense::channels {
+namespace {
+
+constexpr double kRad = std::numbers::pi / 180.0;
+
+scene::Scenario SpectralSea(double eyeHeight_m, double pitch_deg, double roll_deg) {
+    scene::Scenario sc;
+    sc.world.start = *scene::ParseIso8601("2026-06-21T12:00:00Z");
+    sc.world.seed = 5;
+    sc.environment.sun.elevation_rad = 0.6;
+    sc.environment.ocean.depth_m = 60.0;
+    scene::SpectralOceanSettings s;
+    s.sea.beaufort = 4;
+    s.sea.spectrum.windDirection_rad = 0.3;
+    s.fft.gridSize = 128;
+    s.fft.seed = 5;
+    sc.environment.ocean.spectral = s;
+    sc.eyepoint.position_m = {0.0, 0.0, eyeHeight_m};
+    sc.eyepoint.attitude.heading_rad = 0.4;
+    sc.eyepoint.attitude.pitch_rad = pitch_deg * kRad;
+    sc.eyepoint.attitude.roll_rad = roll_deg * kRad;
+    sc.eyepoint.speed_mps = 7.0;
+    scene::ChannelSettings ch;
+    ch.name = "view";
+    ch.width = 320;
+    ch.height = 240;
+    ch.hfov_rad = 60.0 * kRad;
+    ch.supersampling = 1;
+    sc.channels.push_back(ch);
+    return sc;
+}
+
+TEST(ViewGeometry, SeaMeshLeavesNoGapBelowTheHorizon) {
+    // A ray that dips below the horizon of the highest crest by more than a small margin must
+    // meet the sea (a sphere of mean radius R whose surface lies within ±MaxHeight): any sample
+    // there that sees nothing looks through a crack. Several attitudes, eye heights and frames.
+    struct Case {
+        double height, pitch, roll;
+    };
+    for (const Case c : {Case{2.0, -2.0, 0.0}, Case{2.0, -30.0, 25.0}, Case{40.0, -10.0, -40.0},
+                         Case{300.0, -89.0, 0.0}}) {
+        const scene::Scenario sc = SpectralSea(c.height, c.pitch, c.roll);
+        const scene::World world(sc);
+        ViewGeometry view(world, sc.channels[0]);
+        tbb::task_arena arena(2);
+        int checked = 0;
+        for (int64_t frame : {0, 17}) {
+            arena.execute([&] { view.Update(world.State(frame)); });
+            const ChannelCamera& cam = view.Camera();
+            const VisibilityBuffer& vis = view.Visibility();
+            const double crest = view.OceanFrame().MaxHeight_m();
+            const glm::dvec3 eye = cam.worldFromCamera.position_m;
+            const double h = eye.z;
+            // The eye is above the water (below it, the sea is seen from underneath: culled).
+            ASSERT_GT(h, view.OceanFrame().HeightAt(eye.x, eye.y) + 0.3);
+            // Dip of the horizon of a point at height h + crest above a trough-level sphere.
+            const double dip =
+                std::acos(scene::kEarthRadius_m / (scene::kEarthRadius_m + h + crest));
+            const double margin = 2.0 * cam.hfov_rad / cam.SampleWidth();  // two samples
+            for (int y = 0; y < cam.SampleHeight(); ++y)
+                for (int x = 0; x < cam.SampleWidth(); ++x) {
+                    const glm::dvec3 d = cam.SampleDirection(x, y);
+                    if (d.z > -std::sin(dip + margin)) continue;
+                    ++checked;
+                    ASSERT_NE(vis.primitive[vis.Index(x, y)], kNoPrimitive)
+                        << "height " << c.height << " pitch " << c.pitch << " roll " << c.roll
+                        << " frame " << frame << " sample " << x << "," << y;
+                }
+        }
+        EXPECT_GT(checked, 10000) << c.height;
+    }
+}
+
+TEST(ViewGeometry, ContiguousChannelsShareTheirSeaVertices) {
+    // Vertices sit at world-fixed azimuths, so the left and centre channels of a row (equal
+    // resolution and field of view) build the same vertices where their sectors overlap.
+    scene::Scenario sc = SpectralSea(2.0, -1.0, 0.0);
+    scene::ChannelSettings left = sc.channels[0];
+    left.name = "left";
+    left.attitude.heading_rad = -60.0 * kRad;
+    sc.channels.push_back(left);
+    const scene::World world(sc);
+    ViewGeometry centre(world, sc.channels[0]), side(world, sc.channels[1]);
+    const scene::SceneState state = world.State(3);
+    centre.Update(state);
+    side.Update(state);
+    const scene::OceanMesh &a = centre.Ocean(), &b = side.Ocean();
+    ASSERT_EQ(a.circleSegments, b.circleSegments);
+    ASSERT_EQ(a.radii_m, b.radii_m);
+    const int columnsA = a.segments + 1, columnsB = b.segments + 1;
+    int shared = 0;
+    for (int ca = 0; ca < columnsA; ++ca) {
+        const int cb = ca + a.firstColumn - b.firstColumn;
+        if (cb < 0 || cb >= columnsB) continue;
+        for (int j = 0; j < a.rings; ++j) {
+            ASSERT_EQ(a.positions[size_t(j * columnsA + ca)],
+                      b.positions[size_t(j * columnsB + cb)]);
+            ++shared;
+        }
+    }
+    EXPECT_GT(shared, 1000);  // the overlap holds the 20° margins of both sectors
+}
+
+}  // namespace
+}  // namespace seasense::channels
