@@ -310,6 +310,16 @@ scene::ConfigValue ImagerNode(const std::string& noise = "noise: {netd_mK: 0}\n"
     return ParseValue(noise + "agc: {time_constant_s: 0}\n", "imager.yaml");
 }
 
+// The small imaged channel of the pipeline tests: 32×24 pixels, 2×2 supersampled, the ideal
+// imager.
+void SmallImagedChannel(scene::ChannelSettings& ch, double hfov_deg) {
+    ch.width = 32;
+    ch.height = 24;
+    ch.hfov_rad = hfov_deg * M_PI / 180.0;
+    ch.supersampling = 2;
+    ch.imager = ImagerNode();
+}
+
 // A blackbody plate (ε = 1, fixed 320 K) filling the view of a 32×24 imager looking straight
 // down from height_m, through air at 290 K.
 scene::Scenario PlateBelow(const fs::path& dir, double height_m, const std::string& humidity) {
@@ -320,12 +330,7 @@ scene::Scenario PlateBelow(const fs::path& dir, double height_m, const std::stri
     sc.entities.push_back({"plate", dir / "plate.obj", {0, 0, 0}, {}, 1.0, "black"});
     sc.eyepoint.position_m = {0, 0, 0.2 + height_m};
     sc.eyepoint.attitude.pitch_rad = -0.5 * M_PI;
-    scene::ChannelSettings& ch = sc.channels[0];
-    ch.width = 32;
-    ch.height = 24;
-    ch.hfov_rad = 20.0 * M_PI / 180.0;
-    ch.supersampling = 2;
-    ch.imager = ImagerNode();
+    SmallImagedChannel(sc.channels[0], 20.0);
     return sc;
 }
 
@@ -398,11 +403,7 @@ TEST(FlirPipeline, PathCorrectedTemperatureOfADistantPlate) {
     // imager's blur kernel.
     sc.eyepoint.position_m = {0, 0, 40};
     scene::ChannelSettings& ch = sc.channels[0];
-    ch.width = 32;
-    ch.height = 24;
-    ch.hfov_rad = 4.0 * M_PI / 180.0;
-    ch.supersampling = 2;
-    ch.imager = ImagerNode();
+    SmallImagedChannel(ch, 4.0);
     const scene::World world(sc);
     ChannelPipeline pipeline(world, ch, dir / "out", {"exr"}, DefaultOcioConfig());
     pipeline.RenderAndWrite(0);
@@ -451,9 +452,7 @@ TEST(FlirPipeline, TemporalNoiseOf64FramesIsTheConfiguredNetd) {
     sc.eyepoint.position_m = {0, 0, 2.2};
     sc.eyepoint.attitude.pitch_rad = -0.5 * M_PI;
     scene::ChannelSettings& ch = sc.channels[0];
-    ch.width = 32;
-    ch.height = 24;
-    ch.hfov_rad = 20.0 * M_PI / 180.0;
+    SmallImagedChannel(ch, 20.0);
     ch.imager = ImagerNode("noise: {netd_mK: 80}\n");
     const scene::World world(sc);
     ChannelPipeline pipeline(world, ch, dir / "out", {"exr"}, DefaultOcioConfig());
