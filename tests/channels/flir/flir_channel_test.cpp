@@ -288,6 +288,21 @@ channels:
     fs::remove_all(dir);
 }
 
+TEST(FlirChannel, ShadingTransmittanceTableFollowsTheAtmosphere) {
+    // The per-sample path transmittance is a table over √range; it must stay with the exact
+    // band transmittance of radiometry::Atmosphere from a metre to the table's 200 km.
+    scene::Scenario sc = BaseScenario();
+    sc.environment.visibility_m = 3000.0;
+    const scene::World world(sc);
+    FlirChannel flir(world, sc.channels[0]);
+    const radiometry::Atmosphere& air = flir.GetAtmosphere();
+    double worst = 0.0;
+    for (double range = 1.0; range < 2e5; range *= 1.07)
+        worst = std::max(worst,
+                         std::abs(flir.PathTransmittance(float(range)) - air.Transmittance(range)));
+    EXPECT_LT(worst, 2e-4);
+}
+
 // Reads channel `name` of an EXR or PNG (any channel count) as floats, row 0 on top.
 std::vector<float> ReadChannel(const fs::path& file, const std::string& name, int& width,
                                int& height) {
