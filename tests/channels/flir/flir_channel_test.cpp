@@ -17,6 +17,7 @@
 #include "radiometry/planck/planck.h"
 #include "scene/config/config.h"
 #include "scene/core/error.h"
+#include "scene/scenario/scenario_loader.h"
 #include "sensors/thermal/thermal_imager.h"
 #include "tests/support/meshes.h"
 #include "tests/support/shell.h"
@@ -301,6 +302,37 @@ TEST(FlirChannel, ShadingTransmittanceTableFollowsTheAtmosphere) {
         worst = std::max(worst,
                          std::abs(flir.PathTransmittance(float(range)) - air.Transmittance(range)));
     EXPECT_LT(worst, 2e-4);
+}
+
+TEST(FlirConfigs, AfternoonAndNightExamplesShowTheirThermalSignatures) {
+    // configs/flir.yaml: the boat's west (port) side, toward the afternoon sun, is warmer than
+    // the air; configs/flir-night.yaml: every hull orientation has cooled below the sea under
+    // the night sky. In both the 420 K stack is in view, the hottest thing in the frame, and
+    // the field of view follows from the imager (640 × 17 µm behind 25 mm).
+    const fs::path configs = fs::path(SEASENSE_SOURCE_DIR) / "configs";
+    for (const char* name : {"flir.yaml", "flir-night.yaml"}) {
+        SCOPED_TRACE(name);
+        const scene::Scenario sc = scene::LoadScenario(configs / name);
+        const scene::World world(sc);
+        const fs::path out = TempDir("configs");
+        ChannelPipeline pipeline(world, sc.channels.at(0), out, {"exr"}, DefaultOcioConfig());
+        EXPECT_NEAR(pipeline.Flir().Settings().hfov_rad, 2.0 * std::atan(640 * 17e-6 / 0.05), 1e-9);
+        pipeline.Render(world.Advance(0));
+        const Image T = pipeline.Imager().ApparentTemperature();
+        const float hottest = *std::max_element(T.pixels.begin(), T.pixels.end());
+        EXPECT_GT(hottest, 380.0f);
+        EXPECT_LT(hottest, 425.0f);
+        FlirChannel flir(world, sc.channels.at(0));
+        const auto hull = flir.EntityTemperatures_K(0, 0.0);  // entity 0: the boat
+        const double air = 293.0, sea = 291.0;
+        if (std::string(name) == "flir.yaml") {
+            // Orientation class 7: horizontal, facing west; + 10: sunlit.
+            EXPECT_GT(hull[10 + 7], air + 5.0);
+        } else {
+            for (double t : hull) EXPECT_LT(t, sea);
+        }
+        fs::remove_all(out);
+    }
 }
 
 // Reads channel `name` of an EXR or PNG (any channel count) as floats, row 0 on top.
