@@ -1,5 +1,7 @@
 #!/usr/bin/env python3
-"""Writes configs/models/patrol_boat.obj: a 20 m patrol boat built from convex solids.
+"""Writes configs/models/patrol_boat.obj: a 20 m patrol boat built from convex solids, and
+configs/models/patrol_boat_stack.obj: its stack alone, 2 cm wider and taller, so that a second
+entity with a hot material (configs/flir.yaml) can cover the boat's own stack.
 
 Axes follow glTF: +Y up, +Z forward (bow), +X to port; metres; the waterline is y = 0.
 Each solid is convex, so outward face winding is fixed by comparing each face's Newell
@@ -59,10 +61,10 @@ class Obj:
             faces.append([bottom[i], bottom[j], top[j], top[i]])
         self.solid(name, faces)
 
-    def write(self, path):
+    def write(self, path, what="20 m patrol boat"):
         tmp = path + ".tmp"
         with open(tmp, "w") as f:
-            f.write("# seasense example model: 20 m patrol boat (scripts/make_example_model.py)\n")
+            f.write(f"# seasense example model: {what} (scripts/make_example_model.py)\n")
             f.write("# glTF axes: +Y up, +Z forward (bow), +X port; metres; waterline y = 0\n")
             for x, y, z in self.v:
                 f.write(f"v {x:.4f} {y:.4f} {z:.4f}\n")
@@ -76,9 +78,16 @@ class Obj:
         os.replace(tmp, path)
 
 
+def stack_outline(radius):
+    """Octagonal stack aft of the bridge."""
+    return [(radius * math.cos(a), -5.5 + radius * math.sin(a))
+            for a in (2 * math.pi * k / 8 for k in range(8))]
+
+
 def main():
-    out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(
-        os.path.dirname(__file__), "..", "configs", "models", "patrol_boat.obj")
+    folder = sys.argv[1] if len(sys.argv) > 1 else os.path.join(
+        os.path.dirname(__file__), "..", "configs", "models")
+    os.makedirs(folder, exist_ok=True)
     m = Obj()
     # Hull: 20 m long, 5 m beam, pointed bow, 1 m draft, 1.6 m freeboard.
     hull = [(2.5, -10.0), (2.5, 5.0), (0.0, 10.0), (-2.5, 5.0), (-2.5, -10.0)]
@@ -86,12 +95,13 @@ def main():
     # Superstructure (bridge) amidships.
     bridge = [(1.8, -4.0), (1.8, 2.0), (-1.8, 2.0), (-1.8, -4.0)]
     m.prism("bridge", bridge, 1.6, 4.2)
-    # Octagonal stack aft of the bridge.
-    stack = [(0.6 * math.cos(a), -5.5 + 0.6 * math.sin(a))
-             for a in (2 * math.pi * k / 8 for k in range(8))]
-    m.prism("stack", stack, 1.6, 6.0)
-    os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
-    m.write(out)
+    m.prism("stack", stack_outline(0.6), 1.6, 6.0)
+    m.write(os.path.join(folder, "patrol_boat.obj"))
+    # The stack for its own material: 2 cm outside the boat's stack on every side but the
+    # bottom, which stands on the deck.
+    s = Obj()
+    s.prism("stack", stack_outline(0.62), 1.6, 6.02)
+    s.write(os.path.join(folder, "patrol_boat_stack.obj"), "stack of the 20 m patrol boat")
 
 
 if __name__ == "__main__":

@@ -47,9 +47,14 @@ void RunCapture(const CaptureOptions& opt) {
         std::transform(f.begin(), f.end(), f.begin(),
                        [](unsigned char c) { return std::tolower(c); });
         if (f == "tif") f = "tiff";
-        if (f != "exr" && f != "png" && f != "tiff")
+        if (f == "raw_tif") f = "raw_tiff";
+        // raw_png/raw_tiff (flir channels only) are checked against the channel's kind by
+        // ChannelPipeline.
+        if (f != "exr" && f != "png" && f != "tiff" && f != "raw_png" && f != "raw_tiff")
             throw InputError(
-                "--format: expected a comma-separated subset of exr, png, tiff; found '" + f + "'");
+                "--format: expected a comma-separated subset of exr, png, tiff, raw_png, "
+                "raw_tiff; found '" +
+                f + "'");
     }
 
     const int threads =

@@ -63,9 +63,11 @@ int main(int argc, char** argv) {
                         "Simulation start, ISO-8601 UTC (overrides world.start_utc)");
     capture->add_option("--out", cap.out, "Output folder (created if missing)")
         ->capture_default_str();
-    capture->add_option("--format", formats,
-                        "Comma-separated output formats: exr (scene-linear float), png, tiff "
-                        "(display 8-bit); default: the channel's output.formats");
+    capture->add_option(
+        "--format", formats,
+        "Comma-separated output formats: exr (scene-linear float; flir: radiometric "
+        "L and T), png, tiff (display 8-bit), raw_png, raw_tiff (flir: 16-bit "
+        "ADC counts); default: the channel's output.formats");
     capture->add_option("--threads", cap.threads, "Worker threads (0 = all cores)")
         ->capture_default_str();
 

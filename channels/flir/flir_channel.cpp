@@ -3,14 +3,16 @@
 // (heat balance per orientation class, sunlit or shaded by Embree), all through the path.
 #include "channels/flir/flir_channel.h"
 
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
-#include <algorithm>
 #include <chrono>
-#include <cmath>
+#include <map>
 
+#include "channels/view/surface_gather.h"
 #include "scene/core/check.h"
 #include "scene/core/error.h"
+#include "scene/core/simd4.h"
 #include "scene/sky/ephemeris.h"
 #include "scene/sky/illuminance.h"
 
@@ -18,15 +20,37 @@ namespace seasense::channels {
 
 namespace {
 
+using namespace simd4;
+
 // Luminous efficacy of direct-beam sunlight, lm/W: about 93 for a clear sky at moderate
 // elevations (Littlefair, "The luminous efficacy of daylight: a review", Lighting Res.
 // Technol. 17, 162 (1985)); converts the scene's sun illuminance to irradiance.
 constexpr double kSunEfficacy_lm_W = 93.0;
 
+// Shading tables. Sky over cos θ: 1025 nodes keep the linear interpolation within 1e-4
+// relative of the exact spectral sum (the sky radiance is smooth in cos θ). Path over √range
+// to 200 km (as Atmosphere's own table): 4097 nodes, steps of 0.11 √m, 2.2 m at 100 m range;
+// the square root resolves short ranges, where the strongly absorbed parts of a band decay.
+constexpr int kSkyNodes = 1025;
+constexpr int kPathNodes = 4097;
+constexpr double kMaxPathRange_m = 2.0e5;
+
+// Sample rows per parallel task, and samples per shading chunk (a chunk's arrays stay in L1).
+constexpr int kRowsPerBlock = 8;
+constexpr size_t kChunk = 256;
+
 // Shadow-ray offset along the normal: 1 mm plus 4e-6 of the largest coordinate (as the OTW
 // channel), clear of float self-intersection.
 glm::vec3 ShadowRayOrigin(const glm::vec3& p, const glm::vec3& n) {
     return p + n * (4e-6f * std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)}) + 1e-3f);
+}
+
+// A surface's at-aperture radiance τ·[ε·B + (1 − ε)·L_sky] + (1 − τ)·B_air, four lanes, in the
+// order of the scalar expression.
+F4 Aperture4(F4 tau, F4 eps, F4 B, F4 sky, F4 airB) {
+    const F4 one = Set4(1.0f);
+    const F4 L = _mm_add_ps(_mm_mul_ps(eps, B), _mm_mul_ps(_mm_sub_ps(one, eps), sky));
+    return _mm_add_ps(_mm_mul_ps(tau, L), _mm_mul_ps(_mm_sub_ps(one, tau), airB));
 }
 
 }  // namespace
@@ -66,21 +90,32 @@ glm::dvec3 OrientationTemperatures::ClassNormal(int o) {
     return {std::sin(az), std::cos(az), 0.0};
 }
 
-radiometry::ThermalDrivers OrientationTemperatures::DriversAt(int cls, double time_s) const {
-    const int o = cls % kOrientations;
-    const bool sunlit = cls >= kOrientations;
-    const glm::dvec3 n = ClassNormal(o);
-    radiometry::ThermalDrivers d;
-    d.time_s = time_s;
+OrientationTemperatures::Drivers OrientationTemperatures::DriversAt(double time_s) const {
     glm::dvec3 sunDir;
     const double E = SunIrradiance_W_m2(scenario_, time_s, sunDir);
-    d.solarIrradiance_W_m2 = sunlit ? E * std::max(glm::dot(n, sunDir), 0.0) : 0.0;
-    d.longwaveIrradiance_W_m2 = radiometry::TiltedLongwaveIrradiance_W_m2(
-        environment_.skyLongwave_W_m2, std::acos(std::clamp(n.z, -1.0, 1.0)),
-        environment_.seaTemperature_K);
-    d.airTemperature_K = environment_.airTemperature_K;
-    d.windSpeed_mps = environment_.windSpeed_mps;
-    return d;
+    Drivers all;
+    for (int cls = 0; cls < kClasses; ++cls) {
+        const int o = cls % kOrientations;
+        const bool sunlit = cls >= kOrientations;
+        const glm::dvec3 n = ClassNormal(o);
+        radiometry::ThermalDrivers& d = all[size_t(cls)];
+        d.time_s = time_s;
+        d.solarIrradiance_W_m2 = sunlit ? E * std::max(glm::dot(n, sunDir), 0.0) : 0.0;
+        d.longwaveIrradiance_W_m2 = radiometry::TiltedLongwaveIrradiance_W_m2(
+            environment_.skyLongwave_W_m2, std::acos(std::clamp(n.z, -1.0, 1.0)),
+            environment_.seaTemperature_K);
+        d.airTemperature_K = environment_.airTemperature_K;
+        d.windSpeed_mps = environment_.windSpeed_mps;
+    }
+    return all;
+}
+
+std::array<double, OrientationTemperatures::kClasses> OrientationTemperatures::Step(
+    const std::array<double, kClasses>& from, const Drivers& a, const Drivers& b) const {
+    std::array<double, kClasses> to;
+    for (size_t c = 0; c < size_t(kClasses); ++c)
+        to[c] = radiometry::IntegrateSurfaceTemperature(parameters_, {a[c], b[c]}, from[c]).back();
+    return to;
 }
 
 std::array<double, OrientationTemperatures::kClasses> OrientationTemperatures::At(double time_s) {
@@ -88,43 +123,55 @@ std::array<double, OrientationTemperatures::kClasses> OrientationTemperatures::A
     const auto NodeTime = [](size_t k) { return -kSpinUp_s + double(k) * kGridStep_s; };
     const size_t k = size_t(std::floor((time_s + kSpinUp_s) / kGridStep_s));
     if (nodes_.empty()) {
+        lastNodeDrivers_ = DriversAt(NodeTime(0));
         std::array<double, kClasses> first;
-        for (int c = 0; c < kClasses; ++c)
-            first[size_t(c)] =
-                radiometry::EquilibriumTemperature_K(parameters_, DriversAt(c, NodeTime(0)));
+        for (size_t c = 0; c < size_t(kClasses); ++c)
+            first[c] = radiometry::EquilibriumTemperature_K(parameters_, lastNodeDrivers_[c]);
         nodes_.push_back(first);
     }
     // Extend the grid node by node: each interval is integrated on its own, so a node's value
     // does not depend on how far earlier calls went.
     while (nodes_.size() <= k) {
-        const size_t j = nodes_.size();
-        std::array<double, kClasses> next;
-        for (int c = 0; c < kClasses; ++c) {
-            const std::vector<radiometry::ThermalDrivers> d = {DriversAt(c, NodeTime(j - 1)),
-                                                               DriversAt(c, NodeTime(j))};
-            next[size_t(c)] =
-                radiometry::IntegrateSurfaceTemperature(parameters_, d, nodes_[j - 1][size_t(c)])
-                    .back();
-        }
-        nodes_.push_back(next);
+        const Drivers next = DriversAt(NodeTime(nodes_.size()));
+        nodes_.push_back(Step(nodes_.back(), lastNodeDrivers_, next));
+        lastNodeDrivers_ = next;
     }
-    std::array<double, kClasses> out = nodes_[k];
-    if (time_s > NodeTime(k)) {
-        for (int c = 0; c < kClasses; ++c) {
-            const std::vector<radiometry::ThermalDrivers> d = {DriversAt(c, NodeTime(k)),
-                                                               DriversAt(c, time_s)};
-            out[size_t(c)] =
-                radiometry::IntegrateSurfaceTemperature(parameters_, d, nodes_[k][size_t(c)])
-                    .back();
-        }
+    if (!(time_s > NodeTime(k))) return nodes_[k];
+    // The node's drivers again (k is usually the last node, whose drivers are kept).
+    const Drivers atNode = k + 1 == nodes_.size() ? lastNodeDrivers_ : DriversAt(NodeTime(k));
+    return Step(nodes_[k], atNode, DriversAt(time_s));
+}
+
+UniformTable::UniformTable(std::vector<float> nodes, float xMax)
+    : nodes_(std::move(nodes)),
+      scale_(float(nodes_.size() - 1) / xMax),
+      last_(float(nodes_.size() - 1)) {
+    CHECK(nodes_.size() >= 2 && xMax > 0.0f);
+}
+
+void UniformTable::operator()(size_t count, const float* x, float* out) const {
+    const F4 scale = Set4(scale_), last = Set4(last_), lastCell = Set4(float(nodes_.size() - 2));
+    for (size_t i = 0; i < count; i += 4) {
+        const size_t lanes = std::min<size_t>(4, count - i);
+        // clamp(x·scale, 0, last) as std::clamp: min(max(u, 0), last).
+        const F4 u = _mm_min_ps(
+            Max4(_mm_mul_ps(LoadLanes(x + i, lanes, 0.0f), scale), _mm_setzero_ps()), last);
+        const I4 cell = _mm_cvttps_epi32(_mm_min_ps(u, lastCell));
+        alignas(16) int32_t c[4];
+        _mm_store_si128(reinterpret_cast<__m128i*>(c), cell);
+        const F4 a = _mm_setr_ps(nodes_[size_t(c[0])], nodes_[size_t(c[1])], nodes_[size_t(c[2])],
+                                 nodes_[size_t(c[3])]);
+        const F4 b = _mm_setr_ps(nodes_[size_t(c[0]) + 1], nodes_[size_t(c[1]) + 1],
+                                 nodes_[size_t(c[2]) + 1], nodes_[size_t(c[3]) + 1]);
+        const F4 f = _mm_sub_ps(u, _mm_cvtepi32_ps(cell));
+        StoreLanes(out + i, lanes, _mm_add_ps(a, _mm_mul_ps(_mm_sub_ps(b, a), f)));
     }
-    return out;
 }
 
 FlirChannel::FlirChannel(const scene::World& world, const scene::ChannelSettings& settings)
     : world_(world),
-      settings_(settings),
-      geometry_(world, settings),
+      setup_(ResolveFlirImager(settings, world.GetScenario().world.seed)),
+      geometry_(world, setup_.channel),
       air_(world.GetScenario().environment.atmosphere
                ? radiometry::ParseAtmosphereSettings(*world.GetScenario().environment.atmosphere)
                : radiometry::AtmosphereSettings{}),
@@ -140,6 +187,19 @@ FlirChannel::FlirChannel(const scene::World& world, const scene::ChannelSettings
         throw InputError("scenario " + sc.file.string() +
                          ": the flir channel needs the material table's emissivities and "
                          "thermal models, but no material table was loaded");
+    std::vector<float> nodes(kSkyNodes);
+    for (int i = 0; i < kSkyNodes; ++i)
+        nodes[size_t(i)] = float(atmosphere_.SkyRadiance(double(i) / (kSkyNodes - 1)));
+    skyTable_ = UniformTable(std::move(nodes), 1.0f);
+    seaEmissivity_ = UniformTable(seaCurve_.Nodes(), 1.0f);
+    nodes.assign(kPathNodes, 0.0f);
+    const double maxRoot = std::sqrt(kMaxPathRange_m);
+    for (int i = 0; i < kPathNodes; ++i) {
+        const double root = maxRoot * double(i) / (kPathNodes - 1);
+        nodes[size_t(i)] = float(atmosphere_.Transmittance(root * root));
+    }
+    pathTau_ = UniformTable(std::move(nodes), float(maxRoot));
+
     const radiometry::MaterialTable materials = radiometry::ParseMaterialTable(*sc.materialTable);
     radiometry::ThermalEnvironment thermalEnv;
     thermalEnv.airTemperature_K = air_.airTemperature_K;
@@ -149,19 +209,25 @@ FlirChannel::FlirChannel(const scene::World& world, const scene::ChannelSettings
     env.seaTemperature_K = sea_.temperature_K;
     env.windSpeed_mps = sc.environment.windSpeed_mps;
     env.skyLongwave_W_m2 = atmosphere_.SkyLongwaveIrradiance_W_m2();
+    // Entities of one heat-balance material share its temperatures (same drivers).
+    std::map<std::string, int> heatBalanceOf;
     for (const scene::EntitySettings& e : sc.entities) {
         const radiometry::Material& m = materials.Get(e.material);
         EntityThermal t;
         t.emissivity =
             settings.band == scene::InfraredBand::Mwir ? m.emissivityMwir : m.emissivityLwir;
         if (m.thermal.kind == radiometry::ThermalModelKind::HeatBalance) {
-            radiometry::HeatBalanceParameters p = m.thermal.heatBalance;
-            p.emissivity = m.emissivityLwir;
-            t.heatBalance = std::make_unique<OrientationTemperatures>(p, env, world.GetScenario());
+            auto [it, added] = heatBalanceOf.emplace(e.material, int(heatBalance_.size()));
+            if (added) {
+                radiometry::HeatBalanceParameters p = m.thermal.heatBalance;
+                p.emissivity = m.emissivityLwir;
+                heatBalance_.push_back(std::make_unique<OrientationTemperatures>(p, env, sc));
+            }
+            t.heatBalance = it->second;
         } else {
             t.staticT_K = m.StaticTemperature_K(thermalEnv);
         }
-        entities_.push_back(std::move(t));
+        entities_.push_back(t);
     }
 }
 
@@ -170,11 +236,204 @@ FlirChannel::~FlirChannel() = default;
 std::array<double, OrientationTemperatures::kClasses> FlirChannel::EntityTemperatures_K(
     size_t entity, double time_s) {
     CHECK(entity < entities_.size());
-    EntityThermal& t = entities_[entity];
-    if (t.heatBalance) return t.heatBalance->At(time_s);
+    const EntityThermal& t = entities_[entity];
+    if (t.heatBalance >= 0) return heatBalance_[size_t(t.heatBalance)]->At(time_s);
     std::array<double, OrientationTemperatures::kClasses> out;
     out.fill(t.staticT_K);
     return out;
+}
+
+void FlirChannel::UpdateEntityRadiance(double time_s) {
+    constexpr int kC = OrientationTemperatures::kClasses;
+    entityB_.resize(entities_.size());
+    for (size_t i = 0; i < entities_.size(); ++i) {
+        const std::array<double, kC> T = EntityTemperatures_K(i, time_s);
+        for (size_t c = 0; c < size_t(kC); ++c) entityB_[i][c] = float(table_.Radiance(T[c]));
+    }
+}
+
+// The constants of one frame's shading.
+struct FlirChannel::FrameShading {
+    FrameShading(const VisibilityBuffer& v, const OcclusionScene& o) : vis(v), occlusion(o) {}
+
+    const VisibilityBuffer& vis;
+    const OcclusionScene& occlusion;
+    std::vector<MeshArrays> meshes;  // mesh 0 the sea
+    int sampleWidth = 0, sampleHeight = 0;
+    glm::vec3 eye{0.0f}, sunDir{0.0f};
+    bool shadows = false;
+    float seaB = 0.0f, airB = 0.0f;
+    // View rays: direction ∝ forward + up·ndcY − right + (x + ½)·colStep (the camera axes
+    // scaled by the pinhole geometry), so sky samples need no trigonometry.
+    glm::vec3 colStep{0.0f};
+    glm::dvec3 forward{0.0}, right{0.0}, up{0.0};
+};
+
+// Per-thread scratch of the shading pass, kept between frames. Samples of a row block are
+// sorted into sky, sea and model lists so that sky and sea are shaded four lanes at a time in
+// structure-of-arrays chunks; the few model samples go one by one.
+struct FlirChannel::ShadeScratch {
+    struct Block {
+        std::vector<uint32_t> skyK, seaK;  // sample index within the block
+        std::vector<float> skyZ, skyLength;
+        std::vector<float> px, py, pz, nx, ny, nz;
+        std::vector<uint32_t> modelK;
+        std::vector<glm::vec3> modelP, modelN;
+        std::vector<int> modelMesh;
+        std::vector<glm::vec3> origins;
+        std::vector<uint32_t> originOwner;
+        std::vector<uint8_t> lit, visible;
+        alignas(16) float a[kChunk], b[kChunk], c[kChunk], d[kChunk], e[kChunk];
+
+        void Reserve(size_t n) {
+            if (skyK.size() >= n) return;
+            for (std::vector<float>* v : {&skyZ, &skyLength, &px, &py, &pz, &nx, &ny, &nz})
+                v->resize(n);
+            skyK.resize(n), seaK.resize(n);
+        }
+    };
+    tbb::enumerable_thread_specific<Block> perThread;
+};
+
+uint64_t FlirChannel::ShadeRows(const FrameShading& f, int y0, int y1, float* out) {
+    constexpr int kC = OrientationTemperatures::kClasses,
+                  kO = OrientationTemperatures::kOrientations;
+    ShadeScratch::Block& sc = scratch_->perThread.local();
+    const int sw = f.sampleWidth;
+    sc.Reserve(size_t(y1 - y0) * size_t(sw));
+    sc.modelK.clear(), sc.modelP.clear(), sc.modelN.clear(), sc.modelMesh.clear();
+    sc.origins.clear(), sc.originOwner.clear();
+
+    // Pass 1: sort the samples by kind; sky view directions, surface positions and normals.
+    size_t skyCount = 0, seaCount = 0;
+    TriangleCache tri;
+    for (int y = y0; y < y1; ++y) {
+        const double ndcY = 1.0 - 2.0 * (y + 0.5) / f.sampleHeight;
+        const glm::vec3 rowBase(f.forward + f.up * ndcY - f.right);
+        const size_t row = f.vis.Index(0, y);
+        const uint32_t* prims = f.vis.primitive.data() + row;
+        const float* b1 = f.vis.b1.data() + row;
+        const float* b2 = f.vis.b2.data() + row;
+        const uint32_t kRow = uint32_t(size_t(y - y0) * size_t(sw));
+        for (int x = 0; x < sw; ++x) {
+            const uint32_t k = kRow + uint32_t(x), prim = prims[x];
+            if (prim == kNoPrimitive) {
+                const glm::vec3 d = rowBase + (float(x) + 0.5f) * f.colStep;
+                sc.skyK[skyCount] = k;
+                sc.skyZ[skyCount] = d.z;
+                sc.skyLength[skyCount] = glm::dot(d, d);
+                ++skyCount;
+                continue;
+            }
+            alignas(16) float p[4], n[4];
+            int mesh = 0;
+            tri.Surface(f.vis.primitiveBase, f.meshes, prim, b1[x], b2[x], p, n, mesh);
+            if (mesh == 0) {
+                sc.seaK[seaCount] = k;
+                sc.px[seaCount] = p[0], sc.py[seaCount] = p[1], sc.pz[seaCount] = p[2];
+                sc.nx[seaCount] = n[0], sc.ny[seaCount] = n[1], sc.nz[seaCount] = n[2];
+                ++seaCount;
+                continue;
+            }
+            const glm::vec3 position(p[0], p[1], p[2]);
+            glm::vec3 normal = glm::normalize(glm::vec3(n[0], n[1], n[2]));
+            if (glm::dot(normal, f.eye - position) < 0.0f) normal = -normal;
+            sc.modelK.push_back(k);
+            sc.modelP.push_back(position);
+            sc.modelN.push_back(normal);
+            sc.modelMesh.push_back(mesh);
+            if (f.shadows) {
+                const glm::vec3 o = ShadowRayOrigin(position, normal);
+                if (f.occlusion.MayOcclude(o, f.sunDir, 1e30f)) {
+                    sc.origins.push_back(o);
+                    sc.originOwner.push_back(uint32_t(sc.modelK.size() - 1));
+                }
+            }
+        }
+    }
+
+    // Pass 2: sky, L_sky(cos θ) with cos θ = d_z / |d|.
+    for (size_t c = 0; c < skyCount; c += kChunk) {
+        const size_t count = std::min(kChunk, skyCount - c);
+        for (size_t i = 0; i < count; i += 4) {
+            const size_t lanes = std::min<size_t>(4, count - i);
+            const F4 z = LoadLanes(&sc.skyZ[c + i], lanes, 1.0f);
+            const F4 len2 = LoadLanes(&sc.skyLength[c + i], lanes, 1.0f);
+            _mm_store_ps(sc.a + i, _mm_div_ps(z, _mm_sqrt_ps(len2)));
+        }
+        skyTable_(count, sc.a, sc.b);
+        for (size_t i = 0; i < count; ++i) out[sc.skyK[c + i]] = sc.b[i];
+    }
+
+    // Pass 3: sea. Emissivity at the local view angle (Masuda's wind average for the unresolved
+    // slopes), sky reflected about the resolved normal (a ray reflected into the sea meets the
+    // next wave's sky), through the path.
+    const F4 eyeX = Set4(f.eye.x), eyeY = Set4(f.eye.y), eyeZ = Set4(f.eye.z);
+    for (size_t c = 0; c < seaCount; c += kChunk) {
+        const size_t count = std::min(kChunk, seaCount - c);
+        for (size_t i = 0; i < count; i += 4) {
+            const size_t lanes = std::min<size_t>(4, count - i);
+            const size_t j = c + i;
+            F4 nx = LoadLanes(&sc.nx[j], lanes, 0.0f), ny = LoadLanes(&sc.ny[j], lanes, 0.0f),
+               nz = LoadLanes(&sc.nz[j], lanes, 1.0f);
+            const F4 invN = _mm_div_ps(Set4(1.0f), _mm_sqrt_ps(Dot4(nx, ny, nz, nx, ny, nz)));
+            nx = _mm_mul_ps(nx, invN), ny = _mm_mul_ps(ny, invN), nz = _mm_mul_ps(nz, invN);
+            const F4 tx = _mm_sub_ps(eyeX, LoadLanes(&sc.px[j], lanes, 0.0f));
+            const F4 ty = _mm_sub_ps(eyeY, LoadLanes(&sc.py[j], lanes, 0.0f));
+            const F4 tz = _mm_sub_ps(eyeZ, LoadLanes(&sc.pz[j], lanes, 1.0f));
+            const F4 range2 = Dot4(tx, ty, tz, tx, ty, tz);
+            const F4 range = _mm_sqrt_ps(range2);
+            const F4 invRange = _mm_div_ps(Set4(1.0f), range);
+            const F4 ndv = _mm_mul_ps(Dot4(nx, ny, nz, tx, ty, tz), invRange);
+            const F4 rz =
+                _mm_sub_ps(_mm_mul_ps(_mm_mul_ps(Set4(2.0f), ndv), nz), _mm_mul_ps(tz, invRange));
+            _mm_store_ps(sc.a + i, Max4(ndv, _mm_setzero_ps()));  // cos θ_view
+            _mm_store_ps(sc.b + i, Abs4(rz));                     // reflected ray's cos θ_zenith
+            _mm_store_ps(sc.c + i, _mm_sqrt_ps(range));           // √range
+        }
+        seaEmissivity_(count, sc.a, sc.d);
+        skyTable_(count, sc.b, sc.e);
+        pathTau_(count, sc.c, sc.a);
+        const F4 seaB = Set4(f.seaB), airB = Set4(f.airB);
+        for (size_t i = 0; i < count; i += 4)
+            _mm_store_ps(sc.b + i, Aperture4(_mm_load_ps(sc.a + i), _mm_load_ps(sc.d + i), seaB,
+                                             _mm_load_ps(sc.e + i), airB));
+        for (size_t i = 0; i < count; ++i) out[sc.seaK[c + i]] = sc.b[i];
+    }
+
+    // Pass 4: models (a small fraction of the frame): sunlit or shaded by the shadow rays.
+    sc.lit.assign(sc.modelK.size(), f.sunDir.z > 0.0f ? 1 : 0);
+    if (!sc.origins.empty()) {
+        sc.visible.resize(sc.origins.size());
+        f.occlusion.DirectionalVisibility(sc.origins, f.sunDir, 0.0f, sc.visible);
+        for (size_t r = 0; r < sc.origins.size(); ++r) sc.lit[sc.originOwner[r]] = sc.visible[r];
+    }
+    for (size_t i = 0; i < sc.modelK.size(); ++i) {
+        const glm::vec3 p = sc.modelP[i], n = sc.modelN[i];
+        const size_t entity = size_t(sc.modelMesh[i]) - 1;
+        // Orientation classes: up/down by n.z, horizontal azimuths linear in angle.
+        const std::array<float, kC>& B = entityB_[entity];
+        const int base = sc.lit[i] && glm::dot(n, f.sunDir) > 0.0f ? kO : 0;
+        const float up = std::max(n.z, 0.0f), down = std::max(-n.z, 0.0f);
+        const float side = 1.0f - up - down;
+        float az = std::atan2(n.x, n.y) / float(M_PI / 4.0);
+        if (az < 0.0f) az += 8.0f;
+        const int a0 = std::min(int(az), 7), a1 = (a0 + 1) % 8;
+        const float w = az - float(a0);
+        const float Bs =
+            up * B[size_t(base)] + down * B[size_t(base + kO - 1)] +
+            side * ((1.0f - w) * B[size_t(base + 1 + a0)] + w * B[size_t(base + 1 + a1)]);
+        const glm::vec3 toEye = f.eye - p;
+        const float range = glm::length(toEye);
+        const glm::vec3 v = toEye / range;
+        // Reflected sky; rays reflected downward see the horizon (sea and air near B_air).
+        const float rz = 2.0f * glm::dot(n, v) * n.z - v.z;
+        const float eps = float(entities_[entity].emissivity);
+        const float L = eps * Bs + (1.0f - eps) * skyTable_(std::max(rz, 0.0f));
+        const float tau = pathTau_(std::sqrt(range));
+        out[sc.modelK[i]] = tau * L + (1.0f - tau) * f.airB;
+    }
+    return sc.origins.size();
 }
 
 void FlirChannel::Render(const scene::SceneState& state, Image& radiance) {
@@ -186,145 +445,42 @@ void FlirChannel::Render(const scene::SceneState& state, Image& radiance) {
     stats_ = {};
     stats_.view = geometry_.Stats();
     const Clock::time_point t0 = Clock::now();
-
-    // Band blackbody radiance of each entity's orientation classes for this frame.
-    constexpr int kC = OrientationTemperatures::kClasses,
-                  kO = OrientationTemperatures::kOrientations;
-    std::vector<std::array<float, kC>> entityB(entities_.size());
-    for (size_t i = 0; i < entities_.size(); ++i) {
-        const std::array<double, kC> T = EntityTemperatures_K(i, state.time_s);
-        for (int c = 0; c < kC; ++c) entityB[i][size_t(c)] = float(table_.Radiance(T[size_t(c)]));
-    }
+    UpdateEntityRadiance(state.time_s);
     const Clock::time_point t1 = Clock::now();
     stats_.thermalMs = Ms(t0, t1);
 
     const ChannelCamera& cam = geometry_.Camera();
     const VisibilityBuffer& vis = geometry_.Visibility();
     const OcclusionScene& occlusion = geometry_.Occlusion();
-    const scene::OceanMesh& ocean = geometry_.Ocean();
-    const std::vector<scene::TriangleMesh>& meshes = geometry_.EntityMeshes();
     const int sw = cam.SampleWidth(), sh = cam.SampleHeight();
     if (radiance.width != sw || radiance.height != sh || radiance.channels != 1)
         radiance = Image(sw, sh, 1);
 
-    const glm::vec3 sunDir(state.sun.direction);
-    const bool shadows = settings_.shadows && !occlusion.Empty() && sunDir.z > 0.0f;
-    const glm::vec3 eye(cam.worldFromCamera.position_m);
-    const float seaB = float(table_.Radiance(sea_.temperature_K));
-    const float airB = float(atmosphere_.AirRadiance());
     const glm::dmat3& R = cam.worldFromCamera.worldFromBody;
     const double tanH = cam.TanHalfH(), tanV = cam.TanHalfV();
-    const glm::dvec3 forward = R * glm::dvec3(0.0, 1.0, 0.0);
+    FrameShading frame(vis, occlusion);
+    const scene::OceanMesh& ocean = geometry_.Ocean();
+    frame.meshes.push_back({ocean.positions.data(), ocean.normals.data(), ocean.indices.data()});
+    for (const scene::TriangleMesh& m : geometry_.EntityMeshes())
+        frame.meshes.push_back({m.positions.data(), m.normals.data(), m.indices.data()});
+    frame.sampleWidth = sw;
+    frame.sampleHeight = sh;
+    frame.eye = glm::vec3(cam.worldFromCamera.position_m);
+    frame.sunDir = glm::vec3(state.sun.direction);
+    frame.shadows = setup_.channel.shadows && !occlusion.Empty() && frame.sunDir.z > 0.0f;
+    frame.seaB = float(table_.Radiance(sea_.temperature_K));
+    frame.airB = float(atmosphere_.AirRadiance());
+    frame.colStep = glm::vec3(R * glm::dvec3(2.0 * tanH / sw, 0.0, 0.0));
+    frame.forward = R * glm::dvec3(0.0, 1.0, 0.0);
+    frame.right = R * glm::dvec3(tanH, 0.0, 0.0);
+    frame.up = R * glm::dvec3(0.0, 0.0, tanV);
 
-    struct MeshRef {
-        const glm::vec3* P;
-        const glm::vec3* N;
-        const uint32_t* I;
-    };
-    std::vector<MeshRef> refs;
-    refs.push_back({ocean.positions.data(), ocean.normals.data(), ocean.indices.data()});
-    for (const scene::TriangleMesh& m : meshes)
-        refs.push_back({m.positions.data(), m.normals.data(), m.indices.data()});
-
-    // Sky band radiance toward zenith cosine cosZenith (the horizon's at and below 0).
-    const auto Sky = [&](float cosZenith) { return atmosphere_.SkyLookUp(cosZenith); };
-
-    constexpr int kRowsPerBlock = 8;
+    if (!scratch_) scratch_ = std::make_unique<ShadeScratch>();
     const int blocks = (sh + kRowsPerBlock - 1) / kRowsPerBlock;
     std::vector<uint64_t> blockRays(size_t(blocks), 0);
     tbb::parallel_for(0, blocks, [&](int block) {
         const int y0 = block * kRowsPerBlock, y1 = std::min(sh, y0 + kRowsPerBlock);
-        // Model samples wait for their shadow rays: sample index, position, normal, mesh.
-        std::vector<uint32_t> modelK;
-        std::vector<glm::vec3> modelP, modelN;
-        std::vector<int> modelMesh;
-        std::vector<glm::vec3> origins;
-        std::vector<uint32_t> originOwner;
-        float* out = radiance.At(0, y0);
-        for (int y = y0; y < y1; ++y) {
-            const double ndcY = 1.0 - 2.0 * (y + 0.5) / sh;
-            for (int x = 0; x < sw; ++x) {
-                const uint32_t k = uint32_t(size_t(y - y0) * size_t(sw) + size_t(x));
-                const size_t idx = vis.Index(x, y);
-                const uint32_t prim = vis.primitive[idx];
-                if (prim == kNoPrimitive) {
-                    const double ndcX = 2.0 * (x + 0.5) / sw - 1.0;
-                    const glm::dvec3 d =
-                        glm::normalize(forward + R * glm::dvec3(ndcX * tanH, 0.0, ndcY * tanV));
-                    out[k] = Sky(float(d.z));
-                    continue;
-                }
-                int mesh = 0;
-                while (mesh + 1 < int(vis.primitiveBase.size()) &&
-                       prim >= vis.primitiveBase[size_t(mesh) + 1])
-                    ++mesh;
-                const MeshRef& m = refs[size_t(mesh)];
-                const uint32_t t = prim - vis.primitiveBase[size_t(mesh)];
-                const uint32_t i0 = m.I[3 * t], i1 = m.I[3 * t + 1], i2 = m.I[3 * t + 2];
-                const float b1 = vis.b1[idx], b2 = vis.b2[idx], b0 = 1.0f - b1 - b2;
-                const glm::vec3 p = b0 * m.P[i0] + b1 * m.P[i1] + b2 * m.P[i2];
-                glm::vec3 n = glm::normalize(b0 * m.N[i0] + b1 * m.N[i1] + b2 * m.N[i2]);
-                const glm::vec3 toEye = eye - p;
-                const float range = glm::length(toEye);
-                const glm::vec3 v = toEye / range;
-                if (mesh == 0) {
-                    // Sea: emissivity at the local view angle (Masuda's wind average for the
-                    // unresolved slopes), sky reflected about the resolved normal; a ray
-                    // reflected into the sea meets the next wave's sky.
-                    const float ndv = glm::dot(n, v);
-                    const float eps = seaCurve_.Emissivity(std::max(ndv, 0.0f));
-                    const float rz = std::abs(2.0f * ndv * n.z - v.z);
-                    const float L = eps * seaB + (1.0f - eps) * Sky(rz);
-                    const float tau = atmosphere_.TransmittanceLookUp(range);
-                    out[k] = tau * L + (1.0f - tau) * airB;
-                    continue;
-                }
-                if (glm::dot(n, v) < 0.0f) n = -n;
-                modelK.push_back(k);
-                modelP.push_back(p);
-                modelN.push_back(n);
-                modelMesh.push_back(mesh);
-                if (shadows) {
-                    const glm::vec3 o = ShadowRayOrigin(p, n);
-                    if (occlusion.MayOcclude(o, sunDir, 1e30f)) {
-                        origins.push_back(o);
-                        originOwner.push_back(uint32_t(modelK.size() - 1));
-                    }
-                }
-            }
-        }
-        std::vector<uint8_t> lit(modelK.size(), sunDir.z > 0.0f ? 1 : 0);
-        if (!origins.empty()) {
-            std::vector<uint8_t> visible(origins.size());
-            occlusion.DirectionalVisibility(origins, sunDir, 0.0f, visible);
-            for (size_t r = 0; r < origins.size(); ++r) lit[originOwner[r]] = visible[r];
-            blockRays[size_t(block)] = origins.size();
-        }
-        for (size_t i = 0; i < modelK.size(); ++i) {
-            const glm::vec3 p = modelP[i], n = modelN[i];
-            const size_t entity = size_t(modelMesh[i]) - 1;
-            // Orientation classes: up/down by n.z, horizontal azimuths linear in angle.
-            const std::array<float, kC>& B = entityB[entity];
-            const int base = lit[i] && glm::dot(n, sunDir) > 0.0f ? kO : 0;
-            const float up = std::max(n.z, 0.0f), down = std::max(-n.z, 0.0f);
-            const float side = 1.0f - up - down;
-            float az = std::atan2(n.x, n.y) / float(M_PI / 4.0);
-            if (az < 0.0f) az += 8.0f;
-            const int a0 = std::min(int(az), 7), a1 = (a0 + 1) % 8;
-            const float f = az - float(a0);
-            const float Bs =
-                up * B[size_t(base)] + down * B[size_t(base + kO - 1)] +
-                side * ((1.0f - f) * B[size_t(base + 1 + a0)] + f * B[size_t(base + 1 + a1)]);
-            const glm::vec3 toEye = eye - p;
-            const float range = glm::length(toEye);
-            const glm::vec3 v = toEye / range;
-            // Reflected sky; rays reflected downward see the horizon (sea and air near B_air).
-            const float rz = 2.0f * glm::dot(n, v) * n.z - v.z;
-            const float eps = float(entities_[entity].emissivity);
-            const float L = eps * Bs + (1.0f - eps) * Sky(std::max(rz, 0.0f));
-            const float tau = atmosphere_.TransmittanceLookUp(range);
-            out[modelK[i]] = tau * L + (1.0f - tau) * airB;
-        }
+        blockRays[size_t(block)] = ShadeRows(frame, y0, y1, radiance.At(0, y0));
     });
     for (uint64_t r : blockRays) stats_.shadowRays += r;
     stats_.shadeMs = Ms(t1, Clock::now());

@@ -2,10 +2,13 @@
 // LWIR or MWIR band, from emissivity, temperature, reflected sky and the atmospheric path.
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <memory>
 #include <vector>
 
+#include "channels/flir/flir_imager.h"
 #include "channels/view/view_geometry.h"
 #include "radiometry/atmosphere/atmosphere.h"
 #include "radiometry/materials/material_table.h"
@@ -55,12 +58,41 @@ class OrientationTemperatures {
     std::array<double, kClasses> At(double time_s);
 
   private:
-    radiometry::ThermalDrivers DriversAt(int cls, double time_s) const;
+    using Drivers = std::array<radiometry::ThermalDrivers, kClasses>;
+    // The drivers of every class at time_s (one sun position for all of them).
+    Drivers DriversAt(double time_s) const;
+    // Integrates each class from temperatures `from` under drivers a to drivers b.
+    std::array<double, kClasses> Step(const std::array<double, kClasses>& from, const Drivers& a,
+                                      const Drivers& b) const;
 
     radiometry::HeatBalanceParameters parameters_;
     Environment environment_;
     const scene::Scenario& scenario_;
     std::vector<std::array<double, kClasses>> nodes_;  // temperatures at grid nodes 0, 1, …
+    Drivers lastNodeDrivers_;                          // drivers at the last node in nodes_
+};
+
+// A function tabulated at uniformly spaced nodes x_i = i·xMax/(n − 1), linear between them;
+// arguments are clamped to [0, xMax]. Inline (also four lanes wide) for per-sample shading.
+class UniformTable {
+  public:
+    UniformTable() = default;
+    // nodes: the values at x_0 … x_{n−1}, n ≥ 2.
+    UniformTable(std::vector<float> nodes, float xMax);
+
+    float operator()(float x) const {
+        const float u = std::clamp(x * scale_, 0.0f, last_);
+        const size_t i = std::min(size_t(u), nodes_.size() - 2);
+        return nodes_[i] + (nodes_[i + 1] - nodes_[i]) * (u - float(i));
+    }
+    // operator() of each of count values (any count), lane for lane the same arithmetic.
+    void operator()(size_t count, const float* x, float* out) const;
+    float XMax() const { return last_ / scale_; }
+
+  private:
+    std::vector<float> nodes_{0.0f, 0.0f};
+    float scale_ = 1.0f;  // (n − 1) / xMax
+    float last_ = 1.0f;   // n − 1
 };
 
 // Direct shortwave irradiance (W·m⁻²) on a surface normal to the sun at the scenario's site
@@ -69,8 +101,9 @@ double SunIrradiance_W_m2(const scene::Scenario& scenario, double time_s, glm::d
 
 class FlirChannel {
   public:
-    // Reads the atmosphere, sea and material table of the world's scenario (InputError on bad
-    // settings or an entity whose material the table lacks).
+    // Reads the atmosphere, sea and material table of the world's scenario and the channel's
+    // imager (ResolveFlirImager: the camera takes the field of view resolved there). InputError
+    // (ConfigError) on bad settings or an entity whose material the table lacks.
     FlirChannel(const scene::World& world, const scene::ChannelSettings& settings);
     ~FlirChannel();
 
@@ -78,6 +111,13 @@ class FlirChannel {
     // radiance: (width·N)×(height·N)×1. Runs in the caller's oneTBB arena; bit-identical for
     // any thread count.
     void Render(const scene::SceneState& state, Image& radiance);
+
+    // The channel with its field of view resolved, and its imager's settings.
+    const scene::ChannelSettings& Settings() const { return setup_.channel; }
+    const sensors::ThermalImagerSettings& ImagerSettings() const { return setup_.imager; }
+    // Path transmittance over range_m as the shading looks it up (a table over √range of
+    // Atmosphere::Transmittance).
+    float PathTransmittance(float range_m) const { return pathTau_(std::sqrt(range_m)); }
 
     const radiometry::Band& GetBand() const { return table_.GetBand(); }
     // B(T) of the band and its inverse (apparent temperature).
@@ -96,18 +136,33 @@ class FlirChannel {
     struct EntityThermal {
         double emissivity = 1.0;  // in the channel's band
         double staticT_K = 0.0;   // Fixed, Air, Sea models
-        std::unique_ptr<OrientationTemperatures> heatBalance;
+        // Heat-balance models: index into heatBalance_ (one per material), or −1.
+        int heatBalance = -1;
     };
+    struct ShadeScratch;
+    struct FrameShading;
+
+    // Band blackbody radiance of every entity's orientation classes at time_s.
+    void UpdateEntityRadiance(double time_s);
+    // Shades the sample rows [y0, y1) into out (the rows' first sample); returns the number
+    // of shadow rays traced.
+    uint64_t ShadeRows(const FrameShading& frame, int y0, int y1, float* out);
 
     const scene::World& world_;
-    scene::ChannelSettings settings_;
+    FlirImagerSetup setup_;
     ViewGeometry geometry_;
     radiometry::AtmosphereSettings air_;
     radiometry::SeaSettings sea_;
     radiometry::BandRadianceTable table_;
     radiometry::Atmosphere atmosphere_;
     radiometry::SeaEmissivityCurve seaCurve_;
+    // Per-sample lookups: sky radiance over cos θ_zenith, sea emissivity over cos θ_view and
+    // path transmittance over √range.
+    UniformTable skyTable_, seaEmissivity_, pathTau_;
     std::vector<EntityThermal> entities_;
+    std::vector<std::unique_ptr<OrientationTemperatures>> heatBalance_;
+    std::vector<std::array<float, OrientationTemperatures::kClasses>> entityB_;
+    std::unique_ptr<ShadeScratch> scratch_;
     FlirFrameStats stats_;
 };
 

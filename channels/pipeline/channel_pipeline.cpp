@@ -13,6 +13,7 @@
 #include "scene/core/error.h"
 #include "sensors/detector/detector.h"
 #include "sensors/output/image_writer.h"
+#include "sensors/thermal/thermal_output.h"
 
 #ifndef SEASENSE_SOURCE_DIR
 #define SEASENSE_SOURCE_DIR "."
@@ -105,8 +106,20 @@ ChannelPipeline::ChannelPipeline(const scene::World& world, const scene::Channel
       channel_(channel),
       channelDir_(std::move(outDir) / channel.name),
       formats_(std::move(formats)) {
-    if (channel_.kind == scene::ChannelKind::Flir) {
+    const bool thermal = channel_.kind == scene::ChannelKind::Flir;
+    for (const std::string& f : formats_) {
+        const bool raw = f == "raw_png" || f == "raw_tiff";
+        if (f == "exr" || f == "png" || f == "tiff" || (raw && thermal)) continue;
+        std::string msg = "channel '";
+        msg += channel_.name + "': output format '" + f + "'; expected exr, png, tiff";
+        msg += thermal ? ", raw_png or raw_tiff" : " (raw_png and raw_tiff are for flir channels)";
+        throw InputError(msg);
+    }
+    if (thermal) {
         flir_ = std::make_unique<FlirChannel>(world_, channel_);
+        channel_ = flir_->Settings();  // the field of view resolved with the imager
+        imager_ = std::make_unique<sensors::ThermalImager>(
+            flir_->ImagerSettings(), flir_->GetBand(), channel_.supersampling);
         return;
     }
     if (channel_.kind != scene::ChannelKind::Otw)
@@ -126,22 +139,13 @@ const FlirChannel& ChannelPipeline::Flir() const {
     return *flir_;
 }
 
-const ChannelCamera& ChannelPipeline::Camera() const {
-    return flir_ ? flir_->Camera() : otw_->Camera();
+const sensors::ThermalImager& ChannelPipeline::Imager() const {
+    CHECK(imager_);
+    return *imager_;
 }
 
-std::vector<uint8_t> ChannelPipeline::WhiteHot8(const Image& temperature, double lo_K,
-                                                double hi_K) {
-    const size_t n = size_t(temperature.width) * size_t(temperature.height);
-    std::vector<uint8_t> rgb(3 * n);
-    // A uniform frame has no contrast to stretch: show it mid-grey.
-    const double scale = hi_K > lo_K ? 255.0 / (hi_K - lo_K) : 0.0;
-    for (size_t i = 0; i < n; ++i) {
-        const double v = scale > 0.0 ? (double(temperature.pixels[i]) - lo_K) * scale : 127.5;
-        const uint8_t q = uint8_t(std::lround(std::clamp(v, 0.0, 255.0)));
-        rgb[3 * i] = rgb[3 * i + 1] = rgb[3 * i + 2] = q;
-    }
-    return rgb;
+const ChannelCamera& ChannelPipeline::Camera() const {
+    return flir_ ? flir_->Camera() : otw_->Camera();
 }
 
 FrameRecord ChannelPipeline::RenderAndWrite(int64_t frame) {
@@ -162,20 +166,7 @@ FrameRecord ChannelPipeline::Render(const scene::FrameState& frame) {
         flir_->Render(state_, samples_);
         rec.renderMs = MsSince(t0);
         t0 = std::chrono::steady_clock::now();
-        sensors::IntegrateFootprint(samples_, channel_.supersampling, pixels_);
-        if (temperature_.width != pixels_.width || temperature_.height != pixels_.height)
-            temperature_ = Image(pixels_.width, pixels_.height, 1);
-        const radiometry::BandRadianceTable& table = flir_->RadianceTable();
-        const int w = pixels_.width;
-        tbb::parallel_for(0, pixels_.height, [&](int y) {
-            const float* L = pixels_.At(0, y);
-            float* T = temperature_.At(0, y);
-            for (int x = 0; x < w; ++x) T[x] = float(table.Temperature(double(L[x])));
-        });
-        const auto [lo, hi] =
-            std::minmax_element(temperature_.pixels.begin(), temperature_.pixels.end());
-        minT_K_ = *lo;
-        maxT_K_ = *hi;
+        imager_->Process(samples_, state_.time_s, state_.frame);
         displayValid_ = false;
         rec.sensorMs = MsSince(t0);
         return rec;
@@ -196,8 +187,19 @@ FrameRecord ChannelPipeline::Render(const scene::FrameState& frame) {
 
 const std::vector<uint8_t>& ChannelPipeline::DisplayRgb8() {
     if (!displayValid_) {
-        display8_ = flir_ ? WhiteHot8(temperature_, minT_K_, maxT_K_)
-                          : display_->ToDisplay8(pixels_, float(std::exp2(ev_)));
+        if (imager_) {
+            // The imager's display: gray (one byte per pixel) or already RGB.
+            const std::span<const uint8_t> d = imager_->Display();
+            if (imager_->DisplayChannels() == 3) {
+                display8_.assign(d.begin(), d.end());
+            } else {
+                display8_.resize(3 * d.size());
+                for (size_t i = 0; i < d.size(); ++i)
+                    display8_[3 * i] = display8_[3 * i + 1] = display8_[3 * i + 2] = d[i];
+            }
+        } else {
+            display8_ = display_->ToDisplay8(pixels_, float(std::exp2(ev_)));
+        }
         displayValid_ = true;
     }
     return display8_;
@@ -205,16 +207,15 @@ const std::vector<uint8_t>& ChannelPipeline::DisplayRgb8() {
 
 std::vector<uint8_t> ChannelPipeline::PreviewRgb8(int width, int height) {
     CHECK(width > 0 && height > 0);
-    if (flir_) {
-        // The frame's own display range, so the preview matches the full-size display.
-        if (width == temperature_.width && height == temperature_.height)
-            return WhiteHot8(temperature_, minT_K_, maxT_K_);
-        Image small(width, height, 1);
-        const cv::Mat src(temperature_.height, temperature_.width, CV_32FC1,
-                          const_cast<float*>(temperature_.pixels.data()));
-        cv::Mat dst(height, width, CV_32FC1, small.pixels.data());
+    if (imager_) {
+        const std::vector<uint8_t>& rgb = DisplayRgb8();
+        if (width == channel_.width && height == channel_.height) return rgb;
+        std::vector<uint8_t> small(size_t(width) * size_t(height) * 3);
+        const cv::Mat src(channel_.height, channel_.width, CV_8UC3,
+                          const_cast<uint8_t*>(rgb.data()));
+        cv::Mat dst(height, width, CV_8UC3, small.data());
         cv::resize(src, dst, dst.size(), 0, 0, cv::INTER_AREA);
-        return WhiteHot8(small, minT_K_, maxT_K_);
+        return small;
     }
     if (!previewLut_) previewLut_ = std::make_unique<sensors::DisplayLut>(*display_);
     if (width == pixels_.width && height == pixels_.height)
@@ -227,38 +228,38 @@ std::vector<uint8_t> ChannelPipeline::PreviewRgb8(int width, int height) {
     return previewLut_->ToDisplay8(small, float(std::exp2(ev_)));
 }
 
+void ChannelPipeline::WriteThermal(const sensors::ImageMetadata& md, const std::string& base,
+                                   FrameRecord& rec) {
+    for (const std::string& fmt : formats_) {
+        sensors::ThermalOutputPaths paths;
+        std::filesystem::path path;
+        if (fmt == "exr") {
+            path = paths.radiometricExr = channelDir_ / (base + ".exr");
+        } else if (fmt == "png" || fmt == "tiff") {
+            path = paths.display = channelDir_ / (base + "." + fmt);
+        } else {  // raw_png, raw_tiff
+            path = paths.rawCounts = channelDir_ / (base + "_raw." + fmt.substr(4));
+        }
+        sensors::WriteThermalFrame(*imager_, paths, md);
+        rec.files.push_back(path);
+    }
+}
+
 void ChannelPipeline::Write(FrameRecord& rec) {
     const auto t0 = std::chrono::steady_clock::now();
     sensors::ImageMetadata md = FrameMetadata(world_, channel_, state_, Camera(), ev_);
-    Image exr;
-    sensors::ExrOptions exrOptions;
-    if (flir_) {
-        const radiometry::Band& band = flir_->GetBand();
-        md.Set("seasense:band", band.Name());
-        md.Set("seasense:band_min_wavelength_um", float(band.MinWavelength_m() * 1e6));
-        md.Set("seasense:band_max_wavelength_um", float(band.MaxWavelength_m() * 1e6));
-        md.Set("seasense:units",
-               std::string("L: band radiance at the aperture, W/(m^2 sr); T: apparent "
-                           "(blackbody-equivalent) temperature, K"));
-        md.Set("seasense:display", std::string("white-hot, linear between the frame's minimum "
-                                               "and maximum apparent temperature"));
-        md.Set("seasense:display_min_K", float(minT_K_));
-        md.Set("seasense:display_max_K", float(maxT_K_));
-        md.Set("seasense:sensor", std::string("detector footprint (100 % fill), no noise"));
-        exr = Image(pixels_.width, pixels_.height, 2);
-        for (size_t i = 0; i < temperature_.pixels.size(); ++i) {
-            exr.pixels[2 * i] = pixels_.pixels[i];
-            exr.pixels[2 * i + 1] = temperature_.pixels[i];
-        }
-        exrOptions.channelNames = {"L", "T"};
-    }
     char stem[64];
     std::snprintf(stem, sizeof stem, "_%06lld", (long long)rec.frame);
     const std::string base = channel_.name + stem;
+    if (imager_) {
+        WriteThermal(md, base, rec);
+        rec.writeMs = MsSince(t0);
+        return;
+    }
     for (const std::string& fmt : formats_) {
         const std::filesystem::path path = channelDir_ / (base + "." + fmt);
         if (fmt == "exr")
-            sensors::WriteExr(path, flir_ ? exr : pixels_, md, exrOptions);
+            sensors::WriteExr(path, pixels_, md);
         else
             sensors::WriteDisplayImage8(path, DisplayRgb8(), pixels_.width, pixels_.height, 3, md);
         rec.files.push_back(path);

@@ -1,6 +1,6 @@
 // One channel end to end for a frame: render at-aperture radiance, apply the sensor model
-// (detector footprint, exposure), display (OCIO for visible, white-hot for thermal) and write
-// the frame's files.
+// (visible: detector footprint and exposure; thermal: the thermal imager), display (OCIO for
+// visible, the imager's AGC and palette for thermal) and write the frame's files.
 #pragma once
 
 #include <filesystem>
@@ -13,6 +13,7 @@
 #include "scene/world/world.h"
 #include "sensors/display/display_lut.h"
 #include "sensors/display/ocio_display.h"
+#include "sensors/thermal/thermal_imager.h"
 
 namespace seasense::channels {
 
@@ -29,11 +30,17 @@ struct FrameRecord {
 
 class ChannelPipeline {
   public:
-    // outDir: files go to outDir/<channel>/. formats ⊂ {exr, png, tiff}. ocioConfig: path of
-    // the OCIO config for visible channels. Throws InputError for an unsupported channel kind.
-    // Flir channels: the sensor is the detector footprint; EXR holds band radiance
-    // (W·m⁻²·sr⁻¹) and apparent temperature (K); the display is white-hot, linear between the
-    // frame's minimum and maximum apparent temperature.
+    // outDir: files go to outDir/<channel>/. formats ⊂ {exr, png, tiff}, for flir channels
+    // also raw_png and raw_tiff. ocioConfig: path of the OCIO config for visible channels.
+    // Throws InputError for an unsupported channel kind or format.
+    // Flir channels: the sensor is the channel's sensors::ThermalImager (FlirChannel::
+    // ImagerSettings). Files per frame: exr, the radiometric EXR (L: band radiance at the
+    // aperture as measured, W·m⁻²·sr⁻¹; T: its apparent temperature, K); png/tiff, the 8-bit
+    // AGC display; raw_png/raw_tiff (<name>_raw.png/.tiff), the 16-bit raw ADC counts.
+    // The imager is stateful (bolometer lag, AGC memory): its history starts, settled, at the
+    // first frame this pipeline renders, and its temporal noise is keyed by the frame index;
+    // so frames n0, n0 + 1, … rendered by any two pipelines from the same first frame n0 are
+    // bit-identical.
     ChannelPipeline(const scene::World& world, const scene::ChannelSettings& channel,
                     std::filesystem::path outDir, std::vector<std::string> formats,
                     const std::filesystem::path& ocioConfig);
@@ -48,9 +55,10 @@ class ChannelPipeline {
     void Write(FrameRecord& record);
     // The display image of the last rendered frame: 8-bit RGB, Width()×Height(), row 0 on top.
     const std::vector<uint8_t>& DisplayRgb8();
-    // The last frame at a reduced size for previews (the run's mosaic): the linear sensor
-    // image area-averaged to width×height, then displayed through a 3-D LUT of the channel's
-    // display transform (sensors::DisplayLut, within a few code values of it); 8-bit RGB.
+    // The last frame at a reduced size for previews (the run's mosaic), 8-bit RGB. Visible:
+    // the linear sensor image area-averaged to width×height, then displayed through a 3-D LUT
+    // of the channel's display transform (sensors::DisplayLut, within a few code values of
+    // it). Thermal: the imager's display frame, area-averaged.
     std::vector<uint8_t> PreviewRgb8(int width, int height);
     int Width() const { return channel_.width; }
     int Height() const { return channel_.height; }
@@ -59,9 +67,9 @@ class ChannelPipeline {
     // The channel renderer: Otw() for kind otw, Flir() for kind flir (CHECK-fails otherwise).
     const OtwChannel& Otw() const;
     const FlirChannel& Flir() const;
-    // Flir channels: the last frame's apparent (blackbody-equivalent) temperature, K,
-    // Width()×Height()×1.
-    const Image& ApparentTemperature() const { return temperature_; }
+    // Flir channels: the thermal imager (its last frame's counts, display, measured radiance
+    // and apparent temperature).
+    const sensors::ThermalImager& Imager() const;
 
   private:
     const scene::World& world_;
@@ -69,19 +77,18 @@ class ChannelPipeline {
     std::filesystem::path channelDir_;
     std::vector<std::string> formats_;
     const ChannelCamera& Camera() const;
-    // White-hot 8-bit RGB of a temperature image, linear from lo_K (black) to hi_K (white).
-    static std::vector<uint8_t> WhiteHot8(const Image& temperature, double lo_K, double hi_K);
+    // Flir: the frame's files (Write for kind flir).
+    void WriteThermal(const sensors::ImageMetadata& md, const std::string& base, FrameRecord& rec);
 
     std::unique_ptr<OtwChannel> otw_;
     std::unique_ptr<FlirChannel> flir_;
+    std::unique_ptr<sensors::ThermalImager> imager_;  // flir
     std::unique_ptr<sensors::OcioDisplay> display_;
     Image samples_;
-    Image pixels_;                        // the last frame's sensor image (linear)
-    Image temperature_;                   // flir: apparent temperature of pixels_, K
-    double minT_K_ = 0.0, maxT_K_ = 0.0;  // flir: display range of the last frame
-    scene::SceneState state_;             // the last frame's scene
-    double ev_ = 0.0;                     // the last frame's exposure
-    std::vector<uint8_t> display8_;       // display transform of pixels_, when asked for
+    Image pixels_;                   // otw: the last frame's sensor image (linear)
+    scene::SceneState state_;        // the last frame's scene
+    double ev_ = 0.0;                // the last frame's exposure
+    std::vector<uint8_t> display8_;  // display transform of pixels_, when asked for
     bool displayValid_ = false;
     std::unique_ptr<sensors::DisplayLut> previewLut_;  // built on the first preview
 };

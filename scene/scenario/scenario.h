@@ -131,6 +131,12 @@ struct ChannelSettings {
     ExposureSettings exposure;
     std::string ocioView = "ACES 1.0 - SDR Video";  // display view of configs/ocio/config.ocio
     InfraredBand band = InfraredBand::Lwir;         // flir channels only
+    // Flir channels: the `imager:` mapping as written, parsed and checked against the channel
+    // where the channel is built (channels/flir; scene does not depend on sensors). Absent: the
+    // default imager. A flir channel with an imager may leave out hfov_deg (hfovGiven false)
+    // and take its field of view from the imager's focal length and pixel pitch.
+    std::optional<ConfigValue> imager;
+    bool hfovGiven = true;
 };
 
 struct MaterialSettings {

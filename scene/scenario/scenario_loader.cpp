@@ -31,6 +31,8 @@ const std::vector<std::string> kChannelKinds = {"otw", "flir", "nvg"};
 const std::vector<std::string> kInfraredBands = {"lwir", "mwir"};
 const std::vector<std::string> kExposureModes = {"auto", "manual"};
 const std::vector<std::string> kOutputFormats = {"exr", "png", "tiff"};
+// Flir channels also write the imager's 16-bit raw ADC counts.
+const std::vector<std::string> kFlirOutputFormats = {"exr", "png", "tiff", "raw_png", "raw_tiff"};
 const std::vector<std::string> kModelExtensions = {".obj", ".gltf", ".glb"};
 
 // Names that end up in file names and command lines: [A-Za-z0-9_-]+.
@@ -278,7 +280,17 @@ ChannelSettings ReadChannel(const ConfigValue& value) {
         channel.width = int(size[0].AsInt(1, kMaxImageSide));
         channel.height = int(size[1].AsInt(1, kMaxImageSide));
 
-        channel.hfov_rad = c.GetDouble("hfov_deg", NumberRange::Open(0, 180, "deg")) * kRadPerDeg;
+        // A flir channel with an imager may take its field of view from the imager's focal
+        // length and pitch instead (checked where the channel is built).
+        const NumberRange fov = NumberRange::Open(0, 180, "deg");
+        if (channel.kind == ChannelKind::Flir) channel.imager = c.Find("imager");
+        if (channel.imager) {
+            const std::optional<ConfigValue> hfov = c.Find("hfov_deg");
+            channel.hfovGiven = hfov.has_value();
+            if (hfov) channel.hfov_rad = hfov->AsDouble(fov) * kRadPerDeg;
+        } else {
+            channel.hfov_rad = c.GetDouble("hfov_deg", fov) * kRadPerDeg;
+        }
         if (std::optional<ConfigValue> pose = c.Find("pose")) {
             ReadMap(*pose, [&](ConfigMap& p) {
                 channel.offset_m = p.GetVec3("offset_m", NumberRange::Any("m"), channel.offset_m);
@@ -313,9 +325,13 @@ ChannelSettings ReadChannel(const ConfigValue& value) {
         if (std::optional<ConfigValue> output = c.Find("output")) {
             ReadMap(*output, [&](ConfigMap& o) {
                 channel.formats.clear();
+                const bool flir = channel.kind == ChannelKind::Flir;
+                const std::vector<std::string>& names = flir ? kFlirOutputFormats : kOutputFormats;
                 for (const ConfigValue& format :
-                     o.GetList("formats", 1, kOutputFormats.size(), "formats (exr, png, tiff)")) {
-                    const std::string& name = kOutputFormats[format.AsEnum(kOutputFormats)];
+                     o.GetList("formats", 1, names.size(),
+                               flir ? "formats (exr, png, tiff, raw_png, raw_tiff)"
+                                    : "formats (exr, png, tiff)")) {
+                    const std::string& name = names[format.AsEnum(names)];
                     if (std::find(channel.formats.begin(), channel.formats.end(), name) !=
                         channel.formats.end())
                         format.Fail("each format at most once", "'" + name + "' again");

@@ -230,7 +230,7 @@ double ThermalImager::RawSignal(size_t i, double E, double z) const {
     return double(rawGain_[i]) * E + double(rawOffset_[i]) + noiseSigma_ * z;
 }
 
-void ThermalImager::Process(const Image& samples, double time_s) {
+void ThermalImager::Process(const Image& samples, double time_s, int64_t noiseFrame) {
     const int w = settings_.width_px, h = settings_.height_px, n = kernel_.supersamples;
     CHECK_MSG(samples.channels == 1 && samples.width == w * n && samples.height == h * n,
               "thermal imager input " << samples.width << "×" << samples.height << "×"
@@ -254,7 +254,7 @@ void ThermalImager::Process(const Image& samples, double time_s) {
     // scene::HashBits(seed, stream, c) = Mix64(key ^ c) with the key below, hoisted out of
     // the pixel loop.
     const uint64_t key =
-        scene::Mix64(scene::Mix64(settings_.seed) ^ (kStreamTemporal + uint64_t(frame_)));
+        scene::Mix64(scene::Mix64(settings_.seed) ^ (kStreamTemporal + uint64_t(noiseFrame)));
     tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
         std::vector<float> scratch;
         for (int y = rows.begin(); y < rows.end(); ++y) {
@@ -288,17 +288,27 @@ void ThermalImager::Process(const Image& samples, double time_s) {
     display_.Update(counts_, dt_s);
     display_.Render(counts_, display8_);
     lastTime_s_ = time_s;
+    lastNoiseFrame_ = noiseFrame;
     ++frame_;
 }
 
+Image ThermalImager::MeasuredRadiance() const {
+    Image L(signal_.width, signal_.height, 1);
+    const double perIrradiance = 1.0 / irradiancePerRadiance_;
+    tbb::parallel_for(0, L.height, [&](int y) {
+        const float* sig = signal_.At(0, y);
+        float* l = L.At(0, y);
+        for (int x = 0; x < L.width; ++x) l[x] = float(double(sig[x]) * perIrradiance);
+    });
+    return L;
+}
+
 Image ThermalImager::ApparentTemperature() const {
-    Image T(radiance_.width, radiance_.height, 1);
-    const double invTau = 1.0 / settings_.opticsTransmission;
+    Image T = MeasuredRadiance();
     tbb::parallel_for(0, T.height, [&](int y) {
-        const float* rad = radiance_.At(0, y);
         float* t = T.At(0, y);
         for (int x = 0; x < T.width; ++x) {
-            const double L = double(rad[x]) * invTau;
+            const double L = double(t[x]);
             t[x] = L > 0.0 ? float(table_.Temperature(L)) : 0.0f;
         }
     });
@@ -323,7 +333,18 @@ ImageMetadata ThermalImager::Metadata() const {
     m.Set("seasense:adc_bits", kAdcBits);
     m.Set("seasense:adc_range_K", std::vector<float>{float(s.adcMin_K), float(s.adcMax_K)});
     m.Set("seasense:nuc", s.nuc ? 1 : 0);
-    m.Set("seasense:frame_index", int(frame_ - 1));
+    // counts = round(adc_gain · E + adc_offset), E = irradiance_per_radiance · L (W·m⁻²).
+    m.Set("seasense:adc_gain_counts_per_W_m2", float(adcGain_));
+    m.Set("seasense:adc_offset_counts", float(adcOffset_));
+    m.Set("seasense:irradiance_per_radiance_sr", float(irradiancePerRadiance_));
+    static const char* const kModes[] = {"plateau", "linear", "manual"};
+    static const char* const kPolarities[] = {"white_hot", "black_hot"};
+    static const char* const kPalettes[] = {"grayscale", "ironbow", "rainbow"};
+    m.Set("seasense:agc_mode", std::string(kModes[int(s.agc.mode)]));
+    m.Set("seasense:agc_time_constant_s", float(s.agc.timeConstant_s));
+    m.Set("seasense:polarity", std::string(kPolarities[int(s.agc.polarity)]));
+    m.Set("seasense:palette", std::string(kPalettes[int(s.agc.palette)]));
+    m.Set("seasense:frame_index", int(lastNoiseFrame_));
     return m;
 }
 

@@ -39,8 +39,12 @@ class ThermalImager {
 
     // Images one frame: samples is the at-aperture band radiance (W·m⁻²·sr⁻¹, 1 channel,
     // (width·N)×(height·N), row 0 at the top) at simulation time time_s (s), which must
-    // increase from call to call. The first frame sets the lag and AGC state directly.
-    void Process(const Image& samples, double time_s);
+    // increase from call to call. The first frame sets the lag and AGC state directly. The
+    // temporal noise is a pure function of (seed, noiseFrame, pixel), so a frame's noise does
+    // not depend on which frames were imaged before it.
+    void Process(const Image& samples, double time_s, int64_t noiseFrame);
+    // Process with noiseFrame = FramesProcessed().
+    void Process(const Image& samples, double time_s) { Process(samples, time_s, frame_); }
 
     const ThermalImagerSettings& Settings() const { return settings_; }
     const radiometry::Band& GetBand() const { return table_.GetBand(); }
@@ -64,8 +68,13 @@ class ThermalImager {
     // the AGC display, DisplayChannels() bytes per pixel (gray, or RGB for a colour palette);
     std::span<const uint8_t> Display() const { return display8_; }
     int DisplayChannels() const { return display_.Channels(); }
+    // the band radiance at the aperture (W·m⁻²·sr⁻¹) that the detector signal stands for:
+    // Signal() / (τ π / (4F#² + 1)), with the temporal noise and any fixed pattern the NUC
+    // left, what a radiometric camera reports (before the ADC, so neither quantised nor
+    // clipped). Computed on request;
+    Image MeasuredRadiance() const;
     // apparent blackbody temperature (K) per pixel: BandRadianceTable::Temperature of
-    // Radiance()/τ_optics, 0 K where no radiance arrives. Computed on request.
+    // MeasuredRadiance(), 0 K where it is not positive. Computed on request.
     Image ApparentTemperature() const;
 
     // Focal-plane irradiance (W·m⁻²) of a blackbody at T_K filling the field.
@@ -78,7 +87,8 @@ class ThermalImager {
     // reference temperature.
     double NoiseSigma() const { return noiseSigma_; }
 
-    // Header attributes for the outputs: band, NETD, optics, pitch, ADC range, frame count.
+    // Header attributes for the outputs: band, NETD, optics, pitch, ADC range, and the last
+    // frame's noiseFrame as its frame index.
     ImageMetadata Metadata() const;
 
   private:
@@ -101,7 +111,8 @@ class ThermalImager {
     Image radiance_, signal_;
     std::vector<uint16_t> counts_;
     std::vector<uint8_t> display8_;
-    int64_t frame_ = 0;
+    int64_t frame_ = 0;           // frames processed
+    int64_t lastNoiseFrame_ = 0;  // noiseFrame of the last frame (its frame index)
     double lastTime_s_ = 0.0;
 };
 

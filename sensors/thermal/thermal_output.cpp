@@ -22,7 +22,7 @@ void WriteThermalFrame(const ThermalImager& imager, const ThermalOutputPaths& pa
     }
     if (!paths.radiometricExr.empty()) {
         const Image T = imager.ApparentTemperature();
-        const Image& L = imager.Radiance();
+        const Image L = imager.MeasuredRadiance();
         Image both(w, h, 2);
         tbb::parallel_for(0, h, [&](int y) {
             for (int x = 0; x < w; ++x) {
@@ -31,8 +31,10 @@ void WriteThermalFrame(const ThermalImager& imager, const ThermalOutputPaths& pa
             }
         });
         ImageMetadata m = metadata;
-        m.Set("seasense:L_unit", std::string("W m-2 sr-1 (band radiance at the detector)"));
-        m.Set("seasense:T_unit", std::string("K (apparent blackbody temperature)"));
+        m.Set("seasense:L_unit",
+              std::string("W m-2 sr-1 (band radiance at the aperture as measured: the detector "
+                          "signal before the ADC / (optics transmission pi / (4 F^2 + 1)))"));
+        m.Set("seasense:T_unit", std::string("K (apparent blackbody temperature of L)"));
         ExrOptions options;
         options.channelNames = {"L", "T"};
         WriteExr(paths.radiometricExr, both, m, options);

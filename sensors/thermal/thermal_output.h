@@ -14,8 +14,8 @@ struct ThermalOutputPaths {
     std::filesystem::path rawCounts;
     // 8-bit PNG or TIFF of the AGC display (gray, or RGB for a colour palette).
     std::filesystem::path display;
-    // Float OpenEXR with channels "L" (band radiance at the detector, W·m⁻²·sr⁻¹) and "T"
-    // (apparent blackbody temperature, K).
+    // Float OpenEXR with channels "L" (ThermalImager::MeasuredRadiance, band radiance at the
+    // aperture as measured, W·m⁻²·sr⁻¹) and "T" (its apparent blackbody temperature, K).
     std::filesystem::path radiometricExr;
 };
 

@@ -1,5 +1,7 @@
 // FLIR channel against analytic radiometry: a blackbody plate, the sea at nadir, Kirchhoff's
-// law in an isothermal scene, sunlit versus shaded hull sides, determinism, and capture output.
+// law in an isothermal scene, sunlit versus shaded hull sides, determinism, and capture output;
+// and the channel's pipeline with its thermal imager: radiometric EXR, path inversion, NETD,
+// raw counts, and the imager's field of view.
 #include "channels/flir/flir_channel.h"
 
 #include <OpenImageIO/imageio.h>
@@ -11,7 +13,12 @@
 #include <filesystem>
 #include <fstream>
 
+#include "channels/pipeline/channel_pipeline.h"
+#include "radiometry/planck/planck.h"
 #include "scene/config/config.h"
+#include "scene/core/error.h"
+#include "scene/scenario/scenario_loader.h"
+#include "sensors/thermal/thermal_imager.h"
 #include "tests/support/meshes.h"
 #include "tests/support/shell.h"
 
@@ -280,6 +287,282 @@ channels:
         ASSERT_LT(px[i + 1], 360.0f);
     }
     fs::remove_all(dir);
+}
+
+TEST(FlirChannel, ShadingTransmittanceTableFollowsTheAtmosphere) {
+    // The per-sample path transmittance is a table over √range; it must stay with the exact
+    // band transmittance of radiometry::Atmosphere from a metre to the table's 200 km.
+    scene::Scenario sc = BaseScenario();
+    sc.environment.visibility_m = 3000.0;
+    const scene::World world(sc);
+    FlirChannel flir(world, sc.channels[0]);
+    const radiometry::Atmosphere& air = flir.GetAtmosphere();
+    double worst = 0.0;
+    for (double range = 1.0; range < 2e5; range *= 1.07)
+        worst = std::max(worst,
+                         std::abs(flir.PathTransmittance(float(range)) - air.Transmittance(range)));
+    EXPECT_LT(worst, 2e-4);
+}
+
+TEST(FlirConfigs, AfternoonAndNightExamplesShowTheirThermalSignatures) {
+    // configs/flir.yaml: the boat's west (port) side, toward the afternoon sun, is warmer than
+    // the air; configs/flir-night.yaml: every hull orientation has cooled below the sea under
+    // the night sky. In both the 420 K stack is in view, the hottest thing in the frame, and
+    // the field of view follows from the imager (640 × 17 µm behind 25 mm).
+    const fs::path configs = fs::path(SEASENSE_SOURCE_DIR) / "configs";
+    for (const char* name : {"flir.yaml", "flir-night.yaml"}) {
+        SCOPED_TRACE(name);
+        const scene::Scenario sc = scene::LoadScenario(configs / name);
+        const scene::World world(sc);
+        const fs::path out = TempDir("configs");
+        ChannelPipeline pipeline(world, sc.channels.at(0), out, {"exr"}, DefaultOcioConfig());
+        EXPECT_NEAR(pipeline.Flir().Settings().hfov_rad, 2.0 * std::atan(640 * 17e-6 / 0.05), 1e-9);
+        pipeline.Render(world.Advance(0));
+        const Image T = pipeline.Imager().ApparentTemperature();
+        const float hottest = *std::max_element(T.pixels.begin(), T.pixels.end());
+        EXPECT_GT(hottest, 380.0f);
+        EXPECT_LT(hottest, 425.0f);
+        FlirChannel flir(world, sc.channels.at(0));
+        const auto hull = flir.EntityTemperatures_K(0, 0.0);  // entity 0: the boat
+        const double air = 293.0, sea = 291.0;
+        if (std::string(name) == "flir.yaml") {
+            // Orientation class 7: horizontal, facing west; + 10: sunlit.
+            EXPECT_GT(hull[10 + 7], air + 5.0);
+        } else {
+            for (double t : hull) EXPECT_LT(t, sea);
+        }
+        fs::remove_all(out);
+    }
+}
+
+// Reads channel `name` of an EXR or PNG (any channel count) as floats, row 0 on top.
+std::vector<float> ReadChannel(const fs::path& file, const std::string& name, int& width,
+                               int& height) {
+    auto in = OIIO::ImageInput::open(file.string());
+    EXPECT_TRUE(in) << file;
+    if (!in) return {};
+    const OIIO::ImageSpec& spec = in->spec();
+    width = spec.width;
+    height = spec.height;
+    const int c = name.empty() ? 0 : spec.channelindex(name);
+    EXPECT_GE(c, 0) << name;
+    std::vector<float> px(size_t(spec.width) * size_t(spec.height));
+    in->read_image(0, 0, c, c + 1, OIIO::TypeDesc::FLOAT, px.data());
+    return px;
+}
+
+// An ideal imager (no temporal noise, no fixed pattern, no aberration, no AGC memory) unless
+// extra keys say otherwise; the channel's hfov gives the focal length.
+scene::ConfigValue ImagerNode(const std::string& noise = "noise: {netd_mK: 0}\n") {
+    return ParseValue(noise + "agc: {time_constant_s: 0}\n", "imager.yaml");
+}
+
+// The small imaged channel of the pipeline tests: 32×24 pixels, 2×2 supersampled, the ideal
+// imager.
+void SmallImagedChannel(scene::ChannelSettings& ch, double hfov_deg) {
+    ch.width = 32;
+    ch.height = 24;
+    ch.hfov_rad = hfov_deg * M_PI / 180.0;
+    ch.supersampling = 2;
+    ch.imager = ImagerNode();
+}
+
+// A blackbody plate (ε = 1, fixed 320 K) filling the view of a 32×24 imager looking straight
+// down from height_m, through air at 290 K.
+scene::Scenario PlateBelow(const fs::path& dir, double height_m, const std::string& humidity) {
+    WriteBoxObj(dir / "plate.obj", {-60, -60, 0}, {60, 60, 0.2f});
+    scene::Scenario sc = BaseScenario();
+    sc.environment.atmosphere = ParseValue(
+        "air_temperature_K: 290\nrelative_humidity: " + humidity + "\n", "atmosphere.yaml");
+    sc.entities.push_back({"plate", dir / "plate.obj", {0, 0, 0}, {}, 1.0, "black"});
+    sc.eyepoint.position_m = {0, 0, 0.2 + height_m};
+    sc.eyepoint.attitude.pitch_rad = -0.5 * M_PI;
+    SmallImagedChannel(sc.channels[0], 20.0);
+    return sc;
+}
+
+TEST(FlirPipeline, BlackbodyPlateReadsItsTemperatureInTheRadiometricExr) {
+    // Half a metre of dry air: τ = 1 to 1e-5, so the EXR's apparent temperature is the plate's
+    // own (the optics' τ = 0.9 and the F-number are undone by the camera equation).
+    const fs::path dir = TempDir("pipe_plate");
+    const scene::Scenario sc = PlateBelow(dir, 0.5, "0.05");
+    const scene::World world(sc);
+    ChannelPipeline pipeline(world, sc.channels[0], dir / "out", {"exr", "png", "raw_png"},
+                             DefaultOcioConfig());
+    const radiometry::Atmosphere air(radiometry::Band::Lwir(), {290.0, 0.05, 101325.0},
+                                     sc.environment.visibility_m);
+    ASSERT_GT(air.Transmittance(0.5 / std::cos(15.0 * M_PI / 180.0)), 1.0 - 1e-5);
+    const FrameRecord rec = pipeline.RenderAndWrite(0);
+    ASSERT_EQ(rec.files.size(), 3u);
+    int w = 0, h = 0;
+    const std::vector<float> T = ReadChannel(dir / "out/ir/ir_000000.exr", "T", w, h);
+    ASSERT_EQ(w, 32);
+    ASSERT_EQ(h, 24);
+    for (float t : T) ASSERT_NEAR(t, 320.0, 0.05);
+    EXPECT_TRUE(fs::exists(dir / "out/ir/ir_000000.png"));
+    EXPECT_TRUE(fs::exists(dir / "out/ir/ir_000000_raw.png"));
+    fs::remove_all(dir);
+}
+
+TEST(FlirPipeline, RawCountsAreTheAdcTransferOfTheFocalPlaneSignal) {
+    // 14-bit ADC: blackbodies at adc.min_K and adc.max_K span counts 0 … 16383, linear in the
+    // focal-plane irradiance E = τπL/(4F² + 1) (Holst): for the plate,
+    // counts = round(16383 (E(L) − E(B(240 K))) / (E(B(440 K)) − E(B(240 K)))).
+    const fs::path dir = TempDir("pipe_raw");
+    scene::Scenario sc = PlateBelow(dir, 0.5, "0.05");
+    sc.channels[0].imager =
+        ImagerNode("noise: {netd_mK: 0}\nadc: {min_K: 240, max_K: 440}\noptics: {f_number: 1.4}\n");
+    const scene::World world(sc);
+    ChannelPipeline pipeline(world, sc.channels[0], dir / "out", {"raw_png", "exr"},
+                             DefaultOcioConfig());
+    pipeline.RenderAndWrite(0);
+    int w = 0, h = 0;
+    const std::vector<float> counts = ReadChannel(dir / "out/ir/ir_000000_raw.png", "", w, h);
+    const std::vector<float> L = ReadChannel(dir / "out/ir/ir_000000.exr", "L", w, h);
+    ASSERT_EQ(counts.size(), L.size());
+    const radiometry::Band band = radiometry::Band::Lwir();
+    const double k = 0.9 * M_PI / (4.0 * 1.4 * 1.4 + 1.0);
+    const double e0 = k * radiometry::BandRadiance(band, 240.0);
+    const double e1 = k * radiometry::BandRadiance(band, 440.0);
+    for (size_t i = 0; i < counts.size(); ++i) {
+        const double expected = std::round(16383.0 * (k * L[i] - e0) / (e1 - e0));
+        // PNG holds 16 bits; OIIO reads them normalised to [0, 1].
+        ASSERT_NEAR(std::round(counts[i] * 65535.0), expected, 1.0) << i;
+    }
+    // The plate at 320 K lands where the transfer puts it, not at a clip.
+    const double plate = 16383.0 * (k * radiometry::BandRadiance(band, 320.0) - e0) / (e1 - e0);
+    EXPECT_NEAR(counts[0] * 65535.0, plate, 2.0);
+    fs::remove_all(dir);
+}
+
+TEST(FlirPipeline, PathCorrectedTemperatureOfADistantPlate) {
+    // A vertical ε = 1 plate at 320 K, 800 m north, through humid air at 290 K and 3 km
+    // visibility: the EXR's L = τ B(T) + (1 − τ) B(T_air), with τ of the range from
+    // radiometry::Atmosphere; sensors::ApparentTemperature inverts it back to T.
+    const fs::path dir = TempDir("pipe_path");
+    WriteBoxObj(dir / "wall.obj", {-60, 0, -20}, {60, 2, 100});
+    scene::Scenario sc = BaseScenario();
+    sc.environment.visibility_m = 3000.0;
+    sc.environment.atmosphere =
+        ParseValue("air_temperature_K: 290\nrelative_humidity: 0.8\n", "atmosphere.yaml");
+    sc.entities.push_back({"wall", dir / "wall.obj", {0, 800, 0}, {}, 1.0, "black"});
+    // 40 m up, the sea in front of the wall lies 2.9° down, outside the 3° tall view and the
+    // imager's blur kernel.
+    sc.eyepoint.position_m = {0, 0, 40};
+    scene::ChannelSettings& ch = sc.channels[0];
+    SmallImagedChannel(ch, 4.0);
+    const scene::World world(sc);
+    ChannelPipeline pipeline(world, ch, dir / "out", {"exr"}, DefaultOcioConfig());
+    pipeline.RenderAndWrite(0);
+    int w = 0, h = 0;
+    const std::vector<float> L = ReadChannel(dir / "out/ir/ir_000000.exr", "L", w, h);
+    const radiometry::Atmosphere air(radiometry::Band::Lwir(), {290.0, 0.8, 101325.0}, 3000.0);
+    const radiometry::BandRadianceTable table(radiometry::Band::Lwir());
+    const ChannelCamera& cam = pipeline.Flir().Camera();
+    double minTau = 1.0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            // The pixel centre's ray meets the plate's face y = 800 m at range 800 / d_y.
+            const glm::dvec3 d = cam.SampleDirection(2 * x + 1, 2 * y + 1);
+            const double tau = air.Transmittance(800.0 / d.y);
+            minTau = std::min(minTau, tau);
+            const double L_px = L[size_t(y) * size_t(w) + size_t(x)];
+            ASSERT_NEAR(sensors::ApparentTemperature(table, L_px, tau, 290.0), 320.0, 0.1)
+                << x << "," << y;
+            // Without the path correction the plate reads far colder.
+            ASSERT_LT(table.Temperature(L_px), 316.0);
+        }
+    EXPECT_LT(minTau, 0.85);
+    fs::remove_all(dir);
+}
+
+TEST(FlirPipeline, TemporalNoiseOf64FramesIsTheConfiguredNetd) {
+    // A uniform 300 K blackbody (the NETD reference) seen through 300 K air: per-pixel
+    // temporal standard deviation of the EXR temperature over 64 frames, pooled over the
+    // frame, is the NETD (physics.md: NETD = σ / SiTF).
+    const fs::path dir = TempDir("pipe_netd");
+    WriteBoxObj(dir / "plate.obj", {-60, -60, 0}, {60, 60, 0.2f});
+    scene::Scenario sc = BaseScenario();
+    scene::ConfigMap root(ParseValue(R"(materials:
+  bb300:
+    reflectance_rgb: [0.05, 0.05, 0.05]
+    emissivity_mwir: 1.0
+    emissivity_lwir: 1.0
+    thermal: {model: fixed, temperature_K: 300}
+)",
+                                     "bb300.yaml"));
+    sc.materialTable = root.Require("materials", "a mapping");
+    sc.materials = {{"bb300", glm::dvec3(0.05)}};
+    sc.environment.atmosphere =
+        ParseValue("air_temperature_K: 300\nrelative_humidity: 0.5\n", "atmosphere.yaml");
+    sc.entities.push_back({"plate", dir / "plate.obj", {0, 0, 0}, {}, 1.0, "bb300"});
+    sc.eyepoint.position_m = {0, 0, 2.2};
+    sc.eyepoint.attitude.pitch_rad = -0.5 * M_PI;
+    scene::ChannelSettings& ch = sc.channels[0];
+    SmallImagedChannel(ch, 20.0);
+    ch.imager = ImagerNode("noise: {netd_mK: 80}\n");
+    const scene::World world(sc);
+    ChannelPipeline pipeline(world, ch, dir / "out", {"exr"}, DefaultOcioConfig());
+    constexpr int kFrames = 64;
+    const size_t n = size_t(ch.width) * size_t(ch.height);
+    std::vector<double> sum(n, 0.0), sum2(n, 0.0);
+    for (int f = 0; f < kFrames; ++f) {
+        pipeline.Render(world.Advance(f));
+        const Image T = pipeline.Imager().ApparentTemperature();
+        for (size_t i = 0; i < n; ++i) {
+            sum[i] += T.pixels[i];
+            sum2[i] += double(T.pixels[i]) * T.pixels[i];
+        }
+    }
+    double pooled = 0.0, mean = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        pooled += (sum2[i] - sum[i] * sum[i] / kFrames) / (kFrames - 1);
+        mean += sum[i] / kFrames;
+    }
+    // 768 pixels × 63 degrees of freedom: the estimate's spread is ~0.3 %.
+    EXPECT_NEAR(std::sqrt(pooled / double(n)), 0.080, 0.1 * 0.080);
+    EXPECT_NEAR(mean / double(n), 300.0, 0.01);
+    fs::remove_all(dir);
+}
+
+TEST(FlirPipeline, FieldOfViewFromTheImagerOrCheckedAgainstIt) {
+    // hfov = 2 atan(W p / (2 f)): 640 × 17 µm behind 25 mm is 24.552°.
+    scene::ChannelSettings ch = BaseScenario().channels[0];
+    ch.width = 640;
+    ch.height = 480;
+    ch.hfovGiven = false;
+    ch.imager = ParseValue("optics: {focal_length_mm: 25}\ndetector: {pitch_um: 17}\n", "i.yaml");
+    const FlirImagerSetup a = ResolveFlirImager(ch, 7);
+    EXPECT_NEAR(a.channel.hfov_rad, 2.0 * std::atan(640 * 17e-6 / 0.05), 1e-12);
+    EXPECT_NEAR(a.channel.hfov_rad * 180.0 / M_PI, 24.552, 1e-3);
+    // hfov given, no focal length: f from the hfov.
+    ch.hfovGiven = true;
+    ch.hfov_rad = 24.552 * M_PI / 180.0;
+    ch.imager = ParseValue("detector: {pitch_um: 17}\n", "i.yaml");
+    EXPECT_NEAR(ResolveFlirImager(ch, 7).imager.focalLength_m, 0.025, 2e-6);
+    // Both, within 0.1 %: accepted; 1 % off: a ConfigError at the focal length's line.
+    ch.imager = ParseValue("optics: {focal_length_mm: 25.01}\n", "i.yaml");
+    EXPECT_NO_THROW(ResolveFlirImager(ch, 7));
+    ch.imager =
+        ParseValue("detector: {pitch_um: 17}\noptics:\n  focal_length_mm: 25.3\n", "i.yaml");
+    try {
+        ResolveFlirImager(ch, 7);
+        ADD_FAILURE() << "no error for a focal length 1.2 % off the hfov";
+    } catch (const scene::ConfigError& e) {
+        EXPECT_NE(std::string(e.what()).find("i.yaml:3:"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("focal_length_mm"), std::string::npos) << e.what();
+    }
+    // Neither: no field of view at all.
+    ch.hfovGiven = false;
+    ch.imager = ParseValue("detector: {pitch_um: 17}\n", "i.yaml");
+    EXPECT_THROW(ResolveFlirImager(ch, 7), scene::ConfigError);
+    // Seeds: per channel name, per scenario seed.
+    ch.imager = ParseValue("optics: {focal_length_mm: 25}\n", "i.yaml");
+    const uint64_t s1 = ResolveFlirImager(ch, 7).imager.seed;
+    EXPECT_EQ(ResolveFlirImager(ch, 7).imager.seed, s1);
+    EXPECT_NE(ResolveFlirImager(ch, 8).imager.seed, s1);
+    ch.name = "ir2";
+    EXPECT_NE(ResolveFlirImager(ch, 7).imager.seed, s1);
 }
 
 }  // namespace

@@ -340,6 +340,31 @@ TEST_F(ScenarioLoaderTest, FieldOfViewMustLieInsideTheOpenInterval) {
     EXPECT_DOUBLE_EQ(wide.channels[0].hfov_rad, 179.9 * kPi / 180.0);
 }
 
+TEST_F(ScenarioLoaderTest, FlirChannelTakesAnImagerRawFormatsAndMayLeaveOutTheFov) {
+    // With an `imager:` the hfov may come from the imager's focal length (checked where the
+    // channel is built); raw formats are for flir channels only.
+    const std::string flir = Replace(valid_, "    hfov_deg: 20\n    pose: {offset_m: [0.5",
+                                     "    imager: {optics: {focal_length_mm: 25}}\n"
+                                     "    pose: {offset_m: [0.5");
+    const Scenario sc =
+        LoadScenario(Write(Replace(flir, "formats: [tiff]", "formats: [raw_png, exr]")));
+    const ChannelSettings& ch = sc.channels[1];
+    ASSERT_TRUE(ch.imager.has_value());
+    EXPECT_FALSE(ch.hfovGiven);
+    EXPECT_EQ(ch.formats, (std::vector<std::string>{"raw_png", "exr"}));
+    EXPECT_TRUE(sc.channels[0].hfovGiven);
+    // Without an imager the flir channel needs its hfov.
+    const std::string noFov = Replace(valid_, "    hfov_deg: 20\n", "");
+    EXPECT_NE(ErrorFor(noFov).find("channels[1]"), std::string::npos);
+    // An otw channel has no raw output.
+    const std::string otwRaw = Replace(valid_, "formats: [exr, png]", "formats: [exr, raw_png]");
+    const std::string error = ErrorFor(otwRaw);
+    EXPECT_EQ(
+        error.rfind(At(otwRaw, "formats: [exr, ", "raw_png", "channels[0].output.formats[1]"), 0),
+        0u)
+        << error;
+}
+
 TEST_F(ScenarioLoaderTest, WrongNodeTypeIsNamed) {
     const std::string sun = Replace(
         valid_, "sun: {azimuth_deg: 240, elevation_deg: 25, illuminance_lux: 90000}", "sun: 25");

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -37,6 +38,7 @@ TEST(ThermalOutput, WritesRawDisplayAndRadiometricFiles) {
     s.width_px = w;
     s.height_px = h;
     s.opticsTransmission = 1.0;
+    s.netd_K = 0.02;  // the gradient check below reads single pixels: 0.1 K is 5 σ
     s.agc.palette = Palette::Ironbow;
     ThermalImager imager(s, radiometry::Band::Lwir(), 1);
     Image scene(w, h, 1);
@@ -67,14 +69,19 @@ TEST(ThermalOutput, WritesRawDisplayAndRadiometricFiles) {
     EXPECT_EQ(spec.channelnames[1], "T");
     EXPECT_EQ(spec.get_string_attribute("seasense:band"), imager.GetBand().Name());
     EXPECT_EQ(spec.get_string_attribute("seasense:channel"), "flir");
-    EXPECT_FLOAT_EQ(spec.get_float_attribute("seasense:netd_K"), 0.05f);
+    EXPECT_FLOAT_EQ(spec.get_float_attribute("seasense:netd_K"), 0.02f);
     EXPECT_FLOAT_EQ(spec.get_float_attribute("seasense:f_number"), 1.0f);
     EXPECT_FLOAT_EQ(spec.get_float_attribute("seasense:focal_length_m"), 0.025f);
     EXPECT_FLOAT_EQ(spec.get_float_attribute("seasense:pitch_m"), 17e-6f);
+    // L is the measured signal referred back through the camera equation E = τπL/(4F² + 1)
+    // (Holst); T its blackbody temperature.
     const Image T = imager.ApparentTemperature();
+    const radiometry::BandRadianceTable table(radiometry::Band::Lwir());
     for (int i = 0; i < w * h; ++i) {
-        ASSERT_EQ(exr[size_t(2 * i)], imager.Radiance().pixels[size_t(i)]);
+        const double L = imager.Signal().pixels[size_t(i)] * 5.0 / (s.opticsTransmission * M_PI);
+        ASSERT_NEAR(exr[size_t(2 * i)], L, 1e-6 * L);
         ASSERT_EQ(exr[size_t(2 * i + 1)], T.pixels[size_t(i)]);
+        ASSERT_NEAR(T.pixels[size_t(i)], table.Temperature(exr[size_t(2 * i)]), 1e-3);
     }
     // Away from the image edges the gradient is linear in T to first order, so the blurred
     // pixels read close to their scene temperature (within the curvature of Planck's law).
