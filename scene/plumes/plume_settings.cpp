@@ -187,6 +187,7 @@ PlumesSettings ParsePlumesSettings(ConfigMap& map, const PlumeParseContext& cont
     if (stability > 0) settings.stability = StabilityClass(stability - 1);
     settings.inversionHeight_m =
         map.GetDouble("inversion_height_m", NumberRange::Positive("m"), settings.inversionHeight_m);
+    settings.airTemperatureGiven = map.Find("air_temperature_K").has_value();
     settings.airTemperature_K = map.GetDouble(
         "air_temperature_K", NumberRange::Closed(180, 340, "K"), settings.airTemperature_K);
     for (const ConfigValue& source : map.GetList("sources", 0, kMaxPlumeSources, "plume sources"))

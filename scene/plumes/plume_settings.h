@@ -77,6 +77,8 @@ struct PlumesSettings {
     std::optional<StabilityClass> stability;  // nullopt: from wind, sun and cloud (Turner)
     double inversionHeight_m = std::numeric_limits<double>::infinity();  // ENU z; +∞: none
     double airTemperature_K = 288.15;
+    // Whether air_temperature_K was given; if not, renderers take the scenario atmosphere's.
+    bool airTemperatureGiven = false;
     std::vector<PlumeSourceSettings> sources;
 };
 

@@ -10,6 +10,7 @@
 
 #include "scene/config/config.h"
 #include "scene/core/time.h"
+#include "scene/plumes/plume_settings.h"
 
 namespace seasense::scene {
 
@@ -135,6 +136,9 @@ struct Scenario {
     std::vector<EntitySettings> entities;
     EyepointSettings eyepoint;
     std::vector<ChannelSettings> channels;
+    // The `plumes:` section (no sources when absent). Sources attached to an entity already
+    // carry its planned track (PlaceAttachedSource).
+    PlumesSettings plumes;
     std::vector<MaterialSettings> materials;  // from the material table file
     // The `materials:` mapping of the material table file, for radiometry::ParseMaterialTable
     // (emissivities and thermal models); set by LoadScenario.
