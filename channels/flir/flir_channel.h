@@ -67,6 +67,8 @@ class OrientationTemperatures {
 // and time_s (seconds since the start), and the unit ENU direction toward the sun.
 double SunIrradiance_W_m2(const scene::Scenario& scenario, double time_s, glm::dvec3& sunDirection);
 
+class ChannelPlumes;
+
 class FlirChannel {
   public:
     // Reads the atmosphere, sea and material table of the world's scenario (InputError on bad
@@ -108,6 +110,7 @@ class FlirChannel {
     radiometry::Atmosphere atmosphere_;
     radiometry::SeaEmissivityCurve seaCurve_;
     std::vector<EntityThermal> entities_;
+    std::unique_ptr<ChannelPlumes> plumes_;  // scenario plumes (channels/plume)
     FlirFrameStats stats_;
 };
 

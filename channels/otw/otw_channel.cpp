@@ -10,6 +10,7 @@
 #include <cmath>
 #include <limits>
 
+#include "channels/plume/plume_composite.h"
 #include "radiometry/sky/analytic_sky.h"
 #include "radiometry/surface/fresnel.h"
 #include "scene/core/simd4.h"
@@ -286,7 +287,10 @@ F4 Interpolate3(F4 b0, F4 b1, F4 b2, F4 a0, F4 a1, F4 a2) {
 }  // namespace
 
 OtwChannel::OtwChannel(const scene::World& world, const scene::ChannelSettings& settings)
-    : world_(world), settings_(settings), geometry_(world, settings) {
+    : world_(world),
+      settings_(settings),
+      geometry_(world, settings),
+      plumes_(std::make_unique<ChannelPlumes>(world)) {
     for (const scene::EntityState& e : world.State(0).entities)
         reflectance_.push_back(e.reflectanceRgb);
 }
@@ -553,6 +557,9 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     });
     for (uint64_t r : blockRays) stats_.shadowRays += r;
     stats_.shadeMs = Ms(t2, Clock::now());
+
+    // Plumes (channels/plume) over the finished radiance.
+    plumes_->CompositeOtw(state, cam, vis, sky, radiance);
 }
 
 }  // namespace seasense::channels

@@ -12,6 +12,8 @@
 
 namespace seasense::channels {
 
+class ChannelPlumes;
+
 struct OtwFrameStats {
     uint64_t oceanTriangles = 0;
     uint64_t modelTriangles = 0;
@@ -52,6 +54,7 @@ class OtwChannel {
     glm::dvec3 skySun_{0.0};
     double skySunLux_ = -1.0;
     std::unique_ptr<ShadeScratch> scratch_;
+    std::unique_ptr<ChannelPlumes> plumes_;  // scenario plumes (channels/plume)
     OtwFrameStats stats_;
 };
 

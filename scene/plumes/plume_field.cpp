@@ -51,6 +51,7 @@ struct Accumulator {
     float scattering[kObscurantBands] = {};
     float absorption[kObscurantBands] = {};
     float absorptionT[kObscurantBands] = {};
+    float scatteringG = 0.0f;  // visible
 };
 
 // Slab test of a ray against an AABB for s in [0, maxS].
@@ -199,6 +200,7 @@ void PlumeField::SetOptics(uint32_t plume, const ObscurantOptics& optics) {
         o.scattering[b] = float(alpha * omega);
         o.absorption[b] = float(alpha * (1.0 - omega));
     }
+    o.scatteringG = o.scattering[int(ObscurantBand::Visible)] * float(optics.asymmetry);
 }
 
 void PlumeField::Clear(double t_s) {
@@ -392,6 +394,7 @@ PlumeTrace PlumeField::Trace(const glm::vec3& origin_m, const glm::vec3& dir,
                 acc.absorption[b] += tauAbs;
                 acc.absorptionT[b] += tauAbs * T;
             }
+            acc.scatteringG += op.scatteringG * integral;
         }
     }
     for (int b = 0; b < kObscurantBands; ++b) {
@@ -400,6 +403,8 @@ PlumeTrace PlumeField::Trace(const glm::vec3& origin_m, const glm::vec3& dir,
         result.temperature_K[b] =
             acc.absorption[b] > 0.0f ? acc.absorptionT[b] / acc.absorption[b] : 0.0f;
     }
+    constexpr int kVis = int(ObscurantBand::Visible);
+    result.asymmetry = acc.scattering[kVis] > 0.0f ? acc.scatteringG / acc.scattering[kVis] : 0.0f;
     return result;
 }
 

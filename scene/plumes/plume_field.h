@@ -58,6 +58,8 @@ struct PlumeTrace {
     std::array<float, kObscurantBands> opticalDepth{};
     std::array<float, kObscurantBands> albedo{};
     std::array<float, kObscurantBands> temperature_K{};
+    // Henyey–Greenstein asymmetry of the visible scattering, weighted by scattering depth.
+    float asymmetry = 0.0f;
 
     float Transmittance(ObscurantBand band) const;  // exp(−τ), seed 004 Eq 1
 };
@@ -121,6 +123,7 @@ class PlumeField {
         float extinction[kObscurantBands];  // α, m²/kg
         float scattering[kObscurantBands];  // α ω
         float absorption[kObscurantBands];  // α (1 − ω)
+        float scatteringG;                  // α ω g, visible
     };
 
     uint32_t BuildNode(uint32_t begin, uint32_t end);

@@ -54,7 +54,8 @@ PlumeSourceSettings ReadSource(const ConfigValue& value, const PlumeParseContext
         } else {
             s.position_m = m.GetVec3("position_m", NumberRange::Any("m"));
         }
-        s.start_s = m.GetDouble("start_s", NumberRange::NonNegative("s"), s.start_s);
+        // Negative: the source was already going when the scenario starts.
+        s.start_s = m.GetDouble("start_s", NumberRange::Any("s"), s.start_s);
         s.duration_s = m.GetDouble("duration_s", NumberRange::Positive("s"), s.duration_s);
         s.rate_hz =
             m.GetDouble("rate_hz", NumberRange::OpenClosed(0, kMaxRate_hz, "Hz"), s.rate_hz);

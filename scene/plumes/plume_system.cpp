@@ -80,7 +80,7 @@ PlumeSystem::PlumeSystem(const PlumesSettings& settings, const PlumeAmbient& amb
         require(std::isfinite(s.position_m.x) && std::isfinite(s.position_m.y) &&
                     std::isfinite(s.position_m.z),
                 "position must be finite");
-        require(s.start_s >= 0.0 && std::isfinite(s.start_s), "start must be finite and >= 0 s");
+        require(std::isfinite(s.start_s), "start must be finite");
         require(s.duration_s > 0.0, "duration must be > 0 s");
         require(s.rate_hz > 0.0 && s.rate_hz <= 100.0, "rate must be in (0, 100] Hz");
         require(s.lifetime_s > 0.0 && s.lifetime_s <= 3600.0, "lifetime must be in (0, 3600] s");
