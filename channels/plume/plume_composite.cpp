@@ -27,6 +27,16 @@ constexpr float kSeaAlbedo = 0.06f;
 
 constexpr double kGlowMinT_K = 500.0, kGlowMaxT_K = 3000.0, kGlowStep_K = 10.0;
 
+// Interpolation grid: pixels whose surfaces all lie beyond the plumes take their trace from
+// the sky traces at the corners of their kCell × kCell cell, blended bilinearly, when the
+// corners' optical depths differ by at most kInterpolationTolerance and their temperatures by
+// at most kInterpolationTolerance_K; other pixels are traced one by one.
+constexpr int kCell = 4;
+constexpr float kInterpolationTolerance = 0.02f;
+constexpr float kInterpolationTolerance_K = 10.0f;
+// A pixel whose samples' surface ranges differ by more than this ratio traces a second ray.
+constexpr float kDepthEdgeRatio = 1.1f;
+
 // A screen rectangle of output pixels [x0, x1) × [y0, y1).
 struct PixelRect {
     int x0, y0, x1, y1;
@@ -61,8 +71,15 @@ PixelRect ProjectBox(const ChannelCamera& cam, const glm::dvec3& lo, const glm::
             clampX(std::ceil(xMax) + 1.0), clampY(std::ceil(yMax) + 1.0)};
 }
 
-// Screen rectangles of the field's plumes (one per plume with puffs in front of the camera).
-std::vector<PixelRect> PlumeRects(const scene::PlumeField& field, const ChannelCamera& cam) {
+// A plume's screen rectangle and the range (m) from the eye to the nearest and farthest point
+// of its box.
+struct PlumeBounds {
+    PixelRect rect;
+    float near_m, far_m;
+};
+
+std::vector<PlumeBounds> PlumeScreenBounds(const scene::PlumeField& field,
+                                           const ChannelCamera& cam) {
     const scene::PlumeField::PuffArrays puffs = field.Puffs();
     const size_t plumes = field.PlumeCount();
     std::vector<glm::dvec3> lo(plumes, glm::dvec3(1e300)), hi(plumes, glm::dvec3(-1e300));
@@ -74,13 +91,55 @@ std::vector<PixelRect> PlumeRects(const scene::PlumeField& field, const ChannelC
         lo[p] = glm::min(lo[p], c - r);
         hi[p] = glm::max(hi[p], c + r);
     }
-    std::vector<PixelRect> rects;
+    const glm::dvec3 eye = cam.worldFromCamera.position_m;
+    std::vector<PlumeBounds> bounds;
     for (size_t p = 0; p < plumes; ++p) {
         if (lo[p].x > hi[p].x) continue;
         const PixelRect r = ProjectBox(cam, lo[p], hi[p]);
-        if (r.x0 < r.x1 && r.y0 < r.y1) rects.push_back(r);
+        if (r.x0 >= r.x1 || r.y0 >= r.y1) continue;
+        const double nearest = glm::length(glm::clamp(eye, lo[p], hi[p]) - eye);
+        double farthest = 0.0;
+        for (int c = 0; c < 8; ++c) {
+            const glm::dvec3 q{c & 1 ? hi[p].x : lo[p].x, c & 2 ? hi[p].y : lo[p].y,
+                               c & 4 ? hi[p].z : lo[p].z};
+            farthest = std::max(farthest, glm::length(q - eye));
+        }
+        // Float margins: a little nearer and farther than the box.
+        bounds.push_back({r, float(nearest * 0.999), float(farthest * 1.001 + 1.0)});
     }
-    return rects;
+    return bounds;
+}
+
+// Bilinear blend of four traces (corners 00, 10, 01, 11) at fractions fx, fy: optical depths
+// blend linearly; albedo, temperature and asymmetry as optical-depth weighted means.
+scene::PlumeTrace Bilinear(const scene::PlumeTrace& t00, const scene::PlumeTrace& t10,
+                           const scene::PlumeTrace& t01, const scene::PlumeTrace& t11, float fx,
+                           float fy) {
+    const float w[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
+    const scene::PlumeTrace* t[4] = {&t00, &t10, &t01, &t11};
+    scene::PlumeTrace out;
+    for (int b = 0; b < scene::kObscurantBands; ++b) {
+        float tau = 0.0f, albedo = 0.0f, temperature = 0.0f, absorbing = 0.0f;
+        for (int k = 0; k < 4; ++k) {
+            const float wt = w[k] * t[k]->opticalDepth[size_t(b)];
+            tau += wt;
+            albedo += wt * t[k]->albedo[size_t(b)];
+            const float wa = wt * (1.0f - t[k]->albedo[size_t(b)]);
+            temperature += wa * t[k]->temperature_K[size_t(b)];
+            absorbing += wa;
+        }
+        out.opticalDepth[size_t(b)] = tau;
+        out.albedo[size_t(b)] = tau > 0.0f ? albedo / tau : 0.0f;
+        out.temperature_K[size_t(b)] = absorbing > 0.0f ? temperature / absorbing : 0.0f;
+    }
+    float g = 0.0f, scattering = 0.0f;
+    for (int k = 0; k < 4; ++k) {
+        const float ws = w[k] * t[k]->opticalDepth[0] * t[k]->albedo[0];
+        g += ws * t[k]->asymmetry;
+        scattering += ws;
+    }
+    out.asymmetry = scattering > 0.0f ? g / scattering : 0.0f;
+    return out;
 }
 
 glm::vec3 VisibleSource(const scene::PlumeTrace& t, const glm::vec3& toEye,
@@ -140,96 +199,204 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     const auto start = std::chrono::steady_clock::now();
     PlumeCompositeStats stats;
     const bool visible = light.kind == PlumeLighting::Kind::Visible;
-    const int N = camera.supersampling, sw = camera.SampleWidth(), sh = camera.SampleHeight();
-    CHECK(radiance.width == sw && radiance.height == sh && radiance.channels == (visible ? 3 : 1));
-    CHECK(vis.width == sw && vis.height == sh);
+    const int N = camera.supersampling, W = camera.width, H = camera.height;
+    CHECK(radiance.width == camera.SampleWidth() && radiance.height == camera.SampleHeight() &&
+          radiance.channels == (visible ? 3 : 1));
+    CHECK(vis.width == camera.SampleWidth() && vis.height == camera.SampleHeight());
     CHECK(visible || light.planck);
     if (field.PuffCount() == 0) return stats;
-    const std::vector<PixelRect> rects = PlumeRects(field, camera);
-    if (rects.empty()) return stats;
+    const std::vector<PlumeBounds> bounds = PlumeScreenBounds(field, camera);
+    if (bounds.empty()) return stats;
 
     const glm::vec3 eye(camera.worldFromCamera.position_m);
     const glm::vec3 forward(camera.worldFromCamera.worldFromBody * glm::dvec3(0.0, 1.0, 0.0));
     const float nearM = float(camera.near_m);
-    const int band = visible ? int(scene::ObscurantBand::Visible) : int(light.band);
+    const size_t band = size_t(visible ? int(scene::ObscurantBand::Visible) : int(light.band));
     const size_t samples = size_t(N) * size_t(N);
-
-    // Rows of output pixels in parallel; each pixel depends only on its own rays.
-    std::vector<uint64_t> rowCovered(size_t(camera.height), 0), rowTraces(size_t(camera.height), 0);
-    tbb::parallel_for(
-        tbb::blocked_range<int>(0, camera.height, 4), [&](const tbb::blocked_range<int>& rows) {
-            std::vector<uint8_t> covered(size_t(camera.width));
-            std::vector<float> range(samples);
-            for (int py = rows.begin(); py != rows.end(); ++py) {
-                std::fill(covered.begin(), covered.end(), uint8_t(0));
-                bool any = false;
-                for (const PixelRect& r : rects) {
-                    if (py < r.y0 || py >= r.y1) continue;
-                    std::fill(covered.begin() + r.x0, covered.begin() + r.x1, uint8_t(1));
-                    any = true;
+    const auto PixelDirection = [&](double px, double py) {
+        return glm::vec3(camera.SampleDirection(px * N + 0.5 * (N - 1), py * N + 0.5 * (N - 1)));
+    };
+    // Composites one sample with trace t seen along dir.
+    const auto Apply = [&](const scene::PlumeTrace& t, const glm::vec3& dir, int px, int py,
+                           const float* range, float rMin, float rMax,
+                           const scene::PlumeTrace* far) {
+        const scene::PlumeTrace* traces[2] = {&t, far ? far : &t};
+        float T[2], Sir[2] = {0.0f, 0.0f};
+        glm::vec3 Svis[2];
+        for (int k = 0; k < (far ? 2 : 1); ++k) {
+            T[k] = std::exp(-traces[k]->opticalDepth[band]);
+            if (visible)
+                Svis[k] = VisibleSource(*traces[k], -dir, light);
+            else
+                Sir[k] = InfraredSource(*traces[k], light);
+        }
+        for (int j = 0; j < N; ++j) {
+            for (int i = 0; i < N; ++i) {
+                const float r = range[size_t(j * N + i)];
+                const int k = far && (r - rMin > rMax - r) ? 1 : 0;
+                if (!(traces[k]->opticalDepth[band] > 0.0f)) continue;
+                float* o = radiance.At(px * N + i, py * N + j);
+                if (visible) {
+                    for (int c = 0; c < 3; ++c)
+                        o[c] = CompositeThroughPlume(o[c], T[k], Svis[k][c]);
+                } else {
+                    o[0] = CompositeThroughPlume(o[0], T[k], Sir[k]);
                 }
-                if (!any) continue;
-                for (int px = 0; px < camera.width; ++px) {
-                    if (!covered[size_t(px)]) continue;
-                    ++rowCovered[size_t(py)];
-                    const glm::vec3 dir(
-                        camera.SampleDirection(px * N + 0.5 * (N - 1), py * N + 0.5 * (N - 1)));
-                    const float cosForward = std::max(glm::dot(dir, forward), 1e-6f);
-                    float rMin = kPlumeSkyRange_m, rMax = 0.0f;
-                    for (int j = 0; j < N; ++j) {
-                        for (int i = 0; i < N; ++i) {
-                            const size_t idx = vis.Index(px * N + i, py * N + j);
-                            // depth = near / w, w the distance along the optical axis.
-                            const float r =
-                                vis.primitive[idx] == kNoPrimitive || vis.depth[idx] <= 0.0f
-                                    ? kPlumeSkyRange_m
-                                    : std::min(nearM / vis.depth[idx] / cosForward,
-                                               kPlumeSkyRange_m);
-                            range[size_t(j * N + i)] = r;
-                            rMin = std::min(rMin, r), rMax = std::max(rMax, r);
-                        }
+            }
+        }
+    };
+
+    // Nodes of the interpolation grid: the centres of every kCell-th pixel, traced to the sky.
+    const int nodesX = (W + kCell - 1) / kCell + 1, nodesY = (H + kCell - 1) / kCell + 1;
+    const int cellsX = nodesX - 1, cellsY = nodesY - 1;
+    const auto CellBounds = [&](int cx, int cy, float& dNear, float& dFar) {
+        dNear = kPlumeSkyRange_m, dFar = 0.0f;
+        const int x0 = cx * kCell, y0 = cy * kCell;
+        bool any = false;
+        for (const PlumeBounds& b : bounds) {
+            if (b.rect.x1 <= x0 || b.rect.x0 >= x0 + kCell || b.rect.y1 <= y0 ||
+                b.rect.y0 >= y0 + kCell)
+                continue;
+            dNear = std::min(dNear, b.near_m), dFar = std::max(dFar, b.far_m);
+            any = true;
+        }
+        return any;
+    };
+    std::vector<uint8_t> nodeNeeded(size_t(nodesX) * size_t(nodesY), 0);
+    for (int cy = 0; cy < cellsY; ++cy)
+        for (int cx = 0; cx < cellsX; ++cx) {
+            float dNear, dFar;
+            if (!CellBounds(cx, cy, dNear, dFar)) continue;
+            for (int k = 0; k < 4; ++k)
+                nodeNeeded[size_t(cy + k / 2) * size_t(nodesX) + size_t(cx + k % 2)] = 1;
+        }
+    // Cells that a puff smaller than a cell (σ under kCell pixels) touches are traced pixel by
+    // pixel: the corner nodes could miss it.
+    std::vector<uint8_t> cellFine(size_t(cellsX) * size_t(cellsY), 0);
+    {
+        const scene::PlumeField::PuffArrays puffs = field.Puffs();
+        const glm::dmat3 cameraFromWorld = glm::transpose(camera.worldFromCamera.worldFromBody);
+        const double tanH = camera.TanHalfH(), tanV = camera.TanHalfV();
+        const double pixelAngle = 2.0 * tanH / W;
+        for (size_t i = 0; i < puffs.x.size(); ++i) {
+            const glm::dvec3 q = cameraFromWorld * (glm::dvec3(puffs.x[i], puffs.y[i], puffs.z[i]) -
+                                                    camera.worldFromCamera.position_m);
+            if (q.y <= camera.near_m) continue;
+            const double sh = 1.0 / std::sqrt(double(puffs.invVarH[i]));
+            const double sz = 1.0 / std::sqrt(double(puffs.invVarZ[i]));
+            const double perPixel = 1.0 / (q.y * pixelAngle);
+            if (std::min(sh, sz) * perPixel >= kCell) continue;
+            const double reach = scene::kPuffCutoffSigmas * std::max(sh, sz) * perPixel + 1.0;
+            const double x = (q.x / (q.y * tanH) + 1.0) * 0.5 * W;
+            const double y = (1.0 - q.z / (q.y * tanV)) * 0.5 * H;
+            const int cx0 = std::max(0, int(std::floor((x - reach) / kCell)));
+            const int cx1 = std::min(cellsX - 1, int(std::floor((x + reach) / kCell)));
+            const int cy0 = std::max(0, int(std::floor((y - reach) / kCell)));
+            const int cy1 = std::min(cellsY - 1, int(std::floor((y + reach) / kCell)));
+            for (int cy = cy0; cy <= cy1; ++cy)
+                for (int cx = cx0; cx <= cx1; ++cx)
+                    cellFine[size_t(cy) * size_t(cellsX) + size_t(cx)] = 1;
+        }
+    }
+    std::vector<scene::PlumeTrace> nodes(nodeNeeded.size());
+    std::vector<uint64_t> rowCovered(size_t(cellsY), 0), rowTraces(size_t(cellsY), 0);
+    tbb::parallel_for(tbb::blocked_range<int>(0, nodesY, 1), [&](const tbb::blocked_range<int>& r) {
+        for (int ny = r.begin(); ny != r.end(); ++ny)
+            for (int nx = 0; nx < nodesX; ++nx) {
+                const size_t n = size_t(ny) * size_t(nodesX) + size_t(nx);
+                if (!nodeNeeded[n]) continue;
+                nodes[n] =
+                    field.Trace(eye, PixelDirection(nx * kCell, ny * kCell), kPlumeSkyRange_m);
+                if (ny < cellsY)
+                    ++rowTraces[size_t(ny)];
+                else
+                    ++rowTraces[size_t(cellsY - 1)];
+            }
+    });
+
+    // Cells in parallel (a row of cells each); each pixel depends only on its own rays and the
+    // cell's corner nodes.
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, cellsY, 1), [&](const tbb::blocked_range<int>& rows) {
+            std::vector<float> range(samples);
+            for (int cy = rows.begin(); cy != rows.end(); ++cy) {
+                for (int cx = 0; cx < cellsX; ++cx) {
+                    float dNear, dFar;
+                    if (!CellBounds(cx, cy, dNear, dFar)) continue;
+                    const scene::PlumeTrace* corner[4];
+                    for (int k = 0; k < 4; ++k)
+                        corner[k] =
+                            &nodes[size_t(cy + k / 2) * size_t(nodesX) + size_t(cx + k % 2)];
+                    // The corners agree: bilinear interpolation of the sky traces is accurate.
+                    float lo = corner[0]->opticalDepth[band], hi = lo;
+                    float tLo = corner[0]->temperature_K[band], tHi = tLo;
+                    for (int k = 1; k < 4; ++k) {
+                        lo = std::min(lo, corner[k]->opticalDepth[band]);
+                        hi = std::max(hi, corner[k]->opticalDepth[band]);
+                        tLo = std::min(tLo, corner[k]->temperature_K[band]);
+                        tHi = std::max(tHi, corner[k]->temperature_K[band]);
                     }
-                    const scene::PlumeTrace nearTrace = field.Trace(eye, dir, rMin);
-                    ++rowTraces[size_t(py)];
-                    // Depth edge: the far samples see what lies beyond the near surface.
-                    const bool edge = rMax > rMin * 1.001f;
-                    scene::PlumeTrace farTrace = nearTrace;
-                    if (edge) {
-                        farTrace = field.Trace(eye, dir, rMax);
-                        ++rowTraces[size_t(py)];
-                    }
-                    if (!(nearTrace.opticalDepth[size_t(band)] > 0.0f) &&
-                        !(farTrace.opticalDepth[size_t(band)] > 0.0f))
-                        continue;
-                    const scene::PlumeTrace* traces[2] = {&nearTrace, &farTrace};
-                    float T[2];
-                    glm::vec3 Svis[2];
-                    float Sir[2];
-                    for (int k = 0; k < (edge ? 2 : 1); ++k) {
-                        T[k] = std::exp(-traces[k]->opticalDepth[size_t(band)]);
-                        if (visible)
-                            Svis[k] = VisibleSource(*traces[k], -dir, light);
-                        else
-                            Sir[k] = InfraredSource(*traces[k], light);
-                    }
-                    for (int j = 0; j < N; ++j) {
-                        for (int i = 0; i < N; ++i) {
-                            const float r = range[size_t(j * N + i)];
-                            const int k = edge && (r - rMin > rMax - r) ? 1 : 0;
-                            if (!(traces[k]->opticalDepth[size_t(band)] > 0.0f)) continue;
-                            float* o = radiance.At(px * N + i, py * N + j);
-                            if (visible) {
-                                for (int c = 0; c < 3; ++c)
-                                    o[c] = CompositeThroughPlume(o[c], T[k], Svis[k][c]);
+                    const bool smooth = !cellFine[size_t(cy) * size_t(cellsX) + size_t(cx)] &&
+                                        hi - lo <= kInterpolationTolerance &&
+                                        tHi - tLo <= kInterpolationTolerance_K;
+                    for (int py = cy * kCell; py < std::min(H, (cy + 1) * kCell); ++py) {
+                        for (int px = cx * kCell; px < std::min(W, (cx + 1) * kCell); ++px) {
+                            bool covered = false;
+                            for (const PlumeBounds& b : bounds)
+                                covered |= px >= b.rect.x0 && px < b.rect.x1 && py >= b.rect.y0 &&
+                                           py < b.rect.y1;
+                            if (!covered) continue;
+                            ++rowCovered[size_t(cy)];
+                            const glm::vec3 dir = PixelDirection(px, py);
+                            const float cosForward = std::max(glm::dot(dir, forward), 1e-6f);
+                            float rMin = kPlumeSkyRange_m, rMax = 0.0f;
+                            for (int j = 0; j < N; ++j) {
+                                for (int i = 0; i < N; ++i) {
+                                    const size_t idx = vis.Index(px * N + i, py * N + j);
+                                    // depth = near / w, w the distance along the optical axis.
+                                    const float r =
+                                        vis.primitive[idx] == kNoPrimitive || vis.depth[idx] <= 0.0f
+                                            ? kPlumeSkyRange_m
+                                            : std::min(nearM / vis.depth[idx] / cosForward,
+                                                       kPlumeSkyRange_m);
+                                    range[size_t(j * N + i)] = r;
+                                    rMin = std::min(rMin, r), rMax = std::max(rMax, r);
+                                }
+                            }
+                            // Every surface in front of the plumes: nothing to add.
+                            if (rMax <= dNear) continue;
+                            if (rMin >= dFar) {
+                                // Every surface behind the plumes: the sky trace is the trace.
+                                if (smooth) {
+                                    const float fx = float(px - cx * kCell) / kCell;
+                                    const float fy = float(py - cy * kCell) / kCell;
+                                    const scene::PlumeTrace t = Bilinear(
+                                        *corner[0], *corner[1], *corner[2], *corner[3], fx, fy);
+                                    Apply(t, dir, px, py, range.data(), rMin, rMax, nullptr);
+                                } else {
+                                    const scene::PlumeTrace t =
+                                        field.Trace(eye, dir, kPlumeSkyRange_m);
+                                    ++rowTraces[size_t(cy)];
+                                    Apply(t, dir, px, py, range.data(), rMin, rMax, nullptr);
+                                }
+                                continue;
+                            }
+                            const scene::PlumeTrace nearTrace = field.Trace(eye, dir, rMin);
+                            ++rowTraces[size_t(cy)];
+                            // Depth edge: the far samples see what lies beyond the near surface.
+                            if (rMax > rMin * kDepthEdgeRatio) {
+                                const scene::PlumeTrace farTrace = field.Trace(eye, dir, rMax);
+                                ++rowTraces[size_t(cy)];
+                                Apply(nearTrace, dir, px, py, range.data(), rMin, rMax, &farTrace);
                             } else {
-                                o[0] = CompositeThroughPlume(o[0], T[k], Sir[k]);
+                                Apply(nearTrace, dir, px, py, range.data(), rMin, rMax, nullptr);
                             }
                         }
                     }
                 }
             }
         });
-    for (int y = 0; y < camera.height; ++y) {
+    for (int y = 0; y < cellsY; ++y) {
         stats.pixelsCovered += rowCovered[size_t(y)];
         stats.traces += rowTraces[size_t(y)];
     }
