@@ -131,6 +131,15 @@ scene::PlumeTrace Bilinear(const scene::PlumeTrace& t00, const scene::PlumeTrace
         out.opticalDepth[size_t(b)] = tau;
         out.albedo[size_t(b)] = tau > 0.0f ? albedo / tau : 0.0f;
         out.temperature_K[size_t(b)] = absorbing > 0.0f ? temperature / absorbing : 0.0f;
+        float hot = 0.0f, hotT = 0.0f;
+        for (int k = 0; k < 4; ++k) {
+            const float wh = w[k] * t[k]->opticalDepth[size_t(b)] *
+                             (1.0f - t[k]->albedo[size_t(b)]) * t[k]->hotFraction[size_t(b)];
+            hot += wh;
+            hotT += wh * t[k]->hotTemperature_K[size_t(b)];
+        }
+        out.hotFraction[size_t(b)] = absorbing > 0.0f ? std::min(hot / absorbing, 1.0f) : 0.0f;
+        out.hotTemperature_K[size_t(b)] = hot > 0.0f ? hotT / hot : 0.0f;
     }
     float g = 0.0f, scattering = 0.0f;
     for (int k = 0; k < 4; ++k) {
@@ -142,26 +151,43 @@ scene::PlumeTrace Bilinear(const scene::PlumeTrace& t00, const scene::PlumeTrace
     return out;
 }
 
+// Absorption-weighted emission of the trace's puffs in band b: the hot (flame) part and the
+// rest each at their own mean temperature. emit(T) is the band's blackbody radiance.
+template <class Emission>
+auto ThermalEmission(const scene::PlumeTrace& t, size_t b, const Emission& emit) {
+    const float h = t.hotFraction[b];
+    const float T = t.temperature_K[b], Thot = t.hotTemperature_K[b];
+    decltype(emit(T)) sum = emit(0.0f) * 0.0f;
+    if (h > 0.0f && Thot > 0.0f) sum = sum + emit(Thot) * h;
+    if (h < 1.0f && T > 0.0f) {
+        // T = (1 − h) T_rest + h T_hot.
+        const float rest = std::max((T - h * Thot) / (1.0f - h), 0.0f);
+        if (rest > 0.0f) sum = sum + emit(rest) * (1.0f - h);
+    }
+    return sum;
+}
+
 glm::vec3 VisibleSource(const scene::PlumeTrace& t, const glm::vec3& toEye,
                         const PlumeLighting& light) {
-    constexpr int kVis = int(scene::ObscurantBand::Visible);
+    constexpr size_t kVis = size_t(scene::ObscurantBand::Visible);
     const float omega = t.albedo[kVis];
     // Light from the sun travels along −sunDirection, light to the eye along toEye.
     const float cosTheta = -glm::dot(light.sunDirection, toEye);
     glm::vec3 S = omega * (light.sunIlluminance * HenyeyGreensteinPhase(cosTheta, t.asymmetry) +
                            light.ambientRgb);
-    if (t.temperature_K[kVis] > 0.0f && light.glow)
-        S += (1.0f - omega) * (*light.glow)(t.temperature_K[kVis]);
+    if (light.glow)
+        S += (1.0f - omega) *
+             ThermalEmission(t, kVis, [&](float T_K) { return (*light.glow)(T_K); });
     return S;
 }
 
 float InfraredSource(const scene::PlumeTrace& t, const PlumeLighting& light) {
-    const int b = int(light.band);
-    const float omega = t.albedo[size_t(b)];
-    float S = omega * light.ambient;
-    if (t.temperature_K[size_t(b)] > 0.0f)
-        S += (1.0f - omega) * float(light.planck->Radiance(t.temperature_K[size_t(b)]));
-    return S;
+    const size_t b = size_t(light.band);
+    const float omega = t.albedo[b];
+    return omega * light.ambient + (1.0f - omega) * ThermalEmission(t, b, [&](float T_K) {
+                                       return T_K > 0.0f ? float(light.planck->Radiance(T_K))
+                                                         : 0.0f;
+                                   });
 }
 
 }  // namespace

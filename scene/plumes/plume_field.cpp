@@ -51,6 +51,8 @@ struct Accumulator {
     float scattering[kObscurantBands] = {};
     float absorption[kObscurantBands] = {};
     float absorptionT[kObscurantBands] = {};
+    float hotAbsorption[kObscurantBands] = {};
+    float hotAbsorptionT[kObscurantBands] = {};
     float scatteringG = 0.0f;  // visible
 };
 
@@ -394,6 +396,13 @@ PlumeTrace PlumeField::Trace(const glm::vec3& origin_m, const glm::vec3& dir,
                 acc.absorption[b] += tauAbs;
                 acc.absorptionT[b] += tauAbs * T;
             }
+            if (T >= kHotPuff_K) {
+                for (int b = 0; b < kObscurantBands; ++b) {
+                    const float tauAbs = op.absorption[b] * integral;
+                    acc.hotAbsorption[b] += tauAbs;
+                    acc.hotAbsorptionT[b] += tauAbs * T;
+                }
+            }
             acc.scatteringG += op.scatteringG * integral;
         }
     }
@@ -402,6 +411,11 @@ PlumeTrace PlumeField::Trace(const glm::vec3& origin_m, const glm::vec3& dir,
         result.albedo[b] = acc.extinction[b] > 0.0f ? acc.scattering[b] / acc.extinction[b] : 0.0f;
         result.temperature_K[b] =
             acc.absorption[b] > 0.0f ? acc.absorptionT[b] / acc.absorption[b] : 0.0f;
+        result.hotFraction[b] = acc.absorption[b] > 0.0f
+                                    ? std::min(acc.hotAbsorption[b] / acc.absorption[b], 1.0f)
+                                    : 0.0f;
+        result.hotTemperature_K[b] =
+            acc.hotAbsorption[b] > 0.0f ? acc.hotAbsorptionT[b] / acc.hotAbsorption[b] : 0.0f;
     }
     constexpr int kVis = int(ObscurantBand::Visible);
     result.asymmetry = acc.scattering[kVis] > 0.0f ? acc.scatteringG / acc.scattering[kVis] : 0.0f;

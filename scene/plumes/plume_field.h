@@ -58,6 +58,12 @@ struct PlumeTrace {
     std::array<float, kObscurantBands> opticalDepth{};
     std::array<float, kObscurantBands> albedo{};
     std::array<float, kObscurantBands> temperature_K{};
+    // The part of the absorption optical depth from puffs at or above kHotPuff_K (flames) and
+    // their absorption-weighted mean temperature (0 when none): emission is steeply
+    // nonlinear in temperature, so renderers weight B(T_hot) and B(T_rest) separately rather
+    // than take B of the mean.
+    std::array<float, kObscurantBands> hotFraction{};
+    std::array<float, kObscurantBands> hotTemperature_K{};
     // Henyey–Greenstein asymmetry of the visible scattering, weighted by scattering depth.
     float asymmetry = 0.0f;
 
@@ -67,6 +73,10 @@ struct PlumeTrace {
 // Puffs beyond this many σ (Mahalanobis distance) from a ray are skipped: e^(−3.5²/2) ≈ 0.2 %
 // of the peak line integral.
 inline constexpr float kPuffCutoffSigmas = 3.5f;
+
+// Puffs at or above this temperature count as hot (PlumeTrace::hotFraction): well above any
+// smoke, exhaust or steam puff after its first metres, below luminous flames.
+inline constexpr float kHotPuff_K = 700.0f;
 
 // A committed, immutable-after-Build set of puffs. Storage is sized once (capacity); Clear,
 // Add and Build reuse it, so committing a frame allocates nothing.
