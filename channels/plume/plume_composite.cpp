@@ -326,6 +326,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     }
     std::vector<scene::PlumeTrace> nodes(nodeNeeded.size());
     std::vector<uint64_t> rowCovered(size_t(cellsY), 0), rowTraces(size_t(cellsY), 0);
+    std::vector<uint64_t> nodeTraces(size_t(nodesY), 0);
     tbb::parallel_for(tbb::blocked_range<int>(0, nodesY, 1), [&](const tbb::blocked_range<int>& r) {
         for (int ny = r.begin(); ny != r.end(); ++ny)
             for (int nx = 0; nx < nodesX; ++nx) {
@@ -333,10 +334,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                 if (!nodeNeeded[n]) continue;
                 nodes[n] =
                     field.Trace(eye, PixelDirection(nx * kCell, ny * kCell), kPlumeSkyRange_m);
-                if (ny < cellsY)
-                    ++rowTraces[size_t(ny)];
-                else
-                    ++rowTraces[size_t(cellsY - 1)];
+                ++nodeTraces[size_t(ny)];
             }
     });
 
@@ -426,6 +424,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
         stats.pixelsCovered += rowCovered[size_t(y)];
         stats.traces += rowTraces[size_t(y)];
     }
+    for (uint64_t n : nodeTraces) stats.traces += n;
     stats.ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return stats;

@@ -81,12 +81,18 @@ inline constexpr float kPlumeSkyRange_m = 1.0e6f;
 // Composites field over radiance, the channel's supersampled image (3 channels for Visible,
 // 1 for Infrared) of camera with visibility buffer vis. Each plume's puffs (centres ± the trace
 // cutoff of kPuffCutoffSigmas σ) bound a box; the box's screen rectangle (the whole screen
-// when the box reaches behind the near plane) marks the output pixels to trace. A covered
-// pixel traces one ray from the eye through its centre to its nearest sample's surface (sky:
-// kPlumeSkyRange_m); when its samples' ranges differ, a second ray to the farthest, and each
-// sample takes the trace whose end is nearer its own range. Samples outside every rectangle
-// are left bit for bit as they were. Runs in the caller's oneTBB arena; bit-identical for any
-// thread count.
+// when the box reaches behind the near plane) marks the output pixels to consider, and its
+// nearest and farthest points bound the ranges where it can matter. Per covered pixel, with
+// the ranges of its samples' surfaces (sky: kPlumeSkyRange_m):
+//  - all surfaces nearer than every plume box: nothing to do;
+//  - all surfaces beyond every plume box: the sky trace, bilinear from traces at the corners
+//    of its 4×4-pixel cell when no puff smaller than a cell touches the cell and the corners
+//    agree within 0.02 in optical depth and 10 K, else traced through the pixel centre;
+//  - otherwise one ray through the pixel centre to the nearest surface and, when the ranges
+//    differ by more than 10 %, a second to the farthest; each sample takes the trace whose end
+//    is nearer its own range.
+// Samples outside every rectangle are left bit for bit as they were. Runs in the caller's
+// oneTBB arena; bit-identical for any thread count.
 PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const ChannelCamera& camera,
                                     const VisibilityBuffer& vis, const PlumeLighting& light,
                                     Image& radiance);
