@@ -9,6 +9,7 @@
 #include <chrono>
 #include <map>
 
+#include "channels/plume/plume_composite.h"
 #include "channels/view/surface_gather.h"
 #include "scene/core/check.h"
 #include "scene/core/error.h"
@@ -181,7 +182,8 @@ FlirChannel::FlirChannel(const scene::World& world, const scene::ChannelSettings
       table_(InfraredBandOf(settings.band)),
       atmosphere_(table_.GetBand(), air_, world.GetScenario().environment.visibility_m),
       seaCurve_(radiometry::SeaEmissivityTable(radiometry::SeaSurfaceEmissivity(table_.GetBand()))
-                    .Curve(world.GetScenario().environment.windSpeed_mps)) {
+                    .Curve(world.GetScenario().environment.windSpeed_mps)),
+      plumes_(std::make_unique<ChannelPlumes>(world)) {
     const scene::Scenario& sc = world.GetScenario();
     if (!sc.materialTable)
         throw InputError("scenario " + sc.file.string() +
@@ -484,6 +486,9 @@ void FlirChannel::Render(const scene::SceneState& state, Image& radiance) {
     });
     for (uint64_t r : blockRays) stats_.shadowRays += r;
     stats_.shadeMs = Ms(t1, Clock::now());
+
+    // Plumes (channels/plume) over the finished radiance.
+    plumes_->CompositeFlir(state, cam, vis, *this, radiance);
 }
 
 }  // namespace seasense::channels

@@ -99,6 +99,8 @@ class UniformTable {
 // and time_s (seconds since the start), and the unit ENU direction toward the sun.
 double SunIrradiance_W_m2(const scene::Scenario& scenario, double time_s, glm::dvec3& sunDirection);
 
+class ChannelPlumes;
+
 class FlirChannel {
   public:
     // Reads the atmosphere, sea and material table of the world's scenario and the channel's
@@ -163,6 +165,7 @@ class FlirChannel {
     std::vector<std::unique_ptr<OrientationTemperatures>> heatBalance_;
     std::vector<std::array<float, OrientationTemperatures::kClasses>> entityB_;
     std::unique_ptr<ShadeScratch> scratch_;
+    std::unique_ptr<ChannelPlumes> plumes_;  // scenario plumes (channels/plume)
     FlirFrameStats stats_;
 };
 

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <limits>
 
+#include "channels/plume/plume_composite.h"
 #include "radiometry/sky/analytic_sky.h"
 #include "radiometry/surface/fresnel.h"
 #include "scene/core/check.h"
@@ -733,7 +734,10 @@ void ShadeModels(const FrameShading& f, const FrameGeometry& g, const BlockScrat
 }  // namespace
 
 OtwChannel::OtwChannel(const scene::World& world, const scene::ChannelSettings& settings)
-    : world_(world), settings_(settings), geometry_(world, settings) {
+    : world_(world),
+      settings_(settings),
+      geometry_(world, settings),
+      plumes_(std::make_unique<ChannelPlumes>(world)) {
     for (const scene::EntityState& e : world.State(0).entities)
         reflectance_.push_back(e.reflectanceRgb);
 }
@@ -856,6 +860,9 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     });
     for (uint64_t r : blockRays) stats_.shadowRays += r;
     stats_.shadeMs = Ms(t2, Clock::now());
+
+    // Plumes (channels/plume) over the finished radiance.
+    plumes_->CompositeOtw(state, cam, vis, sky, radiance);
 }
 
 }  // namespace seasense::channels

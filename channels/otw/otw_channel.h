@@ -12,6 +12,8 @@
 
 namespace seasense::channels {
 
+class ChannelPlumes;
+
 struct OtwFrameStats {
     uint64_t oceanTriangles = 0;
     uint64_t modelTriangles = 0;
@@ -52,6 +54,7 @@ class OtwChannel {
     std::unique_ptr<radiometry::AnalyticSky> sky_;
     glm::dvec3 skySun_{0.0};
     std::unique_ptr<ShadeScratch> scratch_;
+    std::unique_ptr<ChannelPlumes> plumes_;  // scenario plumes (channels/plume)
     OtwFrameStats stats_;
 };
 

@@ -51,6 +51,9 @@ struct Accumulator {
     float scattering[kObscurantBands] = {};
     float absorption[kObscurantBands] = {};
     float absorptionT[kObscurantBands] = {};
+    float hotAbsorption[kObscurantBands] = {};
+    float hotAbsorptionT[kObscurantBands] = {};
+    float scatteringG = 0.0f;  // visible
 };
 
 // Slab test of a ray against an AABB for s in [0, maxS].
@@ -80,6 +83,23 @@ ObscurantOptics KindOptics(PlumeKind kind, double visibleAlbedo) {
     if (!(visibleAlbedo >= 0.0 && visibleAlbedo <= 1.0))
         throw InputError("plume optics: visible albedo must be within [0, 1]");
     ObscurantOptics optics;
+    // Asymmetry parameters in the visible: biomass-burning smoke ≈ 0.64 and desert dust ≈ 0.69
+    // at 440 nm in the AERONET climatology of Dubovik et al., J. Atmos. Sci. 59 (2002) 590,
+    // taken for every soot plume and for road dust; ≈ 0.86 for water droplets of ~10 µm
+    // (Hansen & Travis, Space Sci. Rev. 16 (1974) 527: 0.85–0.87 for cloud droplets).
+    switch (kind) {
+        case PlumeKind::Smoke:
+        case PlumeKind::Flame:
+        case PlumeKind::Exhaust:
+            optics.asymmetry = 0.64;
+            break;
+        case PlumeKind::Dust:
+            optics.asymmetry = 0.69;
+            break;
+        case PlumeKind::Steam:
+            optics.asymmetry = 0.86;
+            break;
+    }
     const double lambdaVis_m = BandCentre_m(ObscurantBand::Visible);
     for (int b = 0; b < kObscurantBands; ++b) {
         const double lambda_m = BandCentre_m(ObscurantBand(b));
@@ -161,6 +181,7 @@ PlumeField::PlumeField(size_t capacity, size_t plumeCount)
       temperature_K_(capacity),
       plume_(capacity),
       optics_(plumeCount),
+      sourceOptics_(plumeCount),
       nodes_(std::max<size_t>(1, 2 * capacity)),
       order_(capacity),
       scratchF_(capacity),
@@ -172,6 +193,7 @@ PlumeField::PlumeField(size_t capacity, size_t plumeCount)
 
 void PlumeField::SetOptics(uint32_t plume, const ObscurantOptics& optics) {
     CHECK_MSG(plume < optics_.size(), "plume " << plume << " of " << optics_.size());
+    sourceOptics_[plume] = optics;
     PlumeOptics& o = optics_[plume];
     for (int b = 0; b < kObscurantBands; ++b) {
         const double alpha = optics.massExtinction_m2pkg[b];
@@ -180,6 +202,7 @@ void PlumeField::SetOptics(uint32_t plume, const ObscurantOptics& optics) {
         o.scattering[b] = float(alpha * omega);
         o.absorption[b] = float(alpha * (1.0 - omega));
     }
+    o.scatteringG = o.scattering[int(ObscurantBand::Visible)] * float(optics.asymmetry);
 }
 
 void PlumeField::Clear(double t_s) {
@@ -223,6 +246,25 @@ Puff PlumeField::PuffAt(size_t i) const {
     p.temperature_K = temperature_K_[i];
     p.plume = plume_[i];
     return p;
+}
+
+PlumeField::PuffArrays PlumeField::Puffs() const {
+    const auto f = [&](const std::vector<float>& v) {
+        return std::span<const float>(v.data(), count_);
+    };
+    return {f(cx_),
+            f(cy_),
+            f(cz_),
+            f(invVarH_),
+            f(invVarZ_),
+            f(peak_),
+            f(temperature_K_),
+            std::span<const uint32_t>(plume_.data(), count_)};
+}
+
+const ObscurantOptics& PlumeField::Optics(uint32_t plume) const {
+    CHECK_MSG(plume < sourceOptics_.size(), "plume " << plume << " of " << sourceOptics_.size());
+    return sourceOptics_[plume];
 }
 
 void PlumeField::Build() {
@@ -354,6 +396,14 @@ PlumeTrace PlumeField::Trace(const glm::vec3& origin_m, const glm::vec3& dir,
                 acc.absorption[b] += tauAbs;
                 acc.absorptionT[b] += tauAbs * T;
             }
+            if (T >= kHotPuff_K) {
+                for (int b = 0; b < kObscurantBands; ++b) {
+                    const float tauAbs = op.absorption[b] * integral;
+                    acc.hotAbsorption[b] += tauAbs;
+                    acc.hotAbsorptionT[b] += tauAbs * T;
+                }
+            }
+            acc.scatteringG += op.scatteringG * integral;
         }
     }
     for (int b = 0; b < kObscurantBands; ++b) {
@@ -361,7 +411,14 @@ PlumeTrace PlumeField::Trace(const glm::vec3& origin_m, const glm::vec3& dir,
         result.albedo[b] = acc.extinction[b] > 0.0f ? acc.scattering[b] / acc.extinction[b] : 0.0f;
         result.temperature_K[b] =
             acc.absorption[b] > 0.0f ? acc.absorptionT[b] / acc.absorption[b] : 0.0f;
+        result.hotFraction[b] = acc.absorption[b] > 0.0f
+                                    ? std::min(acc.hotAbsorption[b] / acc.absorption[b], 1.0f)
+                                    : 0.0f;
+        result.hotTemperature_K[b] =
+            acc.hotAbsorption[b] > 0.0f ? acc.hotAbsorptionT[b] / acc.hotAbsorption[b] : 0.0f;
     }
+    constexpr int kVis = int(ObscurantBand::Visible);
+    result.asymmetry = acc.scattering[kVis] > 0.0f ? acc.scatteringG / acc.scattering[kVis] : 0.0f;
     return result;
 }
 

@@ -20,10 +20,13 @@ inline constexpr int kObscurantBands = 4;
 // MWIR 4 µm (3–5 µm window), LWIR 10 µm (8–12 µm window).
 double BandCentre_m(ObscurantBand band);
 
-// Mass extinction coefficient α (m²/kg, seed 004 Eq 1) and single-scattering albedo per band.
+// Mass extinction coefficient α (m²/kg, seed 004 Eq 1) and single-scattering albedo per band,
+// and the Henyey–Greenstein asymmetry parameter g of the particles in sunlight (visible and
+// near-IR; the infrared channels scatter no sunlight).
 struct ObscurantOptics {
     std::array<double, kObscurantBands> massExtinction_m2pkg{};
     std::array<double, kObscurantBands> albedo{};
+    double asymmetry = 0.0;
 };
 
 // Optics of a plume kind with the given visible single-scattering albedo (the other bands
@@ -55,6 +58,14 @@ struct PlumeTrace {
     std::array<float, kObscurantBands> opticalDepth{};
     std::array<float, kObscurantBands> albedo{};
     std::array<float, kObscurantBands> temperature_K{};
+    // The part of the absorption optical depth from puffs at or above kHotPuff_K (flames) and
+    // their absorption-weighted mean temperature (0 when none): emission is steeply
+    // nonlinear in temperature, so renderers weight B(T_hot) and B(T_rest) separately rather
+    // than take B of the mean.
+    std::array<float, kObscurantBands> hotFraction{};
+    std::array<float, kObscurantBands> hotTemperature_K{};
+    // Henyey–Greenstein asymmetry of the visible scattering, weighted by scattering depth.
+    float asymmetry = 0.0f;
 
     float Transmittance(ObscurantBand band) const;  // exp(−τ), seed 004 Eq 1
 };
@@ -62,6 +73,10 @@ struct PlumeTrace {
 // Puffs beyond this many σ (Mahalanobis distance) from a ray are skipped: e^(−3.5²/2) ≈ 0.2 %
 // of the peak line integral.
 inline constexpr float kPuffCutoffSigmas = 3.5f;
+
+// Puffs at or above this temperature count as hot (PlumeTrace::hotFraction): well above any
+// smoke, exhaust or steam puff after its first metres, below luminous flames.
+inline constexpr float kHotPuff_K = 700.0f;
 
 // A committed, immutable-after-Build set of puffs. Storage is sized once (capacity); Clear,
 // Add and Build reuse it, so committing a frame allocates nothing.
@@ -86,6 +101,18 @@ class PlumeField {
     // The i-th puff (after Build, in BVH order).
     Puff PuffAt(size_t i) const;
 
+    // The committed puffs as float arrays (PuffCount() entries each, BVH order), for renderers
+    // that walk every puff: centre (ENU m), 1/σh², 1/σz² (m⁻²), peak concentration
+    // M / ((2π)^(3/2) σh² σz) (kg/m³), temperature (K) and plume index.
+    struct PuffArrays {
+        std::span<const float> x, y, z, invVarH, invVarZ, peak_kgpm3, temperature_K;
+        std::span<const uint32_t> plume;
+    };
+    PuffArrays Puffs() const;
+    size_t PlumeCount() const { return optics_.size(); }
+    // The optics set for plume (SetOptics).
+    const ObscurantOptics& Optics(uint32_t plume) const;
+
     // Along origin + s·dir, s in [0, maxDistance_m]; dir must be a unit vector.
     PlumeTrace Trace(const glm::vec3& origin_m, const glm::vec3& dir, float maxDistance_m) const;
     // One ray per entry, in parallel (oneTBB); each result depends only on its own ray.
@@ -106,6 +133,7 @@ class PlumeField {
         float extinction[kObscurantBands];  // α, m²/kg
         float scattering[kObscurantBands];  // α ω
         float absorption[kObscurantBands];  // α (1 − ω)
+        float scatteringG;                  // α ω g, visible
     };
 
     uint32_t BuildNode(uint32_t begin, uint32_t end);
@@ -121,6 +149,7 @@ class PlumeField {
     std::vector<float> temperature_K_;
     std::vector<uint32_t> plume_;
     std::vector<PlumeOptics> optics_;
+    std::vector<ObscurantOptics> sourceOptics_;  // as given to SetOptics
     std::vector<Node> nodes_;
     size_t nodeCount_ = 0;
     // Build scratch, sized with the capacity.

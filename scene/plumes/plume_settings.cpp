@@ -1,8 +1,12 @@
 // Per-kind plume defaults and the validating reader of the plumes configuration section.
 #include "scene/plumes/plume_settings.h"
 
+#include <algorithm>
+#include <cmath>
 #include <numbers>
 #include <string>
+
+#include "scene/config/suggest.h"
 
 namespace seasense::scene {
 namespace {
@@ -18,12 +22,40 @@ const std::vector<std::string> kStabilityNames = {"auto", "A", "B", "C", "D", "E
 constexpr double kMaxRate_hz = 100.0;
 constexpr double kMaxLifetime_s = 3600.0;
 
-PlumeSourceSettings ReadSource(const ConfigValue& value) {
-    return ReadMap(value, [](ConfigMap& m) {
+// The entity named by attach_to, which must be one of names.
+std::string ReadEntityName(const ConfigValue& value, const std::vector<std::string>& names) {
+    std::string expected = "the name of an entity";
+    if (names.empty()) expected += " (the scenario has none)";
+    const std::string name = value.AsString();
+    if (std::find(names.begin(), names.end(), name) == names.end()) {
+        const std::optional<std::string> suggestion = SuggestClosest(name, names);
+        value.Fail(expected,
+                   value.Describe() + (suggestion ? " (did you mean '" + *suggestion + "'?)" : ""));
+    }
+    return name;
+}
+
+// Fails at key of m, when present, because attach_to sets what it would set.
+void RejectWithAttachment(ConfigMap& m, std::string_view key, const char* why) {
+    if (const std::optional<ConfigValue> v = m.Find(key))
+        v->Fail(std::string("no ") + std::string(key) + " together with attach_to (" + why + ")",
+                v->Describe());
+}
+
+PlumeSourceSettings ReadSource(const ConfigValue& value, const PlumeParseContext& context) {
+    return ReadMap(value, [&](ConfigMap& m) {
         const auto kind = PlumeKind(m.GetEnum("kind", kKindNames));
         PlumeSourceSettings s = DefaultPlumeSource(kind);
-        s.position_m = m.GetVec3("position_m", NumberRange::Any("m"));
-        s.start_s = m.GetDouble("start_s", NumberRange::NonNegative("s"), s.start_s);
+        const std::optional<ConfigValue> attach = m.Find("attach_to");
+        if (attach) {
+            s.attachTo = ReadEntityName(*attach, context.entityNames);
+            s.attachOffset_m = m.GetVec3("offset_m", NumberRange::Any("m"), s.attachOffset_m);
+            RejectWithAttachment(m, "position_m", "the entity's pose and offset_m place it");
+        } else {
+            s.position_m = m.GetVec3("position_m", NumberRange::Any("m"));
+        }
+        // Negative: the source was already going when the scenario starts.
+        s.start_s = m.GetDouble("start_s", NumberRange::Any("s"), s.start_s);
         s.duration_s = m.GetDouble("duration_s", NumberRange::Positive("s"), s.duration_s);
         s.rate_hz =
             m.GetDouble("rate_hz", NumberRange::OpenClosed(0, kMaxRate_hz, "Hz"), s.rate_hz);
@@ -64,10 +96,15 @@ PlumeSourceSettings ReadSource(const ConfigValue& value) {
                                                  s.exitVelocity_mps);
                 break;
             case PlumeKind::Dust:
-                s.speed_mps =
-                    m.GetDouble("speed_mps", NumberRange::Closed(0, 100, "m/s"), s.speed_mps);
-                s.heading_rad =
-                    m.GetDouble("heading_deg", NumberRange::Any("deg"), 0.0) * kRadPerDeg;
+                if (attach) {
+                    RejectWithAttachment(m, "speed_mps", "the vehicle is the entity");
+                    RejectWithAttachment(m, "heading_deg", "the vehicle is the entity");
+                } else {
+                    s.speed_mps =
+                        m.GetDouble("speed_mps", NumberRange::Closed(0, 100, "m/s"), s.speed_mps);
+                    s.heading_rad =
+                        m.GetDouble("heading_deg", NumberRange::Any("deg"), 0.0) * kRadPerDeg;
+                }
                 s.soil = SoilType(m.GetEnum("soil", kSoilNames, size_t(s.soil)));
                 s.road = RoadType(m.GetEnum("road", kRoadNames, size_t(s.road)));
                 s.siltPercent =
@@ -144,18 +181,34 @@ PlumeSourceSettings DefaultPlumeSource(PlumeKind kind) {
     return s;
 }
 
-PlumesSettings ParsePlumesSettings(ConfigMap& map) {
+PlumesSettings ParsePlumesSettings(ConfigMap& map, const PlumeParseContext& context) {
     PlumesSettings settings;
+    settings.airTemperature_K = context.airTemperature_K;
     const size_t stability = map.GetEnum("stability", kStabilityNames, 0);
     if (stability > 0) settings.stability = StabilityClass(stability - 1);
     settings.inversionHeight_m =
         map.GetDouble("inversion_height_m", NumberRange::Positive("m"), settings.inversionHeight_m);
+    settings.airTemperatureGiven = map.Find("air_temperature_K").has_value();
     settings.airTemperature_K = map.GetDouble(
         "air_temperature_K", NumberRange::Closed(180, 340, "K"), settings.airTemperature_K);
     for (const ConfigValue& source : map.GetList("sources", 0, kMaxPlumeSources, "plume sources"))
-        settings.sources.push_back(ReadSource(source));
+        settings.sources.push_back(ReadSource(source, context));
     map.Finish();
     return settings;
+}
+
+void PlaceAttachedSource(PlumeSourceSettings& source, const glm::dvec3& entityPosition_m,
+                         const glm::dmat3& worldFromBody, const glm::dvec3& entityVelocity_mps) {
+    const glm::dvec3 v{entityVelocity_mps.x, entityVelocity_mps.y, 0.0};
+    source.position_m =
+        entityPosition_m + v * source.start_s + worldFromBody * source.attachOffset_m;
+    if (source.kind == PlumeKind::Dust) {
+        source.speed_mps = glm::length(v);
+        source.heading_rad = source.speed_mps > 0.0 ? std::atan2(v.x, v.y) : 0.0;
+        source.velocity_mps = glm::dvec3(0.0);
+    } else {
+        source.velocity_mps = v;
+    }
 }
 
 }  // namespace seasense::scene

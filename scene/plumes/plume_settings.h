@@ -6,6 +6,7 @@
 #include <glm/glm.hpp>
 #include <limits>
 #include <optional>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -30,6 +31,15 @@ double SeedIndex(RoadType road);
 struct PlumeSourceSettings {
     PlumeKind kind = PlumeKind::Smoke;
     glm::dvec3 position_m{0.0};  // ENU, the base of the fire / stack exit / vehicle at start_s
+    // Horizontal velocity of the source (ENU m/s, z = 0) for every kind but dust, whose vehicle
+    // moves by speed_mps and heading_rad: the source at time t is position_m + velocity_mps ·
+    // (t − start_s), and each puff is born where the source was at its birth.
+    glm::dvec3 velocity_mps{0.0};
+    // Set when the source rides on a scenario entity (`attach_to`): the entity's name and the
+    // source's offset in the entity's body frame (x right, y forward, z up; metres). The
+    // scenario loader turns them into position_m and velocity_mps (speed and heading for dust).
+    std::string attachTo;
+    glm::dvec3 attachOffset_m{0.0};
     double start_s = 0.0;
     double duration_s = std::numeric_limits<double>::infinity();
     double rate_hz = 1.0;           // puffs born per second in each of the five columns
@@ -67,6 +77,8 @@ struct PlumesSettings {
     std::optional<StabilityClass> stability;  // nullopt: from wind, sun and cloud (Turner)
     double inversionHeight_m = std::numeric_limits<double>::infinity();  // ENU z; +∞: none
     double airTemperature_K = 288.15;
+    // Whether air_temperature_K was given; if not, renderers take the scenario atmosphere's.
+    bool airTemperatureGiven = false;
     std::vector<PlumeSourceSettings> sources;
 };
 
@@ -81,13 +93,19 @@ struct PlumeAmbient {
 // Most sources a scenario may list.
 inline constexpr size_t kMaxPlumeSources = 256;
 
+// What the plumes reader needs from the rest of the scenario.
+struct PlumeParseContext {
+    std::vector<std::string> entityNames;  // the names `attach_to` may take
+    double airTemperature_K = 288.15;      // default of air_temperature_K
+};
+
 // Reads the plumes section:
 //   stability: auto | A | B | C | D | E | F        (default auto)
 //   inversion_height_m: 800                        (default: none)
-//   air_temperature_K: 288.15
+//   air_temperature_K: 288.15                      (default: context.airTemperature_K)
 //   sources:
 //     - kind: smoke | flame | dust | exhaust | steam
-//       position_m: [x, y, z]
+//       position_m: [x, y, z]      or   attach_to: <entity name>, offset_m: [x, y, z]
 //       start_s, duration_s, rate_hz, lifetime_s, mass_rate_kgps (not dust),
 //       long_term_fraction, decay_rate_hz, albedo, seed
 //       smoke: heat_release_W, source_radius_m, exit_temperature_K
@@ -95,8 +113,17 @@ inline constexpr size_t kMaxPlumeSources = 256;
 //       exhaust, steam: source_radius_m, exit_temperature_K, exit_velocity_mps
 //       dust: speed_mps, heading_deg, soil (none|dry_clay|light_sand),
 //             road (paved|clay|sand), silt_percent, moisture_percent
-// Keys of another kind are rejected as unknown. Calls map.Finish(). Throws ConfigError naming
-// the key path.
-PlumesSettings ParsePlumesSettings(ConfigMap& map);
+// Keys of another kind are rejected as unknown; position_m together with attach_to, and a dust
+// source's speed_mps or heading_deg together with attach_to, are errors (the entity sets them).
+// Calls map.Finish(). Throws ConfigError naming the key path.
+PlumesSettings ParsePlumesSettings(ConfigMap& map, const PlumeParseContext& context = {});
+
+// Places an attached source on its entity's planned track: the entity at time t is at
+// entityPosition_m + entityVelocity_mps · t with rotation worldFromBody (ENU from body), so the
+// source is at entityPosition_m + entityVelocity_mps · start_s + worldFromBody · attachOffset_m
+// at start_s and moves with entityVelocity_mps (horizontal). Dust takes it as the vehicle's
+// speed and heading. The entity's wave-riding heave, pitch and roll are not followed.
+void PlaceAttachedSource(PlumeSourceSettings& source, const glm::dvec3& entityPosition_m,
+                         const glm::dmat3& worldFromBody, const glm::dvec3& entityVelocity_mps);
 
 }  // namespace seasense::scene

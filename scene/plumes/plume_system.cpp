@@ -80,7 +80,7 @@ PlumeSystem::PlumeSystem(const PlumesSettings& settings, const PlumeAmbient& amb
         require(std::isfinite(s.position_m.x) && std::isfinite(s.position_m.y) &&
                     std::isfinite(s.position_m.z),
                 "position must be finite");
-        require(s.start_s >= 0.0 && std::isfinite(s.start_s), "start must be finite and >= 0 s");
+        require(std::isfinite(s.start_s), "start must be finite");
         require(s.duration_s > 0.0, "duration must be > 0 s");
         require(s.rate_hz > 0.0 && s.rate_hz <= 100.0, "rate must be in (0, 100] Hz");
         require(s.lifetime_s > 0.0 && s.lifetime_s <= 3600.0, "lifetime must be in (0, 3600] s");
@@ -93,6 +93,11 @@ PlumeSystem::PlumeSystem(const PlumesSettings& settings, const PlumeAmbient& amb
         require(s.albedo >= 0.0 && s.albedo <= 1.0, "albedo must be in [0, 1]");
         require(s.sourceRadius_m > 0.0 && std::isfinite(s.sourceRadius_m),
                 "source radius must be finite and > 0 m");
+        require(std::isfinite(s.velocity_mps.x) && std::isfinite(s.velocity_mps.y) &&
+                    s.velocity_mps.z == 0.0,
+                "velocity must be finite and horizontal");
+        require(s.kind != PlumeKind::Dust || s.velocity_mps == glm::dvec3(0.0),
+                "a dust vehicle moves by speed and heading, not velocity");
 
         Plume p;
         p.s = s;
@@ -109,6 +114,7 @@ PlumeSystem::PlumeSystem(const PlumesSettings& settings, const PlumeAmbient& amb
         p.baseHeight_m = s.position_m.z;
         p.puffMass_kg = s.massRate_kgps / (kPlumeColumns * s.rate_hz);
         p.wind_mps = WindAtHeight_mps(stability_, ambient.windSpeed_mps, s.position_m.z);
+        p.sourceVelocity_mps = s.velocity_mps;
         double effectiveHeight = p.baseHeight_m;
 
         switch (s.kind) {
@@ -173,7 +179,7 @@ PlumeSystem::PlumeSystem(const PlumesSettings& settings, const PlumeAmbient& amb
                 const double V = s.speed_mps;
                 require(V >= 0.0 && std::isfinite(V), "speed must be finite and >= 0 m/s");
                 require(std::isfinite(s.heading_rad), "heading must be finite");
-                p.vehicleVelocity_mps =
+                p.sourceVelocity_mps =
                     V * glm::dvec3{std::sin(s.heading_rad), std::cos(s.heading_rad), 0.0};
                 // AP-42 emission per metre scaled by the seed's dust and road indices, so
                 // that "no dust" or a paved road leaves no trail.
@@ -197,10 +203,11 @@ PlumeSystem::PlumeSystem(const PlumesSettings& settings, const PlumeAmbient& amb
 
         // Level of detail: level k merges 2^k consecutive puffs once 2 σ_p reaches 2^k times
         // the birth spacing.
+        // Consecutive puffs separate at the wind's speed relative to the source.
         p.spacingSpeed_mps =
-            s.kind == PlumeKind::Dust
-                ? std::max(glm::length(p.vehicleVelocity_mps - p.wind_mps * downwind), 0.1)
-                : p.wind_mps;
+            p.sourceVelocity_mps == glm::dvec3(0.0)
+                ? p.wind_mps
+                : std::max(glm::length(p.sourceVelocity_mps - p.wind_mps * downwind), 0.1);
         p.levels = 1;
         if (s.kind != PlumeKind::Flame) {
             const double spacing_m = p.spacingSpeed_mps / s.rate_hz;
@@ -292,7 +299,8 @@ PlumeSystem::Envelope PlumeSystem::EnvelopeAt(const Plume& p, double age_s, doub
     Envelope env;
     env.temperature_K = airTemperature_K_;
     const double u = p.wind_mps;
-    const glm::dvec3& src = p.s.position_m;
+    // Where the source was when the puff was born.
+    const glm::dvec3 src = p.s.position_m + p.sourceVelocity_mps * (birth_s - p.s.start_s);
     switch (p.s.kind) {
         case PlumeKind::Smoke:
         case PlumeKind::Exhaust:
@@ -337,8 +345,7 @@ PlumeSystem::Envelope PlumeSystem::EnvelopeAt(const Plume& p, double age_s, doub
         }
         case PlumeKind::Dust: {
             const double x = u * age_s;
-            const glm::dvec3 birthPlace = src + p.vehicleVelocity_mps * (birth_s - p.s.start_s);
-            env.centre_m = birthPlace + x * p.downwind;
+            env.centre_m = src + x * p.downwind;
             env.centre_m.z = p.ground_m + p.sigma0_m;
             const double sy = SigmaY_m(stability_, x);
             const double sz = SigmaZ_m(p.verticalClass, x);

@@ -27,9 +27,11 @@ struct PlumeCommitStats {
     double puffMass_kg = 0;  // total mass of the real puffs
 };
 
-// Puff i of a plume is born at t_i = start_s + i / rate_hz and at age a = t − t_i sits where
-// the plume model puts it (Briggs rise and Pasquill–Gifford spread for smoke, exhaust and
-// steam; buoyant rise against drag for flames; wind drift behind the moving vehicle for dust),
+// Puff i of a plume is born at t_i = start_s + i / rate_hz where the (possibly moving) source
+// is then, and at age a = t − t_i sits where the plume model puts it (Briggs rise and
+// Pasquill–Gifford spread for smoke, exhaust and steam; buoyant rise against drag for flames;
+// wind drift behind the moving vehicle for dust), all as functions of the age (so a moving
+// source needs nothing more than the birth place),
 // with mass M0 · M(a)/M0 (seed 004 Eq 4) and a random jitter keyed by (seed, column, i). Older
 // puffs are merged in pairs, fours, … (level of detail) once their spread exceeds the spacing
 // of the merged puffs, and from groups of four on the five columns merge into one puff; the
@@ -71,7 +73,7 @@ class PlumeSystem {
         glm::dvec3 crosswind{1.0, 0.0, 0.0};
         glm::dvec3 footprintA{1.0, 0.0, 0.0};  // footprint axes of the outer columns
         glm::dvec3 footprintB{0.0, 0.0, 1.0};
-        glm::dvec3 vehicleVelocity_mps{0.0};
+        glm::dvec3 sourceVelocity_mps{0.0};  // dust: the vehicle; others: velocity_mps
         double wind_mps = 1.0;
         double baseHeight_m = 0.0;  // release height after stack-tip downwash
         double ground_m = 0.0;

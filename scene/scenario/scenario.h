@@ -10,8 +10,9 @@
 
 #include "scene/config/config.h"
 #include "scene/core/time.h"
-#include "scene/sky/lightning.h"
 #include "scene/ocean/ocean_settings.h"
+#include "scene/plumes/plume_settings.h"
+#include "scene/sky/lightning.h"
 
 namespace seasense::scene {
 
@@ -152,6 +153,9 @@ struct Scenario {
     std::vector<EntitySettings> entities;
     EyepointSettings eyepoint;
     std::vector<ChannelSettings> channels;
+    // The `plumes:` section (no sources when absent). Sources attached to an entity already
+    // carry its planned track (PlaceAttachedSource).
+    PlumesSettings plumes;
     std::vector<MaterialSettings> materials;  // from the material table file
     // The `materials:` mapping of the material table file, for radiometry::ParseMaterialTable
     // (emissivities and thermal models); set by LoadScenario.

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <numbers>
@@ -11,7 +12,9 @@
 #include "scene/config/config.h"
 #include "scene/config/digest.h"
 #include "scene/config/suggest.h"
+#include "scene/core/check.h"
 #include "scene/core/error.h"
+#include "scene/core/frames.h"
 #include "scene/ocean/fft_ocean.h"
 #include "scene/ocean/gerstner.h"
 
@@ -432,6 +435,27 @@ Scenario LoadScenario(const std::filesystem::path& file) {
                     }
                 }
                 scenario.entities.push_back(std::move(entity));
+            }
+        }
+
+        if (std::optional<ConfigValue> plumes = root.Find("plumes")) {
+            PlumeParseContext context;
+            for (const EntitySettings& e : scenario.entities) context.entityNames.push_back(e.name);
+            ReadMap(*plumes,
+                    [&](ConfigMap& m) { scenario.plumes = ParsePlumesSettings(m, context); });
+            // An attached source follows its entity's planned track (World's MovingPose:
+            // position_m + speed_mps · t along the heading).
+            for (PlumeSourceSettings& source : scenario.plumes.sources) {
+                if (source.attachTo.empty()) continue;
+                const auto entity = std::find_if(
+                    scenario.entities.begin(), scenario.entities.end(),
+                    [&](const EntitySettings& e) { return e.name == source.attachTo; });
+                CHECK(entity != scenario.entities.end());
+                const double h = entity->attitude.heading_rad;
+                const glm::dvec3 velocity =
+                    entity->speed_mps * glm::dvec3{std::sin(h), std::cos(h), 0.0};
+                PlaceAttachedSource(source, entity->position_m,
+                                    WorldFromBodyRotation(entity->attitude), velocity);
             }
         }
 

@@ -1,11 +1,15 @@
-// Plume benchmarks: committing 20 plumes for a frame, and the per-pixel transmittance query
-// for a 640x480 view of those 20 plumes (oneTBB, all threads of the process).
+// Plume benchmarks: committing 20 plumes for a frame, the per-pixel transmittance query for a
+// 640x480 view of those 20 plumes (oneTBB, all threads of the process), and the channels'
+// compositing of them (screen bounds, per-pixel traces) at 1 and 2 threads.
 #include <benchmark/benchmark.h>
+#include <tbb/task_arena.h>
 
 #include <cmath>
 #include <numbers>
 #include <vector>
 
+#include "channels/plume/plume_composite.h"
+#include "scene/core/frames.h"
 #include "scene/plumes/plume_system.h"
 
 namespace seasense::scene {
@@ -81,6 +85,60 @@ void BM_PlumeTransmittance640x480(benchmark::State& state) {
     state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(dirs.size()));
 }
 BENCHMARK(BM_PlumeTransmittance640x480)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// CompositePlumes on a 640x480 OTW frame (2x2 supersampling, sea below the horizon at the
+// range of a level plane 40 m below the eye) of the twenty plumes, at state.range(0) threads;
+// the commit is not included (BM_PlumeCommit20).
+void BM_PlumeComposite(benchmark::State& state) {
+    const PlumeSystem system = TwentyPlumes();
+    PlumeField field = system.MakeField();
+    system.Commit(300.0, field);
+    channels::ChannelCamera cam;
+    Attitude attitude;
+    attitude.pitch_rad = 4.0 * std::numbers::pi / 180.0;
+    cam.worldFromCamera = Pose{glm::dvec3(0.0, -2500.0, 40.0), WorldFromBodyRotation(attitude)};
+    cam.hfov_rad = kHfov_rad;
+    cam.width = kWidth;
+    cam.height = kHeight;
+    cam.supersampling = 2;
+    channels::VisibilityBuffer vis;
+    vis.width = cam.SampleWidth();
+    vis.height = cam.SampleHeight();
+    const size_t n = size_t(vis.width) * size_t(vis.height);
+    vis.depth.assign(n, 0.0f);
+    vis.primitive.assign(n, channels::kNoPrimitive);
+    vis.b1.assign(n, 0.0f), vis.b2.assign(n, 0.0f);
+    const glm::dvec3 forward = cam.worldFromCamera.worldFromBody * glm::dvec3(0.0, 1.0, 0.0);
+    for (int y = 0; y < vis.height; ++y) {
+        for (int x = 0; x < vis.width; ++x) {
+            const glm::dvec3 d = cam.SampleDirection(x, y);
+            if (d.z >= -1e-3) continue;
+            vis.primitive[vis.Index(x, y)] = 0;
+            vis.depth[vis.Index(x, y)] = float(cam.near_m / (40.0 / -d.z * glm::dot(d, forward)));
+        }
+    }
+    const channels::BlackbodyGlowTable glow;
+    channels::PlumeLighting light;
+    light.sunDirection = glm::normalize(glm::vec3(-0.8f, 0.3f, 0.1f));
+    light.sunIlluminance = glm::vec3(3000.0f);
+    light.ambientRgb = glm::vec3(300.0f);
+    light.glow = &glow;
+    Image background(cam.SampleWidth(), cam.SampleHeight(), 3), image;
+    std::fill(background.pixels.begin(), background.pixels.end(), 1000.0f);
+    tbb::task_arena arena(int(state.range(0)));
+    channels::PlumeCompositeStats stats;
+    for (auto _ : state) {
+        state.PauseTiming();
+        image = background;
+        state.ResumeTiming();
+        arena.execute([&] { stats = channels::CompositePlumes(field, cam, vis, light, image); });
+        benchmark::ClobberMemory();
+    }
+    state.counters["puffs"] = double(field.PuffCount());
+    state.counters["covered_pixels"] = double(stats.pixelsCovered);
+    state.counters["traces"] = double(stats.traces);
+}
+BENCHMARK(BM_PlumeComposite)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace seasense::scene

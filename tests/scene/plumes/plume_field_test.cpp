@@ -181,6 +181,9 @@ TEST(PlumeField, TemperatureIsAbsorptionWeightedMean) {
     EXPECT_NEAR(t.opticalDepth[0], 4.0 / (2 * kPi * 4.0), 1e-5);
     EXPECT_NEAR(t.temperature_K[0], (3.0 * 1000.0 + 1.0 * 300.0) / 4.0, 0.01);
     EXPECT_NEAR(t.albedo[0], 0.5, 1e-6);
+    // The hot puff (≥ kHotPuff_K) carries 3/4 of the absorption, at its own temperature.
+    EXPECT_NEAR(t.hotFraction[0], 0.75, 1e-5);
+    EXPECT_NEAR(t.hotTemperature_K[0], 1000.0, 0.01);
 }
 
 TEST(PlumeField, TransmittanceBoundedAndMonotoneAlongRay) {

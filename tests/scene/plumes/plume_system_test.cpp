@@ -268,5 +268,36 @@ TEST(PlumeSystem, BadSettingsNameTheSource) {
     EXPECT_THROW(PlumeSystem(s, Breezy()), InputError);
 }
 
+// A moving source leaves its newest puffs where it is now and its first ones where it started:
+// each puff is born where the source was at its birth.
+TEST(PlumeSystem, MovingSourceBirthPlaces) {
+    PlumesSettings moving;
+    PlumeSourceSettings src = DefaultPlumeSource(PlumeKind::Exhaust);
+    src.position_m = {0.0, 0.0, 20.0};
+    src.start_s = -30.0;
+    src.velocity_mps = {20.0, 0.0, 0.0};
+    src.seed = 3;
+    moving.sources.push_back(src);
+    PlumesSettings fixed = moving;
+    fixed.sources[0].velocity_mps = glm::dvec3(0.0);
+    const auto nearest = [](const PlumesSettings& settings, const glm::dvec3& p) {
+        const PlumeSystem system(settings, Breezy());
+        PlumeField field = system.MakeField();
+        system.Commit(0.0, field);
+        double best = 1e30;
+        for (size_t i = 0; i < field.PuffCount(); ++i) {
+            const glm::dvec3 d = field.PuffAt(i).centre_m - p;
+            best = std::min(best, std::hypot(d.x, d.y));
+        }
+        return best;
+    };
+    // Now (t = 0) the source has moved 600 m east of where it started.
+    const glm::dvec3 now{600.0, 0.0, 20.0};
+    // The newest puff is under a birth interval (0.5 s) old: within its drift (wind · 0.5 s)
+    // plus the jitter of its column of the source.
+    EXPECT_LT(nearest(moving, now), 10.0);
+    EXPECT_GT(nearest(fixed, now), 300.0);
+}
+
 }  // namespace
 }  // namespace seasense::scene

@@ -590,5 +590,56 @@ TEST(MaterialTable, RepositoryTableIsPhysicallyPlausible) {
     EXPECT_LE(Mean(find("hull_white")), 0.9);
 }
 
+// A source attached to a moving entity starts at the entity's planned position at start_s
+// plus the body-frame offset turned by the heading, and moves with the entity.
+TEST_F(ScenarioLoaderTest, PlumesAttachToEntities) {
+    const std::string text =
+        Replace(valid_, "    scale: 1.5\n", "    scale: 1.5\n    speed_mps: 4\n") +
+        "plumes:\n"
+        "  stability: D\n"
+        "  sources:\n"
+        "    - kind: exhaust\n"
+        "      attach_to: target-barge\n"
+        "      offset_m: [0, -2, 10]\n"
+        "      start_s: 5\n"
+        "    - kind: smoke\n"
+        "      position_m: [10, 20, 0]\n";
+    const Scenario s = LoadScenario(Write(text));
+    ASSERT_EQ(s.plumes.sources.size(), 2u);
+    EXPECT_FALSE(s.plumes.airTemperatureGiven);
+    const PlumeSourceSettings& exhaust = s.plumes.sources[0];
+    // Heading 30°: forward (sin 30°, cos 30°), right (cos 30°, −sin 30°).
+    const double h = kPi / 6.0;
+    const glm::dvec3 forward{std::sin(h), std::cos(h), 0.0};
+    const glm::dvec3 expected = glm::dvec3(120.0, 300.0, 0.0) + 4.0 * 5.0 * forward -
+                                2.0 * forward + glm::dvec3(0.0, 0.0, 10.0);
+    EXPECT_NEAR(glm::length(exhaust.position_m - expected), 0.0, 1e-9);
+    EXPECT_NEAR(glm::length(exhaust.velocity_mps - 4.0 * forward), 0.0, 1e-12);
+    EXPECT_EQ(s.plumes.sources[1].position_m, glm::dvec3(10.0, 20.0, 0.0));
+    EXPECT_EQ(s.plumes.sources[1].velocity_mps, glm::dvec3(0.0));
+}
+
+TEST_F(ScenarioLoaderTest, PlumeErrorsNameTheKey) {
+    const std::string base = valid_ + "plumes:\n  sources:\n    - kind: smoke\n";
+    const auto expectError = [&](const std::string& text, const std::string& context,
+                                 const std::string& part, const std::string& keyPath) {
+        const std::string message = ErrorFor(text);
+        EXPECT_TRUE(message.starts_with(At(text, context, part, keyPath))) << message;
+        return message;
+    };
+    const std::string unknownEntity = base + "      attach_to: target-barg\n";
+    const std::string message =
+        expectError(unknownEntity, "attach_to", "target-barg", "plumes.sources[0].attach_to");
+    EXPECT_NE(message.find("did you mean 'target-barge'"), std::string::npos) << message;
+    expectError(base + "      position_m: [0, 0, 0]\n      heat_release_MW: 5\n", "heat_release_MW",
+                "heat_release_MW", "plumes.sources[0].heat_release_MW");
+    expectError(base + "      attach_to: target-barge\n      position_m: [0, 0, 0]\n",
+                "barge\n      position_m", "[0, 0, 0]", "plumes.sources[0].position_m");
+    expectError(base + "      position_m: [0, 0, 0]\n      rate_hz: -1\n", "rate_hz: -1", "-1",
+                "plumes.sources[0].rate_hz");
+    expectError(valid_ + "plumes:\n  stabilty: D\n  sources: []\n", "stabilty", "stabilty",
+                "plumes.stabilty");
+}
+
 }  // namespace
 }  // namespace seasense::scene

@@ -1,0 +1,140 @@
+// Plumes in the rendered channels: the scenario's plume field committed at the frame's time,
+// traced once per output pixel inside the plumes' screen bounds and composited over the
+// channel's supersampled radiance (visible RGB for OTW, band radiance for FLIR).
+#pragma once
+
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include "channels/camera/channel_camera.h"
+#include "channels/raster/rasterizer.h"
+#include "radiometry/planck/planck.h"
+#include "radiometry/sky/analytic_sky.h"
+#include "scene/core/image.h"
+#include "scene/plumes/plume_field.h"
+#include "scene/plumes/plume_system.h"
+#include "scene/world/world.h"
+
+namespace seasense::channels {
+
+class FlirChannel;
+
+// Henyey–Greenstein phase function (sr⁻¹, ∫ p dΩ = 1) at scattering-angle cosine cosTheta for
+// asymmetry g in (−1, 1): p = (1 − g²) / (4π (1 + g² − 2 g cos θ)^(3/2)) (Henyey & Greenstein,
+// Astrophys. J. 93 (1941) 70).
+float HenyeyGreensteinPhase(float cosTheta, float g);
+
+// Background radiance seen through a plume of transmittance T with a source function S that
+// is constant along the path: L = L_bg·T + (1 − T)·S, the formal solution of the radiative
+// transfer equation dL/dτ = S − L over optical depth τ = −ln T (Chandrasekhar, "Radiative
+// Transfer" (1960) §1.8; Bohren & Clothiaux, "Fundamentals of Atmospheric Radiation" (2006)
+// §5.3). Exactly L_bg when T = 1.
+inline float CompositeThroughPlume(float background, float transmittance, float source) {
+    return background * transmittance + (1.0f - transmittance) * source;
+}
+
+// Visible thermal emission of a blackbody (linear Rec.709 RGB, cd/m², Y = luminance):
+// 683 lm/W × the CIE 1931 X, Y, Z band radiances of Planck's law (radiometry CieX/Y/Z), turned
+// into Rec.709 by Rec709FromXyz; tabulated every 10 K on [500, 3000] K and linear between
+// (zero below 500 K, where the luminance is below 1e-9 cd/m²; clamped above 3000 K).
+class BlackbodyGlowTable {
+  public:
+    BlackbodyGlowTable();
+    glm::vec3 operator()(float T_K) const;
+
+  private:
+    std::vector<glm::vec3> rgb_;
+};
+
+// The light on the plumes for one frame of one channel, and what the source function is.
+struct PlumeLighting {
+    enum class Kind { Visible, Infrared };
+    Kind kind = Kind::Visible;
+    // Visible: S = ω [E_sun p_HG(cos θ; g) + L_amb] + (1 − ω) L_glow(T), per colour: single
+    // scattering of the direct sun (E_sun in lx on a surface normal to the sun, per Rec.709
+    // colour) and of an isotropic ambient radiance L_amb (cd/m², the solid-angle mean of sky
+    // and sea), plus the visible glow of the absorbing (emitting) particles at the trace's
+    // absorption-weighted temperature. θ is the angle between the sun's light and the light
+    // reaching the eye. The sun is not attenuated inside the plume (single scattering).
+    glm::vec3 sunDirection{0.0f, 0.0f, 1.0f};  // unit ENU, toward the sun
+    glm::vec3 sunIlluminance{0.0f};
+    glm::vec3 ambientRgb{0.0f};
+    const BlackbodyGlowTable* glow = nullptr;
+    // Infrared: S = ω L_amb + (1 − ω) B_band(T) with the band's optical depth and albedo.
+    scene::ObscurantBand band = scene::ObscurantBand::Lwir;
+    float ambient = 0.0f;  // W·m⁻²·sr⁻¹
+    const radiometry::BandRadianceTable* planck = nullptr;
+};
+
+struct PlumeCompositeStats {
+    uint64_t pixelsCovered = 0;  // output pixels inside some plume's screen bounds
+    uint64_t traces = 0;         // rays traced (one per covered pixel, two at depth edges)
+    double ms = 0.0;             // bounds, traces and compositing
+};
+
+// Rays to the sky are traced this far (m).
+inline constexpr float kPlumeSkyRange_m = 1.0e6f;
+
+// Composites field over radiance, the channel's supersampled image (3 channels for Visible,
+// 1 for Infrared) of camera with visibility buffer vis. Each plume's puffs (centres ± the trace
+// cutoff of kPuffCutoffSigmas σ) bound a box; the box's screen rectangle (the whole screen
+// when the box reaches behind the near plane) marks the output pixels to consider, and its
+// nearest and farthest points bound the ranges where it can matter. Per covered pixel, with
+// the ranges of its samples' surfaces (sky: kPlumeSkyRange_m):
+//  - all surfaces nearer than every plume box: nothing to do;
+//  - all surfaces beyond every plume box: the sky trace, bilinear from traces at the corners
+//    of its 4×4-pixel cell when no puff smaller than a cell touches the cell and the corners
+//    agree within 0.02 in optical depth and 10 K, else traced through the pixel centre;
+//  - otherwise one ray through the pixel centre to the nearest surface and, when the ranges
+//    differ by more than 10 %, a second to the farthest; each sample takes the trace whose end
+//    is nearer its own range.
+// Samples outside every rectangle are left bit for bit as they were. Runs in the caller's
+// oneTBB arena; bit-identical for any thread count.
+PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const ChannelCamera& camera,
+                                    const VisibilityBuffer& vis, const PlumeLighting& light,
+                                    Image& radiance);
+
+// One channel's plumes: the scenario's PlumeSystem (ambient from the scenario's wind, the sun
+// elevation at frame 0 and a clear sky; air temperature from plumes.air_temperature_K, else
+// environment.atmosphere's) and a field committed at each frame's time. Every channel process
+// commits the same field for the same time (PlumeSystem::Commit is pure in t).
+class ChannelPlumes {
+  public:
+    // InputError for plume settings PlumeSystem rejects.
+    explicit ChannelPlumes(const scene::World& world);
+
+    // Whether the scenario has any plume source.
+    bool Active() const { return system_ != nullptr; }
+    // The field at time_s (committed when the time changed).
+    const scene::PlumeField& FieldAt(double time_s);
+
+    // The one call in OtwChannel::Render: composites onto the OTW radiance (cd/m², RGB) with
+    // the frame's sky. No-op without plumes.
+    void CompositeOtw(const scene::SceneState& state, const ChannelCamera& camera,
+                      const VisibilityBuffer& vis, const radiometry::AnalyticSky& sky,
+                      Image& radiance);
+    // The one call in FlirChannel::Render: composites onto the band radiance with the
+    // channel's atmosphere, sea and Planck table. No-op without plumes.
+    void CompositeFlir(const scene::SceneState& state, const ChannelCamera& camera,
+                       const VisibilityBuffer& vis, const FlirChannel& channel, Image& radiance);
+
+    const PlumeCompositeStats& Stats() const { return stats_; }
+
+  private:
+    std::unique_ptr<scene::PlumeSystem> system_;
+    scene::PlumeField field_;
+    double committed_s_ = std::numeric_limits<double>::quiet_NaN();
+    std::unique_ptr<BlackbodyGlowTable> glow_;  // OTW only, made on first use
+    PlumeCompositeStats stats_;
+};
+
+// Solid-angle mean radiance (cd/m², RGB) of sky and sea around a plume: the upper hemisphere
+// from the sky model (midpoint quadrature, 16 × 32 directions), the lower from the sea's
+// diffuse reflection of the downwelling light (albedo 0.06, Payne, J. Atmos. Sci. 29 (1972)
+// 959, as a Lambertian reflector).
+glm::vec3 VisibleAmbientRadiance(const radiometry::AnalyticSky& sky);
+
+}  // namespace seasense::channels

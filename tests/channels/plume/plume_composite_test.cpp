@@ -1,0 +1,281 @@
+// Tests of plume compositing: transmittance of one puff against the analytic line integral,
+// the apparent temperature of an optically thick flame, identity outside the plumes, the
+// Henyey–Greenstein normalisation and thread-count independence.
+#include "channels/plume/plume_composite.h"
+
+#include <gtest/gtest.h>
+#include <tbb/task_arena.h>
+
+#include <cmath>
+#include <cstring>
+#include <numbers>
+
+#include "radiometry/bands/builtin_bands.h"
+#include "radiometry/planck/planck.h"
+
+namespace seasense::channels {
+namespace {
+
+using scene::ObscurantBand;
+
+// A level camera at eye looking north (y), odd-sized so that the centre pixel's ray is the
+// optical axis.
+ChannelCamera NorthCamera(const glm::dvec3& eye, int width, int height, int supersampling) {
+    ChannelCamera cam;
+    cam.worldFromCamera = scene::Pose{eye, glm::dmat3(1.0)};
+    cam.hfov_rad = 30.0 * std::numbers::pi / 180.0;
+    cam.width = width;
+    cam.height = height;
+    cam.supersampling = supersampling;
+    cam.near_m = 0.25;
+    return cam;
+}
+
+// A visibility buffer that sees only sky.
+VisibilityBuffer SkyOnly(const ChannelCamera& cam) {
+    VisibilityBuffer vis;
+    vis.width = cam.SampleWidth();
+    vis.height = cam.SampleHeight();
+    const size_t n = size_t(vis.width) * size_t(vis.height);
+    vis.depth.assign(n, 0.0f);
+    vis.primitive.assign(n, kNoPrimitive);
+    vis.b1.assign(n, 0.0f);
+    vis.b2.assign(n, 0.0f);
+    vis.primitiveBase = {0};
+    return vis;
+}
+
+// A field of the given puffs, all of one plume with the optics of kind and albedo.
+scene::PlumeField OnePlume(scene::PlumeKind kind, double albedo,
+                           const std::vector<scene::Puff>& puffs) {
+    scene::PlumeField field(puffs.size() + 1, 1);
+    field.SetOptics(0, scene::KindOptics(kind, albedo));
+    field.Clear(0.0);
+    for (const scene::Puff& p : puffs) field.Add(p);
+    field.Build();
+    return field;
+}
+
+// A light that neither scatters nor glows: the composite is then L_bg · T.
+PlumeLighting Dark() {
+    PlumeLighting light;
+    light.kind = PlumeLighting::Kind::Visible;
+    return light;
+}
+
+TEST(PlumeComposite, PuffTransmittanceMatchesLineIntegral) {
+    const glm::dvec3 eye{0.0, 0.0, 10.0};
+    scene::Puff puff;
+    puff.centre_m = {0.0, 500.0, 10.0};
+    puff.sigmaH_m = 20.0;
+    puff.sigmaZ_m = 10.0;
+    puff.mass_kg = 0.3;
+    const scene::PlumeField field = OnePlume(scene::PlumeKind::Smoke, 0.3, {puff});
+    const double alpha = scene::KindOptics(scene::PlumeKind::Smoke, 0.3).massExtinction_m2pkg[0];
+    const ChannelCamera cam = NorthCamera(eye, 33, 25, 2);
+    VisibilityBuffer vis = SkyOnly(cam);
+    // The centre pixel's lower-right sample sees a surface 470 m along the axis (the pixel
+    // centre's ray is the axis; the sample's own direction differs by a fraction of a pixel).
+    const int cx = cam.width / 2, cy = cam.height / 2;
+    const size_t edge = vis.Index(2 * cx + 1, 2 * cy + 1);
+    vis.primitive[edge] = 0;
+    vis.depth[edge] = float(cam.near_m / 470.0);
+
+    Image radiance(cam.SampleWidth(), cam.SampleHeight(), 3);
+    std::fill(radiance.pixels.begin(), radiance.pixels.end(), 1.0f);
+    const PlumeCompositeStats stats = CompositePlumes(field, cam, vis, Dark(), radiance);
+    EXPECT_GT(stats.pixelsCovered, 0u);
+
+    const glm::dvec3 axis{0.0, 1.0, 0.0};
+    const double tSky = std::exp(
+        -alpha * scene::GaussianPuffLineIntegral_kgpm2(puff.centre_m, puff.sigmaH_m, puff.sigmaZ_m,
+                                                       puff.mass_kg, eye, axis, kPlumeSkyRange_m));
+    const double tSurface = std::exp(
+        -alpha * scene::GaussianPuffLineIntegral_kgpm2(puff.centre_m, puff.sigmaH_m, puff.sigmaZ_m,
+                                                       puff.mass_kg, eye, axis, 470.0));
+    ASSERT_LT(tSky, 0.5);  // the puff is thick enough for the test to mean something
+    ASSERT_LT(tSky, tSurface - 0.1);
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(radiance.At(2 * cx, 2 * cy)[c], tSky, 1e-3);
+        EXPECT_NEAR(radiance.At(2 * cx + 1, 2 * cy + 1)[c], tSurface, 1e-3);
+    }
+}
+
+TEST(PlumeComposite, ThickFlameShowsItsTemperatureInTheInfrared) {
+    const glm::dvec3 eye{0.0, 0.0, 5.0};
+    scene::Puff flame;
+    flame.centre_m = {0.0, 200.0, 5.0};
+    flame.sigmaH_m = flame.sigmaZ_m = 3.0;
+    flame.mass_kg = 50.0;  // optical depth in the hundreds
+    flame.temperature_K = 1200.0;
+    const double albedo = 0.2;
+    const scene::PlumeField field = OnePlume(scene::PlumeKind::Flame, albedo, {flame});
+    const radiometry::Band lwir = radiometry::BuiltinBand("LWIR");
+    const radiometry::BandRadianceTable table(lwir);
+    PlumeLighting light;
+    light.kind = PlumeLighting::Kind::Infrared;
+    light.band = ObscurantBand::Lwir;
+    light.planck = &table;
+    light.ambient = float(radiometry::BandRadiance(lwir, 280.0));
+    const ChannelCamera cam = NorthCamera(eye, 21, 15, 1);
+    const VisibilityBuffer vis = SkyOnly(cam);
+    Image radiance(cam.SampleWidth(), cam.SampleHeight(), 1);
+    CompositePlumes(field, cam, vis, light, radiance);
+
+    // Kirchhoff: an opaque layer of single-scattering albedo ω emits (1 − ω) B(T) and
+    // scatters ω of the ambient radiance.
+    const double omega = scene::KindOptics(scene::PlumeKind::Flame, albedo).albedo[3];
+    const double expected = radiometry::BandTemperature(
+        lwir, omega * radiometry::BandRadiance(lwir, 280.0) +
+                  (1.0 - omega) * radiometry::BandRadiance(lwir, 1200.0));
+    const double apparent =
+        radiometry::BandTemperature(lwir, radiance.At(cam.width / 2, cam.height / 2)[0]);
+    EXPECT_NEAR(apparent, expected, 1.0);
+    EXPECT_GT(apparent, 800.0);
+}
+
+TEST(PlumeComposite, PixelsOutsideThePlumesAreUntouched) {
+    const glm::dvec3 eye{0.0, 0.0, 10.0};
+    const ChannelCamera cam = NorthCamera(eye, 64, 48, 2);
+    const VisibilityBuffer vis = SkyOnly(cam);
+    Image before(cam.SampleWidth(), cam.SampleHeight(), 3);
+    for (size_t i = 0; i < before.pixels.size(); ++i)
+        before.pixels[i] = float(std::sin(0.37 * double(i)) * 100.0 + 101.0);
+    PlumeLighting light = Dark();
+    light.ambientRgb = glm::vec3(50.0f);
+
+    // No puffs: the image is bit-identical.
+    Image same = before;
+    const scene::PlumeField empty = OnePlume(scene::PlumeKind::Smoke, 0.3, {});
+    CompositePlumes(empty, cam, vis, light, same);
+    EXPECT_EQ(std::memcmp(same.pixels.data(), before.pixels.data(), before.pixels.size() * 4), 0);
+
+    // A small puff right of centre: changes inside its 3.5 σ cone, none elsewhere.
+    scene::Puff puff;
+    puff.centre_m = {30.0, 500.0, 10.0};
+    puff.sigmaH_m = puff.sigmaZ_m = 5.0;
+    puff.mass_kg = 0.1;
+    const scene::PlumeField field = OnePlume(scene::PlumeKind::Smoke, 0.3, {puff});
+    Image after = before;
+    CompositePlumes(field, cam, vis, light, after);
+    int changed = 0;
+    for (int y = 0; y < cam.SampleHeight(); ++y) {
+        for (int x = 0; x < cam.SampleWidth(); ++x) {
+            const glm::dvec3 d = cam.SampleDirection(x, y);
+            // Distance of the puff centre from the sample ray, in σ.
+            const glm::dvec3 q = puff.centre_m - eye;
+            const double miss = glm::length(q - glm::dot(q, d) * d) / puff.sigmaH_m;
+            const bool differs = std::memcmp(after.At(x, y), before.At(x, y), 12) != 0;
+            changed += differs;
+            if (miss > scene::kPuffCutoffSigmas + 0.5) {
+                EXPECT_FALSE(differs) << x << ", " << y;
+            }
+        }
+    }
+    EXPECT_GT(changed, 20);
+}
+
+TEST(PlumeComposite, HenyeyGreensteinIsNormalised) {
+    for (float g : {0.0f, 0.64f, 0.86f, -0.3f}) {
+        // ∫ p dΩ = 2π ∫ p(μ) dμ, midpoint rule on a fine grid.
+        constexpr int kSteps = 200000;
+        double sum = 0.0;
+        for (int i = 0; i < kSteps; ++i)
+            sum += HenyeyGreensteinPhase(float(-1.0 + 2.0 * (i + 0.5) / kSteps), g);
+        EXPECT_NEAR(2.0 * std::numbers::pi * sum * 2.0 / kSteps, 1.0, 1e-3) << g;
+    }
+    EXPECT_NEAR(HenyeyGreensteinPhase(0.3f, 0.0f), 1.0 / (4.0 * std::numbers::pi), 1e-7);
+}
+
+TEST(PlumeComposite, SameImageForOneAndTwoThreads) {
+    const glm::dvec3 eye{0.0, 0.0, 10.0};
+    const ChannelCamera cam = NorthCamera(eye, 160, 120, 2);
+    VisibilityBuffer vis = SkyOnly(cam);
+    // A sea surface over the lower half at the range of a level plane 10 m below the eye.
+    for (int y = cam.SampleHeight() / 2 + 1; y < cam.SampleHeight(); ++y) {
+        for (int x = 0; x < cam.SampleWidth(); ++x) {
+            const glm::dvec3 d = cam.SampleDirection(x, y);
+            const size_t i = vis.Index(x, y);
+            vis.primitive[i] = 0;
+            vis.depth[i] = float(cam.near_m / (10.0 / -d.z * d.y));
+        }
+    }
+    std::vector<scene::Puff> puffs;
+    for (int i = 0; i < 200; ++i) {
+        scene::Puff p;
+        p.centre_m = {-60.0 + 0.6 * i, 300.0 + 2.0 * i, 5.0 + 0.2 * i};
+        p.sigmaH_m = 3.0 + 0.05 * i;
+        p.sigmaZ_m = 2.0 + 0.03 * i;
+        p.mass_kg = 0.01;
+        p.temperature_K = 300.0 + 4.0 * i;
+        puffs.push_back(p);
+    }
+    const scene::PlumeField field = OnePlume(scene::PlumeKind::Flame, 0.2, puffs);
+    const BlackbodyGlowTable glow;
+    PlumeLighting light;
+    light.sunDirection = glm::normalize(glm::vec3(0.3f, 1.0f, 0.1f));
+    light.sunIlluminance = glm::vec3(2000.0f);
+    light.ambientRgb = glm::vec3(40.0f);
+    light.glow = &glow;
+    const auto render = [&](int threads) {
+        Image image(cam.SampleWidth(), cam.SampleHeight(), 3);
+        std::fill(image.pixels.begin(), image.pixels.end(), 100.0f);
+        tbb::task_arena arena(threads);
+        arena.execute([&] { CompositePlumes(field, cam, vis, light, image); });
+        return image;
+    };
+    const Image one = render(1), two = render(2);
+    EXPECT_EQ(std::memcmp(one.pixels.data(), two.pixels.data(), one.pixels.size() * 4), 0);
+    EXPECT_NE(std::count(one.pixels.begin(), one.pixels.end(), 100.0f),
+              ptrdiff_t(one.pixels.size()));
+}
+
+// Pixels whose trace comes from the interpolation grid stay within the grid's optical-depth
+// tolerance (0.02) of a ray traced through the pixel itself.
+TEST(PlumeComposite, InterpolatedPixelsMatchTheirOwnTraces) {
+    const glm::dvec3 eye{0.0, 0.0, 10.0};
+    const ChannelCamera cam = NorthCamera(eye, 160, 120, 1);
+    const VisibilityBuffer vis = SkyOnly(cam);
+    std::vector<scene::Puff> puffs;
+    for (int i = 0; i < 60; ++i) {
+        scene::Puff p;
+        p.centre_m = {-40.0 + 1.5 * i, 400.0 + 3.0 * i, 10.0 + 0.5 * i};
+        p.sigmaH_m = 2.0 + 0.4 * i;  // from a third of a pixel to several cells
+        p.sigmaZ_m = 1.5 + 0.3 * i;
+        p.mass_kg = 0.002 * (1 + i);
+        puffs.push_back(p);
+    }
+    const scene::PlumeField field = OnePlume(scene::PlumeKind::Smoke, 0.3, puffs);
+    Image image(cam.SampleWidth(), cam.SampleHeight(), 3);
+    std::fill(image.pixels.begin(), image.pixels.end(), 1.0f);
+    const PlumeCompositeStats stats = CompositePlumes(field, cam, vis, Dark(), image);
+    // Fewer rays than covered pixels: the grid was used.
+    EXPECT_LT(stats.traces, stats.pixelsCovered);
+    double worst = 0.0;
+    int dark = 0;
+    for (int y = 0; y < cam.height; ++y) {
+        for (int x = 0; x < cam.width; ++x) {
+            const glm::vec3 d(cam.SampleDirection(x, y));
+            const double T = field.Trace(glm::vec3(eye), d, kPlumeSkyRange_m)
+                                 .Transmittance(ObscurantBand::Visible);
+            worst = std::max(worst, std::abs(double(image.At(x, y)[0]) - T));
+            dark += T < 0.9;
+        }
+    }
+    EXPECT_GT(dark, 100);
+    EXPECT_LT(worst, 0.02);
+}
+
+// Luminance of a blackbody at the platinum freezing point, 2042 K: 60 cd/cm² (the candela's
+// definition of 1948–1979, CGPM 9th meeting).
+TEST(PlumeComposite, BlackbodyGlowMatchesThePlatinumPointCandela) {
+    const BlackbodyGlowTable glow;
+    const glm::vec3 rgb = glow(2042.0f);
+    const double Y = 0.2126 * rgb.r + 0.7152 * rgb.g + 0.0722 * rgb.b;
+    EXPECT_NEAR(Y, 6.0e5, 0.05 * 6.0e5);
+    EXPECT_GT(rgb.r, rgb.b);  // red-hot
+    EXPECT_EQ(glow(300.0f), glm::vec3(0.0f));
+}
+
+}  // namespace
+}  // namespace seasense::channels
