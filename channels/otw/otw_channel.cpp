@@ -10,6 +10,8 @@
 #include <cmath>
 #include <limits>
 
+#include "channels/otw/celestial.h"
+#include "channels/otw/lightning_overlay.h"
 #include "channels/plume/plume_composite.h"
 #include "radiometry/sky/analytic_sky.h"
 #include "radiometry/surface/fresnel.h"
@@ -740,6 +742,7 @@ OtwChannel::OtwChannel(const scene::World& world, const scene::ChannelSettings& 
       plumes_(std::make_unique<ChannelPlumes>(world)) {
     for (const scene::EntityState& e : world.State(0).entities)
         reflectance_.push_back(e.reflectanceRgb);
+    stars_ = scene::LoadStarCatalog(scene::DefaultStarCatalogPath());
 }
 
 struct OtwChannel::ShadeScratch {
@@ -778,10 +781,21 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     // (disc, glint, direct light) stays exact.
     const glm::dvec3 skySun =
         radiometry::QuantizeSunDirection(state.sun.direction, kSkySunStep_rad);
-    if (!sky_ || skySun_ != skySun) {
-        sky_ = std::make_unique<radiometry::AnalyticSky>(skySun, state.sun.illuminance_lux,
-                                                         env.sky.turbidity);
+    const glm::dvec3 skyMoon =
+        radiometry::QuantizeSunDirection(state.moon.direction, kSkySunStep_rad);
+    if (!sky_ || skySun_ != skySun || skyMoon_ != skyMoon) {
+        radiometry::SkyConditions c;
+        c.sunDirection = skySun;
+        c.sunIlluminance_lux = state.sun.illuminance_lux;
+        c.turbidity = env.sky.turbidity;
+        c.extinctionV_magPerAirmass = scene::ZenithExtinctionV_mag(sc.eyepoint.position_m.z);
+        c.moon = true;
+        c.moonDirection = skyMoon;
+        c.moonPhaseAngle_rad = state.moon.phaseAngle_rad;
+        c.moonDistance_m = state.moon.distance_m;
+        sky_ = std::make_unique<radiometry::AnalyticSky>(c);
         skySun_ = skySun;
+        skyMoon_ = skyMoon;
     }
     const radiometry::AnalyticSky& sky = *sky_;
     const glm::vec3 sunDir(state.sun.direction);
@@ -860,6 +874,21 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     });
     for (uint64_t r : blockRays) stats_.shadowRays += r;
     stats_.shadeMs = Ms(t2, Clock::now());
+
+    // The moon's disc, the stars and lightning bolts over the sky, before the plumes that may
+    // hide them (channels/otw/celestial, lightning_overlay).
+    scene::Observer observer;
+    observer.latitude_deg = sc.world.latitude_deg;
+    observer.longitude_deg = sc.world.longitude_deg;
+    observer.height_m = state.eyepoint.position_m.z;
+    AddMoonAndStars(cam, vis, MakeMoonDisc(state.moon, state.sun),
+                    scene::VisibleStars(stars_, state.utc, observer), radiance);
+    if (const scene::Lightning* lightning = world_.GetLightning()) {
+        // The frame's exposure: one frame period of scene time ending at this frame's instant.
+        const double exposure_s = sc.world.timeScale / sc.world.frameRate_hz;
+        DrawLightning(cam, vis, *lightning, state.time_s - exposure_s, state.time_s, beta,
+                      radiance);
+    }
 
     // Plumes (channels/plume) over the finished radiance.
     plumes_->CompositeOtw(state, cam, vis, sky, radiance);

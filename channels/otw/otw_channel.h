@@ -8,6 +8,7 @@
 #include "channels/view/view_geometry.h"
 #include "radiometry/sky/analytic_sky.h"
 #include "scene/core/image.h"
+#include "scene/sky/stars.h"
 #include "scene/world/world.h"
 
 namespace seasense::channels {
@@ -49,10 +50,12 @@ class OtwChannel {
     scene::ChannelSettings settings_;
     ViewGeometry geometry_;
     std::vector<glm::dvec3> reflectance_;  // per entity
-    // The sky table depends only on the sun's direction and turbidity: rebuilt when the
-    // quantized sun direction changes.
+    // The sky table depends only on the sun's and moon's directions and turbidity: rebuilt
+    // when the quantized sun or moon direction changes.
     std::unique_ptr<radiometry::AnalyticSky> sky_;
     glm::dvec3 skySun_{0.0};
+    glm::dvec3 skyMoon_{0.0};
+    std::vector<scene::CatalogStar> stars_;  // the bright-star list (configs/stars)
     std::unique_ptr<ShadeScratch> scratch_;
     std::unique_ptr<ChannelPlumes> plumes_;  // scenario plumes (channels/plume)
     OtwFrameStats stats_;

@@ -200,7 +200,12 @@ glm::dvec3 AnalyticSky::Radiance(const glm::dvec3& dIn) const {
         grey += DarkSkyLuminance_cdm2(zenith_rad, c.extinctionV_magPerAirmass,
                                       c.darkZenithLuminance_cdm2);
     if (c.moon) {
-        const double separation_rad = std::acos(std::clamp(glm::dot(d, moonDir_), -1.0, 1.0));
+        // The aureole's ρ⁻² peak is held at its 4° value inside 4° of the moon: the sky
+        // table (128² over the hemisphere, ~1° texels) cannot carry a steeper peak without
+        // drawing its texels.
+        constexpr double kMinSeparation_rad = 4.0 * M_PI / 180.0;
+        const double separation_rad =
+            std::max(kMinSeparation_rad, std::acos(std::clamp(glm::dot(d, moonDir_), -1.0, 1.0)));
         grey += MoonlitSkyLuminance_cdm2(zenith_rad, moonZenith_rad_, separation_rad,
                                          c.moonPhaseAngle_rad, c.moonDistance_m,
                                          c.extinctionV_magPerAirmass);

@@ -25,11 +25,11 @@ double DarkSkyLuminance_cdm2(double zenith_rad, double k_magPerAirmass,
 // Luminance (cd/m²) of the sky at zenith distance z_rad lit by moonlight: K&S eqs. 15–21,
 // B = f(ρ) · I* · 10^(−0.4 k X_moon) · [1 − 10^(−0.4 k X)] nL, with the scattering function
 // f(ρ) = 10^5.36 (1.06 + cos²ρ) (Rayleigh) + 10^(6.15 − ρ/40) (aerosols; 6.2·10⁷ ρ⁻² below
-// ρ = 10°), ρ the moon–sky angle in degrees, and the moon's brightness
-// I* = 10^(−0.4 (3.84 + 0.026 |α| + 4·10⁻⁹ α⁴)) at phase angle α (degrees), scaled by the
-// inverse square of the moon's distance from its mean 384 400 km. Zero when the moon's centre
-// is more than its mean semidiameter below the horizon; between ± the semidiameter it fades
-// linearly (the fraction of the disc above the horizon, to first order).
+// ρ = 8.45°, where the two meet; K&S switch at 10°), ρ the moon–sky angle in degrees, and the
+// moon's brightness I* = 10^(−0.4 (3.84 + 0.026 |α| + 4·10⁻⁹ α⁴)) at phase angle α (degrees),
+// scaled by the inverse square of the moon's distance from its mean 384 400 km. Zero when the
+// moon's centre is more than its mean semidiameter below the horizon; between ± the semidiameter it
+// fades linearly (the fraction of the disc above the horizon, to first order).
 double MoonlitSkyLuminance_cdm2(double skyZenith_rad, double moonZenith_rad, double separation_rad,
                                 double phaseAngle_rad, double moonDistance_m,
                                 double k_magPerAirmass);

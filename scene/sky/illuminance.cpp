@@ -154,7 +154,16 @@ double ClearSkyDiffuseIlluminance_lux(double sunAltitude_rad) {
     CheckAltitude(sunAltitude_rad, "ClearSkyDiffuseIlluminance_lux");
     // IES clear sky at the horizon: 0.8 klx.
     constexpr double kHorizon_lux = 800.0;
-    if (sunAltitude_rad >= 0.0) return kHorizon_lux + 15.5e3 * std::sqrt(std::sin(sunAltitude_rad));
+    const auto ies = [](double h) { return 800.0 + 15.5e3 * std::sqrt(std::sin(h)); };
+    // The IES fit's √(sin h) rises with unbounded slope at the horizon, where it overshoots
+    // Circular 171's diffuse light (its total less the direct sun) by 2× at 1°. Below 5° the
+    // illuminance is interpolated exponentially from 800 lx at the horizon to the IES value at
+    // 5°, which follows the circular's diffuse light within 10 % at 1° and 3°.
+    constexpr double kBlend_rad = 5.0 * kDeg;
+    if (sunAltitude_rad >= kBlend_rad) return ies(sunAltitude_rad);
+    if (sunAltitude_rad >= 0.0)
+        return kHorizon_lux *
+               std::pow(ies(kBlend_rad) / kHorizon_lux, sunAltitude_rad / kBlend_rad);
     return kHorizon_lux * SunIlluminance_lux(sunAltitude_rad) / SunIlluminance_lux(0.0);
 }
 

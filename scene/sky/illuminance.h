@@ -55,8 +55,9 @@ double DirectNormalSunIlluminance_lux(double altitude_rad, double distance_m,
                                       double luminousTurbidity);
 
 // Illuminance (lux) on a horizontal surface from the clear sky dome alone (no direct sun) at
-// apparent sun altitude sunAltitude_rad. Sun up: the IES clear-sky model
-// 0.8 + 15.5·(sin h)^½ klx (IES Lighting Handbook, Reference Volume 1984, ch. 7; CIE 110-1994).
+// apparent sun altitude sunAltitude_rad. Sun above 5°: the IES clear-sky model
+// 0.8 + 15.5·(sin h)^½ klx (IES Lighting Handbook, Reference Volume 1984, ch. 7; CIE 110-1994);
+// from 0° to 5°, exponential from 800 lx to the IES value at 5° (see the implementation).
 // Sun down: 800 lx scaled by Circular 171's twilight fall-off SunIlluminance_lux(h) /
 // SunIlluminance_lux(0) (all of which is sky light below the horizon), continuous at h = 0 and
 // zero below -18 deg, where the night sky takes over. Throws InputError for a bad altitude.
