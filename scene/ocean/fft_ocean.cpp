@@ -24,9 +24,6 @@ constexpr double kTwoPi = 2.0 * std::numbers::pi;
 constexpr uint64_t kOceanStream = 0x6f6365616e464654ULL;  // "oceanFFT"
 // Rows of the spectrum filled per task.
 constexpr int kRowsPerTask = 16;
-// Fixed-point iterations of the inverse displacement and their tolerance (m).
-constexpr int kMaxInverseIterations = 64;
-constexpr double kInverseTolerance_m = 1e-9;
 
 bool IsPowerOfTwo(int n) { return n > 0 && (n & (n - 1)) == 0; }
 
@@ -371,18 +368,8 @@ SurfaceTerms FftOceanFrame::Terms(double x0, double y0) const {
 }
 
 OceanSample FftOceanFrame::SampleAt(double x, double y) const {
-    // Fixed-point iteration x0 ← x0 + (x − P_h(x0)); a contraction while the horizontal map is
-    // not folded (eigenvalues of ∂P_h/∂x0 in (0, 2)).
-    double x0 = x, y0 = y;
-    OceanSample s = Evaluate(x0, y0);
-    for (int iter = 0; iter < kMaxInverseIterations; ++iter) {
-        const double ex = x - s.position.x, ey = y - s.position.y;
-        if (ex * ex + ey * ey < kInverseTolerance_m * kInverseTolerance_m) break;
-        x0 += ex;
-        y0 += ey;
-        s = Evaluate(x0, y0);
-    }
-    return s;
+    return InvertHorizontalDisplacement(x, y,
+                                        [this](double x0, double y0) { return Evaluate(x0, y0); });
 }
 
 }  // namespace seasense::scene

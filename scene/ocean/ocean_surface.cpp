@@ -20,9 +20,6 @@ namespace {
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-// Fixed-point iterations of the inverse displacement and their tolerance (m).
-constexpr int kMaxInverseIterations = 64;
-constexpr double kInverseTolerance_m = 1e-9;
 // Frames kept by OceanSurface::At: the current frame time and the one before, so the host's
 // wave riding and a renderer's mesh of one frame share a synthesis.
 constexpr size_t kCachedFrames = 2;
@@ -123,19 +120,8 @@ SurfaceTerms OceanSurfaceFrame::Terms(double x0, double y0) const {
 }
 
 OceanSample OceanSurfaceFrame::SampleAt(double x, double y, glm::dvec2* rest) const {
-    // Fixed-point iteration x0 ← x0 + (x − P_h(x0)); a contraction while the horizontal map is
-    // not folded (eigenvalues of ∂P_h/∂x0 in (0, 2)).
-    double x0 = x, y0 = y;
-    OceanSample s = Evaluate(x0, y0);
-    for (int iter = 0; iter < kMaxInverseIterations; ++iter) {
-        const double ex = x - s.position.x, ey = y - s.position.y;
-        if (ex * ex + ey * ey < kInverseTolerance_m * kInverseTolerance_m) break;
-        x0 += ex;
-        y0 += ey;
-        s = Evaluate(x0, y0);
-    }
-    if (rest) *rest = {x0, y0};
-    return s;
+    return InvertHorizontalDisplacement(
+        x, y, [this](double x0, double y0) { return Evaluate(x0, y0); }, rest);
 }
 
 FftFilter OceanSurfaceFrame::Filter(float footprint_m) const {

@@ -35,6 +35,28 @@ struct OceanSample {
     double minEigenvalue = 1.0;        // smaller eigenvalue of ∂(x, y)/∂(x0, y0)
 };
 
+// The sample whose displaced horizontal position is (x, y): evaluate(x0, y0) → OceanSample at
+// rest position (x0, y0), inverted by the fixed-point iteration x0 ← x0 + (x − P_h(x0)), a
+// contraction while the horizontal map is not folded (eigenvalues of ∂P_h/∂x0 in (0, 2)); at
+// most 64 steps, to 1e-9 m. The rest position found is stored in *rest when given.
+template <typename Evaluate>
+OceanSample InvertHorizontalDisplacement(double x, double y, const Evaluate& evaluate,
+                                         glm::dvec2* rest = nullptr) {
+    constexpr int kMaxIterations = 64;
+    constexpr double kTolerance_m = 1e-9;
+    double x0 = x, y0 = y;
+    OceanSample s = evaluate(x0, y0);
+    for (int iter = 0; iter < kMaxIterations; ++iter) {
+        const double ex = x - s.position.x, ey = y - s.position.y;
+        if (ex * ex + ey * ey < kTolerance_m * kTolerance_m) break;
+        x0 += ex;
+        y0 += ey;
+        s = evaluate(x0, y0);
+    }
+    if (rest) *rest = {x0, y0};
+    return s;
+}
+
 // The sample of rest position (x0, y0) with the given terms: the tangents ∂P/∂x0 = (1 + Dxx, Dxy,
 // ηx) and ∂P/∂y0 = (Dxy, 1 + Dyy, ηy) give the normal; the horizontal Jacobian matrix
 // [[1 + Dxx, Dxy], [Dxy, 1 + Dyy]] (symmetric) its determinant and smaller eigenvalue.
