@@ -11,6 +11,7 @@
 #include <limits>
 
 #include "channels/otw/celestial.h"
+#include "channels/otw/cloud_layer.h"
 #include "channels/otw/lightning_overlay.h"
 #include "channels/plume/plume_composite.h"
 #include "radiometry/sky/analytic_sky.h"
@@ -802,7 +803,16 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     const glm::dvec3 sunIlluminance =
         radiometry::SunIlluminanceRgb(state.sun.direction, state.sun.illuminance_lux);
     const glm::vec3 sunE(sunIlluminance);
-    const glm::vec3 skyE(sky.HorizontalSkyIlluminance());
+    // Clouds (world.Clouds()): the world divided the direct sun and moon by their sky-condition
+    // divisors (USNO Circular 171); the sky dome's light is divided by the divisor of the sky
+    // overhead, and the sun's disc keeps its light above the clouds (the cloud pass attenuates
+    // it by e^−τ). Without clouds both divisors are 1.
+    const glm::dvec3 up(0.0, 0.0, 1.0);
+    const double domeDivisor =
+        world_.SkyConditionDivisor(state.eyepoint.position_m, up, state.time_s);
+    const double sunDivisor =
+        world_.SkyConditionDivisor(state.eyepoint.position_m, state.sun.direction, state.time_s);
+    const glm::vec3 skyE(sky.HorizontalSkyIlluminance() / domeDivisor);
     // Downwelling irradiance on the sea surface (lx): direct sun on a level surface plus sky.
     const glm::vec3 downwelling = sunE * std::max(sunDir.z, 0.0f) + skyE;
     const float beta = float(ExtinctionFromVisibility(env.visibility_m));
@@ -829,23 +839,24 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     // Pixel size on the image plane at unit distance bounds the angle between a pixel's
     // centre ray and its samples' (the plane is at least that far from the eye).
     const double pixelTan = n * (2.0 * g.tanH / sw + 2.0 * g.tanV / sh);
-    const FrameShading f{eye,
-                         sunDir,
-                         sunE,
-                         glm::vec3(sunIlluminance / radiometry::SunDiscSolidAngle_sr()),
-                         skyE,
-                         downwelling,
-                         Load3(eye),
-                         float(std::cos(radiometry::kSunAngularRadius_rad)),
-                         float(std::cos(radiometry::kSunAngularRadius_rad + pixelTan)),
-                         beta,
-                         settings_.shadows && !occlusion.Empty() && sunDir.z > 0.0f,
-                         sky,
-                         occlusion,
-                         RayBoxTest(geometry_.CasterMin(), geometry_.CasterMax(), sunDir),
-                         SeaShading{eye, sunDir, sunE, downwelling, beta,
-                                    CoxMunkSlopeVariance(env.windSpeed_mps), fresnel, sky},
-                         reflectance_};
+    const FrameShading f{
+        eye,
+        sunDir,
+        sunE,
+        glm::vec3(sunIlluminance * sunDivisor / radiometry::SunDiscSolidAngle_sr()),
+        skyE,
+        downwelling,
+        Load3(eye),
+        float(std::cos(radiometry::kSunAngularRadius_rad)),
+        float(std::cos(radiometry::kSunAngularRadius_rad + pixelTan)),
+        beta,
+        settings_.shadows && !occlusion.Empty() && sunDir.z > 0.0f,
+        sky,
+        occlusion,
+        RayBoxTest(geometry_.CasterMin(), geometry_.CasterMax(), sunDir),
+        SeaShading{eye, sunDir, sunE, downwelling, beta, CoxMunkSlopeVariance(env.windSpeed_mps),
+                   fresnel, sky},
+        reflectance_};
 
     if (radiance.width != sw || radiance.height != sh || radiance.channels != 3)
         radiance = Image(sw, sh, 3);
@@ -881,8 +892,20 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     observer.latitude_deg = sc.world.latitude_deg;
     observer.longitude_deg = sc.world.longitude_deg;
     observer.height_m = state.eyepoint.position_m.z;
-    AddMoonAndStars(cam, vis, MakeMoonDisc(state.moon, state.sun),
+    scene::MoonState moonAboveClouds = state.moon;
+    moonAboveClouds.illuminance_lux *=
+        world_.SkyConditionDivisor(state.eyepoint.position_m, state.moon.direction, state.time_s);
+    AddMoonAndStars(cam, vis, MakeMoonDisc(moonAboveClouds, state.sun),
                     scene::VisibleStars(stars_, state.utc, observer), radiance);
+    // --- Cloud layers (channels/otw/cloud_layer) over the sky, sun, moon and stars. ---
+    if (world_.Clouds()) {
+        if (!clouds_) clouds_ = std::make_unique<CloudSky>();
+        const CloudSkyStats cloud =
+            DrawOtwClouds(*clouds_, world_, state, cam, vis, sky, beta, radiance);
+        stats_.cloudMs = cloud.ms;
+        stats_.cloudTraces = cloud.gridTraces + cloud.exactTraces;
+    }
+    // --- end of cloud layers ---
     if (const scene::Lightning* lightning = world_.GetLightning()) {
         // The frame's exposure: one frame period of scene time ending at this frame's instant.
         const double exposure_s = sc.world.timeScale / sc.world.frameRate_hz;
