@@ -813,6 +813,7 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     const double sunDivisor =
         world_.SkyConditionDivisor(state.eyepoint.position_m, state.sun.direction, state.time_s);
     const glm::vec3 skyE(sky.HorizontalSkyIlluminance() / domeDivisor);
+    const glm::dvec3 sunAboveClouds = sunIlluminance * sunDivisor;
     // Downwelling irradiance on the sea surface (lx): direct sun on a level surface plus sky.
     const glm::vec3 downwelling = sunE * std::max(sunDir.z, 0.0f) + skyE;
     const float beta = float(ExtinctionFromVisibility(env.visibility_m));
@@ -839,24 +840,23 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     // Pixel size on the image plane at unit distance bounds the angle between a pixel's
     // centre ray and its samples' (the plane is at least that far from the eye).
     const double pixelTan = n * (2.0 * g.tanH / sw + 2.0 * g.tanV / sh);
-    const FrameShading f{
-        eye,
-        sunDir,
-        sunE,
-        glm::vec3(sunIlluminance * sunDivisor / radiometry::SunDiscSolidAngle_sr()),
-        skyE,
-        downwelling,
-        Load3(eye),
-        float(std::cos(radiometry::kSunAngularRadius_rad)),
-        float(std::cos(radiometry::kSunAngularRadius_rad + pixelTan)),
-        beta,
-        settings_.shadows && !occlusion.Empty() && sunDir.z > 0.0f,
-        sky,
-        occlusion,
-        RayBoxTest(geometry_.CasterMin(), geometry_.CasterMax(), sunDir),
-        SeaShading{eye, sunDir, sunE, downwelling, beta, CoxMunkSlopeVariance(env.windSpeed_mps),
-                   fresnel, sky},
-        reflectance_};
+    const FrameShading f{eye,
+                         sunDir,
+                         sunE,
+                         glm::vec3(sunAboveClouds / radiometry::SunDiscSolidAngle_sr()),
+                         skyE,
+                         downwelling,
+                         Load3(eye),
+                         float(std::cos(radiometry::kSunAngularRadius_rad)),
+                         float(std::cos(radiometry::kSunAngularRadius_rad + pixelTan)),
+                         beta,
+                         settings_.shadows && !occlusion.Empty() && sunDir.z > 0.0f,
+                         sky,
+                         occlusion,
+                         RayBoxTest(geometry_.CasterMin(), geometry_.CasterMax(), sunDir),
+                         SeaShading{eye, sunDir, sunE, downwelling, beta,
+                                    CoxMunkSlopeVariance(env.windSpeed_mps), fresnel, sky},
+                         reflectance_};
 
     if (radiance.width != sw || radiance.height != sh || radiance.channels != 3)
         radiance = Image(sw, sh, 3);
