@@ -9,6 +9,7 @@
 #include <chrono>
 #include <map>
 
+#include "channels/flir/cloud_infrared.h"
 #include "channels/plume/plume_composite.h"
 #include "channels/view/surface_gather.h"
 #include "scene/core/check.h"
@@ -486,6 +487,28 @@ void FlirChannel::Render(const scene::SceneState& state, Image& radiance) {
     });
     for (uint64_t r : blockRays) stats_.shadowRays += r;
     stats_.shadeMs = Ms(t1, Clock::now());
+
+    // --- Cloud layers (channels/flir/cloud_infrared) over the sky. ---
+    if (const scene::CloudField* clouds = world_.Clouds()) {
+        if (!clouds_) clouds_ = std::make_unique<CloudSky>();
+        FlirCloudOptics optics;
+        optics.table = &table_;
+        optics.surfaceAir_K = air_.airTemperature_K;
+        optics.airRadiance = atmosphere_.AirRadiance();
+        optics.transmittance = [this](double range_m) {
+            return double(pathTau_(float(std::sqrt(std::min(range_m, kMaxPathRange_m)))));
+        };
+        const glm::dvec3 eye = cam.worldFromCamera.position_m;
+        const CloudSkyStats cloud = clouds_->Composite(
+            *clouds, state.time_s, cam, vis,
+            [&](const glm::dvec3& d, const scene::CloudHit& hit) {
+                return FlirCloudCover(optics, eye, d, hit);
+            },
+            {}, radiance);
+        stats_.cloudMs = cloud.ms;
+        stats_.cloudTraces = cloud.gridTraces;
+    }
+    // --- end of cloud layers ---
 
     // Plumes (channels/plume) over the finished radiance.
     plumes_->CompositeFlir(state, cam, vis, *this, radiance);

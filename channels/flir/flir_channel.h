@@ -21,9 +21,11 @@ namespace seasense::channels {
 
 struct FlirFrameStats {
     ViewFrameStats view;
-    uint64_t shadowRays = 0;  // rays traced for sunlit/shaded model samples
-    double thermalMs = 0.0;   // model surface temperatures for the frame
-    double shadeMs = 0.0;     // shadow rays and shading
+    uint64_t shadowRays = 0;   // rays traced for sunlit/shaded model samples
+    double thermalMs = 0.0;    // model surface temperatures for the frame
+    double shadeMs = 0.0;      // shadow rays and shading
+    double cloudMs = 0.0;      // cloud layers over the sky (channels/flir/cloud_infrared)
+    uint64_t cloudTraces = 0;  // cloud grid rays traced
 };
 
 // The band of a flir channel (Band::Lwir 8–12 µm or Band::Mwir 3–5 µm).
@@ -100,6 +102,7 @@ class UniformTable {
 double SunIrradiance_W_m2(const scene::Scenario& scenario, double time_s, glm::dvec3& sunDirection);
 
 class ChannelPlumes;
+class CloudSky;
 
 class FlirChannel {
   public:
@@ -166,6 +169,7 @@ class FlirChannel {
     std::vector<std::array<float, OrientationTemperatures::kClasses>> entityB_;
     std::unique_ptr<ShadeScratch> scratch_;
     std::unique_ptr<ChannelPlumes> plumes_;  // scenario plumes (channels/plume)
+    std::unique_ptr<CloudSky> clouds_;       // cloud pass scratch (environment.clouds)
     FlirFrameStats stats_;
 };
 

@@ -19,14 +19,14 @@ LitFlashes FindLitFlashes(const scene::Lightning& lightning, double t0_s, double
 }
 
 FlashLight FlashLightAt(const scene::Lightning& lightning, const LitFlashes& lit,
-                        const glm::dvec3& point_m, double beta) {
+                        const glm::dvec3& point_m, double beta, const scene::CloudField* clouds) {
     FlashLight light;
     glm::dvec3 weighted(0.0);
     for (size_t i = 0; i < lit.flashes.size(); ++i) {
         const scene::Flash& flash = lit.flashes[i];
         const scene::Bolt& bolt = lit.bolts[i];
         const double e =
-            lightning.MeanIlluminance_lux(flash, bolt, point_m, lit.t0_s, lit.t1_s, beta);
+            lightning.MeanIlluminance_lux(flash, bolt, point_m, lit.t0_s, lit.t1_s, beta, clouds);
         if (e <= 0.0) continue;
         ++light.flashes;
         light.illuminance_lux += e;

@@ -28,9 +28,11 @@ struct LitFlashes {
 LitFlashes FindLitFlashes(const scene::Lightning& lightning, double t0_s, double t1_s);
 
 // The flash light at point_m (ENU m) over the exposure: Lightning::MeanIlluminance_lux summed
-// over the lit flashes, with extinction_perM (1/m) along each path.
+// over the lit flashes, with extinction_perM (1/m) along each path and, when clouds is given,
+// the cloud layers' transmittance between the point and each channel.
 FlashLight FlashLightAt(const scene::Lightning& lightning, const LitFlashes& lit,
-                        const glm::dvec3& point_m, double extinction_perM);
+                        const glm::dvec3& point_m, double extinction_perM,
+                        const scene::CloudField* clouds = nullptr);
 
 // Draws the lit flashes into the supersampled radiance image (rgb cd/m², white: equal
 // components). The channel is optically thin, so each element dl radiates isotropically with

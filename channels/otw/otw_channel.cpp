@@ -11,6 +11,7 @@
 #include <limits>
 
 #include "channels/otw/celestial.h"
+#include "channels/otw/cloud_layer.h"
 #include "channels/otw/lightning_overlay.h"
 #include "channels/plume/plume_composite.h"
 #include "radiometry/sky/analytic_sky.h"
@@ -812,6 +813,16 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     const glm::vec3 sunDir(state.sun.direction);
     const glm::dvec3 sunIlluminance =
         radiometry::SunIlluminanceRgb(state.sun.direction, state.sun.illuminance_lux);
+    // Clouds (world.Clouds()): the world divided the direct sun and moon by their sky-condition
+    // divisors (USNO Circular 171); the sky dome's light is divided by the divisor of the sky
+    // overhead, and the sun's disc keeps its light above the clouds (the cloud pass attenuates
+    // it by e^−τ). Without clouds both divisors are 1.
+    const glm::dvec3 up(0.0, 0.0, 1.0);
+    const double domeDivisor =
+        world_.SkyConditionDivisor(state.eyepoint.position_m, up, state.time_s);
+    const double sunDivisor =
+        world_.SkyConditionDivisor(state.eyepoint.position_m, state.sun.direction, state.time_s);
+    const glm::dvec3 sunAboveClouds = sunIlluminance * sunDivisor;
     const float beta = float(ExtinctionFromVisibility(env.visibility_m));
     const glm::vec3 eye(cam.worldFromCamera.position_m);
 
@@ -838,11 +849,12 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     LitFlashes flashes;
     if (lightning) {
         flashes = FindLitFlashes(*lightning, state.time_s - exposure_s, state.time_s);
-        const FlashLight flash = FlashLightAt(*lightning, flashes, glm::dvec3(eye), beta);
+        const FlashLight flash =
+            FlashLightAt(*lightning, flashes, glm::dvec3(eye), beta, world_.Clouds());
         if (flash.illuminance_lux > 0.0)
             fill.push_back({glm::vec3(flash.direction), glm::vec3(float(flash.illuminance_lux))});
     }
-    const glm::vec3 skyE(sky.HorizontalSkyIlluminance());
+    const glm::vec3 skyE(sky.HorizontalSkyIlluminance() / domeDivisor);
     // Downwelling irradiance on the sea surface (lx): direct light on a level surface plus sky.
     glm::vec3 downwelling = key.E * std::max(key.dir.z, 0.0f) + skyE;
     for (const DirectionalLight& l : fill) downwelling += l.E * std::max(l.dir.z, 0.0f);
@@ -870,7 +882,7 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     const double pixelTan = n * (2.0 * g.tanH / sw + 2.0 * g.tanV / sh);
     const FrameShading f{eye,
                          sunDir,
-                         glm::vec3(sunIlluminance / radiometry::SunDiscSolidAngle_sr()),
+                         glm::vec3(sunAboveClouds / radiometry::SunDiscSolidAngle_sr()),
                          key.dir,
                          key.E,
                          skyE,
@@ -922,8 +934,20 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     observer.latitude_deg = sc.world.latitude_deg;
     observer.longitude_deg = sc.world.longitude_deg;
     observer.height_m = state.eyepoint.position_m.z;
-    AddMoonAndStars(cam, vis, MakeMoonDisc(state.moon, state.sun),
+    scene::MoonState moonAboveClouds = state.moon;
+    moonAboveClouds.illuminance_lux *=
+        world_.SkyConditionDivisor(state.eyepoint.position_m, state.moon.direction, state.time_s);
+    AddMoonAndStars(cam, vis, MakeMoonDisc(moonAboveClouds, state.sun),
                     scene::VisibleStars(stars_, state.utc, observer), radiance);
+    // --- Cloud layers (channels/otw/cloud_layer) over the sky, sun, moon and stars. ---
+    if (world_.Clouds()) {
+        if (!clouds_) clouds_ = std::make_unique<CloudSky>();
+        const CloudSkyStats cloud =
+            DrawOtwClouds(*clouds_, world_, state, cam, vis, sky, beta, radiance);
+        stats_.cloudMs = cloud.ms;
+        stats_.cloudTraces = cloud.gridTraces + cloud.exactTraces;
+    }
+    // --- end of cloud layers ---
     if (lightning) DrawLightning(cam, vis, *lightning, flashes, beta, radiance);
 
     // Plumes (channels/plume) over the finished radiance.

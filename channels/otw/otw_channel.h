@@ -14,14 +14,17 @@
 namespace seasense::channels {
 
 class ChannelPlumes;
+class CloudSky;
 
 struct OtwFrameStats {
     uint64_t oceanTriangles = 0;
     uint64_t modelTriangles = 0;
-    uint64_t shadowRays = 0;  // rays actually traced (after the caster-bounds test)
-    double meshMs = 0.0;      // sea mesh for the view
-    double rasterMs = 0.0;    // visibility buffer
-    double shadeMs = 0.0;     // shadow rays and shading
+    uint64_t shadowRays = 0;   // rays actually traced (after the caster-bounds test)
+    double meshMs = 0.0;       // sea mesh for the view
+    double rasterMs = 0.0;     // visibility buffer
+    double shadeMs = 0.0;      // shadow rays and shading
+    double cloudMs = 0.0;      // cloud layers over the sky (channels/otw/cloud_layer)
+    uint64_t cloudTraces = 0;  // cloud rays traced (grid nodes and exact sun/moon samples)
     RasterStats raster;
 };
 
@@ -58,6 +61,7 @@ class OtwChannel {
     std::vector<scene::CatalogStar> stars_;  // the bright-star list (configs/stars)
     std::unique_ptr<ShadeScratch> scratch_;
     std::unique_ptr<ChannelPlumes> plumes_;  // scenario plumes (channels/plume)
+    std::unique_ptr<CloudSky> clouds_;       // cloud pass scratch (environment.clouds)
     OtwFrameStats stats_;
 };
 

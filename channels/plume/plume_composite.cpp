@@ -465,7 +465,8 @@ ChannelPlumes::ChannelPlumes(const scene::World& world) {
     ambient.windSpeed_mps = sc.environment.windSpeed_mps;
     ambient.windDirection_rad = sc.environment.windDirection_rad;
     ambient.sunElevation_rad = world.Advance(0).sun.elevation_rad;
-    ambient.cloudCover = 0.0;  // the scenario has no cloud cover yet
+    // Pasquill–Turner stability follows the total cover (random overlap of the layers).
+    ambient.cloudCover = world.Clouds() ? world.Clouds()->TotalCoverage() : 0.0;
     system_ = std::make_unique<scene::PlumeSystem>(settings, ambient);
     field_ = system_->MakeField();
 }

@@ -12,6 +12,7 @@
 #include "scene/core/time.h"
 #include "scene/ocean/ocean_settings.h"
 #include "scene/plumes/plume_settings.h"
+#include "scene/sky/clouds.h"
 #include "scene/sky/lightning.h"
 
 namespace seasense::scene {
@@ -80,6 +81,8 @@ struct EnvironmentSettings {
     std::optional<ConfigValue> sea;
     // environment.lightning: thunderstorm cells and bolt/stroke parameters (ReadLightningSettings).
     std::optional<LightningSettings> lightning;
+    // environment.clouds: cloud layers (ReadCloudLayers); empty: a cloudless sky.
+    std::vector<CloudLayerSettings> clouds;
 };
 
 // A static mesh placed in the world. Positions are ENU metres at the model origin.

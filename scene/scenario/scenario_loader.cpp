@@ -181,6 +181,17 @@ EnvironmentSettings ReadEnvironment(ConfigMap& map, const WorldSettings& world) 
                 lightning->Fail(std::string("consistent lightning settings: ") + error.what());
             }
         }
+        if (std::optional<ConfigValue> clouds = e.Find("clouds")) {
+            env.clouds = ReadCloudLayers(*clouds);
+            // The field checks what the single keys cannot (and calibrates its patterns).
+            try {
+                const CloudField field(env.clouds, world.seed);
+            } catch (const ConfigError&) {
+                throw;
+            } catch (const InputError& error) {
+                clouds->Fail(std::string("consistent cloud layers: ") + error.what());
+            }
+        }
         env.atmosphere = e.Find("atmosphere");
         env.sea = e.Find("sea");
         ReadMap(e.Require("ocean", "a mapping"), [&](ConfigMap& ocean) {

@@ -31,6 +31,14 @@ World::World(const Scenario& scenario) : scenario_(scenario), ocean_(scenario.en
     if (scenario_.environment.lightning)
         lightning_ = std::make_shared<const Lightning>(*scenario_.environment.lightning,
                                                        scenario_.world.seed);
+    if (!scenario_.environment.clouds.empty())
+        clouds_ =
+            std::make_shared<const CloudField>(scenario_.environment.clouds, scenario_.world.seed);
+}
+
+double World::SkyConditionDivisor(const glm::dvec3& from_m, const glm::dvec3& toBody,
+                                  double t_s) const {
+    return clouds_ ? clouds_->SkyConditionDivisor(from_m, toBody, t_s) : 1.0;
 }
 
 namespace {
@@ -49,6 +57,9 @@ FrameState World::Advance(int64_t frame) const {
     s.frame = frame;
     s.time_s = double(frame) * w.timeScale / w.frameRate_hz;
     s.utc = w.start.PlusSeconds(s.time_s);
+
+    const EyepointSettings& eye = scenario_.eyepoint;
+    s.eyepoint = MovingPose(eye.position_m, eye.attitude, eye.speed_mps, s.time_s);
 
     Observer observer;
     observer.latitude_deg = w.latitude_deg;
@@ -79,8 +90,14 @@ FrameState World::Advance(int64_t frame) const {
         s.sun.illuminance_lux = sun.illuminance_lux;
     }
 
-    const EyepointSettings& eye = scenario_.eyepoint;
-    s.eyepoint = MovingPose(eye.position_m, eye.attitude, eye.speed_mps, s.time_s);
+    // Clouds between the eyepoint and the sun or moon lower their light (USNO Circular 171).
+    if (clouds_) {
+        s.sun.illuminance_lux /=
+            clouds_->SkyConditionDivisor(s.eyepoint.position_m, s.sun.direction, s.time_s);
+        s.moon.illuminance_lux /=
+            clouds_->SkyConditionDivisor(s.eyepoint.position_m, s.moon.direction, s.time_s);
+    }
+
     std::shared_ptr<const OceanSurfaceFrame> sea;  // made on first use: only riders need it
     for (size_t i = 0; i < scenario_.entities.size(); ++i) {
         const EntitySettings& e = scenario_.entities[i];

@@ -10,6 +10,7 @@
 #include "scene/models/triangle_mesh.h"
 #include "scene/ocean/ocean_surface.h"
 #include "scene/scenario/scenario.h"
+#include "scene/sky/clouds.h"
 #include "scene/sky/ephemeris.h"
 #include "scene/sky/lightning.h"
 
@@ -28,7 +29,9 @@ struct SunState {
     glm::dvec3 direction{0.0, 0.0, 1.0};  // unit ENU vector toward the sun
     double elevation_rad = 0.0;
     double azimuth_rad = 0.0;
-    double illuminance_lux = 0.0;  // on a surface normal to the sun
+    // On a surface normal to the sun, divided by the sky-condition divisor of the clouds along
+    // the sun's direction from the eyepoint (World::SkyConditionDivisor).
+    double illuminance_lux = 0.0;
 };
 
 // The moon as the observer sees it (always from the ephemeris and the scenario clock).
@@ -36,7 +39,9 @@ struct MoonState {
     glm::dvec3 direction{0.0, 0.0, -1.0};  // unit ENU vector toward the moon (apparent)
     double elevation_rad = -0.5 * 3.14159265358979323846;
     double azimuth_rad = 0.0;
-    double illuminance_lux = 0.0;  // direct, on a surface normal to the moon, at the ground
+    // Direct, on a surface normal to the moon, at the ground, divided by the sky-condition
+    // divisor of the clouds along the moon's direction (World::SkyConditionDivisor).
+    double illuminance_lux = 0.0;
     double phaseAngle_rad = 3.14159265358979323846;  // sun–moon–observer; 0 full, π new
     double distance_m = 3.844e8;                     // observer to the moon's centre
 };
@@ -82,6 +87,14 @@ class World {
     // The scenario's thunderstorms (environment.lightning), or nullptr. Flashes are pure
     // functions of the scene time, so every channel sees the same ones.
     const Lightning* GetLightning() const { return lightning_.get(); }
+    // The scenario's cloud layers (environment.clouds), or nullptr for a cloudless sky. Pure
+    // functions of position and scene time, so every channel sees the same clouds.
+    const CloudField* Clouds() const { return clouds_.get(); }
+    // USNO Circular 171 sky-condition divisor of a body (sun or moon) in unit direction
+    // toBody seen from from_m (ENU) at scene time t_s: CloudField::SkyConditionDivisor, 1
+    // without clouds. Advance divides the sun's and moon's direct illuminance by it.
+    double SkyConditionDivisor(const glm::dvec3& from_m, const glm::dvec3& toBody,
+                               double t_s) const;
     // The sea surface (Gerstner or spectral), frames cached per time.
     const OceanSurface& Ocean() const { return ocean_; }
 
@@ -92,6 +105,7 @@ class World {
     // Half length (body y) and half beam (body x) of each entity's mesh, for riding the waves.
     std::vector<glm::dvec2> halfExtent_m_;
     std::shared_ptr<const Lightning> lightning_;
+    std::shared_ptr<const CloudField> clouds_;
 };
 
 }  // namespace seasense::scene

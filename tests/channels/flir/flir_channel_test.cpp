@@ -565,5 +565,70 @@ TEST(FlirPipeline, FieldOfViewFromTheImagerOrCheckedAgainstIt) {
     EXPECT_NE(ResolveFlirImager(ch, 7).imager.seed, s1);
 }
 
+TEST(FlirChannel, OvercastStratusBaseReadsItsLapseRateTemperature) {
+    // Thick stratus (τ = 30, ε = 1 − e^−15) over the whole sky, base 1000 m, seen at the zenith
+    // from 2 m: the base is at the ICAO standard lapse rate's 290 − 6.5 K/km · 1 km = 283.5 K.
+    constexpr double kBase_m = 1000.0;
+    const double baseT_K = 290.0 - 0.0065 * kBase_m;
+    for (const char* humidity : {"0.0", "0.7"}) {
+        scene::Scenario sc = BaseScenario();
+        sc.environment.atmosphere =
+            ParseValue(std::string("air_temperature_K: 290\nrelative_humidity: ") + humidity + "\n",
+                       "atmosphere.yaml");
+        scene::CloudLayerSettings stratus;
+        stratus.type = scene::CloudType::Stratus;
+        stratus.coverage = 1.0;
+        stratus.base_m = kBase_m;
+        stratus.thickness_m = 400.0;
+        stratus.opticalDepth = 30.0;
+        sc.environment.clouds = {stratus};
+        sc.eyepoint.position_m = {0, 0, 2};
+        sc.eyepoint.attitude.pitch_rad = 0.5 * M_PI;
+        const scene::World world(sc);
+        FlirChannel flir(world, sc.channels[0]);
+        const Image L = RenderOnce(world, flir, 2);
+        const radiometry::BandRadianceTable& table = flir.RadianceTable();
+        const radiometry::Atmosphere& air = flir.GetAtmosphere();
+        const float radiance = L.At(L.width / 2, L.height / 2)[0];
+        // The path of 998 m up holds as much water vapour (scale height 2 km) as a horizontal
+        // path of 2000 (1 − e^(−998/2000)) m at the surface; its emission is the air's.
+        const double tau = air.Transmittance(2000.0 * -std::expm1(-998.0 / 2000.0));
+        const double corrected = (radiance - (1.0 - tau) * air.AirRadiance()) / tau;
+        EXPECT_NEAR(table.Temperature(corrected), baseT_K, 0.5) << humidity;
+        if (std::string(humidity) == "0.0") {
+            // Dry air: the path is nearly transparent and the raw reading is the base's.
+            EXPECT_NEAR(table.Temperature(radiance), baseT_K, 0.5);
+        } else {
+            // Humid air: the warmer path raises the reading, but not above the air.
+            EXPECT_GT(table.Temperature(radiance), baseT_K);
+            EXPECT_LT(table.Temperature(radiance), 290.0);
+        }
+        // Beside the cloud-free zenith (cold, far below the base) the overcast is warm.
+        scene::Scenario clearSky = sc;
+        clearSky.environment.clouds.clear();
+        const scene::World clearWorld(clearSky);
+        FlirChannel clearFlir(clearWorld, clearSky.channels[0]);
+        const Image C = RenderOnce(clearWorld, clearFlir, 2);
+        EXPECT_LT(table.Temperature(C.At(C.width / 2, C.height / 2)[0]), baseT_K - 10.0);
+    }
+}
+
+TEST(FlirChannel, CloudsAreTheSameForOneAndTwoThreads) {
+    scene::Scenario sc = BaseScenario();
+    sc.eyepoint.attitude.pitch_rad = 0.3;
+    scene::CloudLayerSettings cumulus;
+    cumulus.type = scene::CloudType::Cumulus;
+    cumulus.coverage = 0.5;
+    cumulus.base_m = 700.0;
+    cumulus.thickness_m = 900.0;
+    sc.environment.clouds = {cumulus};
+    const scene::World world(sc);
+    FlirChannel a(world, sc.channels[0]), b(world, sc.channels[0]);
+    const Image one = RenderOnce(world, a, 1), two = RenderOnce(world, b, 2);
+    EXPECT_EQ(std::memcmp(one.pixels.data(), two.pixels.data(), one.pixels.size() * sizeof(float)),
+              0);
+    EXPECT_GT(a.Stats().cloudTraces, 0u);
+}
+
 }  // namespace
 }  // namespace seasense::channels

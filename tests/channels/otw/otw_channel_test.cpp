@@ -5,8 +5,11 @@
 #include <tbb/task_arena.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <memory>
 
 #include "scene/ocean/ocean_mesh.h"
 #include "tests/support/meshes.h"
@@ -311,6 +314,123 @@ TEST(OtwChannel, PoleOnTheBorderOfAdjacentChannelsLinesUp) {
     EXPECT_NEAR(l.bottom, c.bottom, 1.0);
     EXPECT_GT(l.bottom - l.top, 20);  // the pole really is there
     std::filesystem::remove_all(dir);
+}
+
+// A full-cover uniform slab (coverage 1: every column full) of vertical optical depth tau.
+scene::CloudLayerSettings UniformSlab(double tau, double base_m) {
+    scene::CloudLayerSettings layer;
+    layer.type = scene::CloudType::Stratus;
+    layer.coverage = 1.0;
+    layer.base_m = base_m;
+    layer.thickness_m = 300.0;
+    layer.opticalDepth = tau;
+    return layer;
+}
+
+// CalmSeaScenario's camera turned to look at a fixed sun at 40° elevation.
+scene::Scenario SunViewScenario() {
+    scene::Scenario sc = CalmSeaScenario(2.0, 4.0);
+    sc.environment.sun.azimuth_rad = 1.0;
+    sc.environment.sun.elevation_rad = 40.0 * M_PI / 180.0;
+    sc.eyepoint.attitude.heading_rad = 1.0;
+    sc.eyepoint.attitude.pitch_rad = 40.0 * M_PI / 180.0;
+    sc.channels[0].height = 48;
+    return sc;
+}
+
+// Renders frame 0 of sc; the channel (kept until the next call) through keep.
+Image RenderOtw(const scene::Scenario& sc, int threads, OtwChannel** keep = nullptr) {
+    static std::unique_ptr<scene::World> world;
+    static std::unique_ptr<OtwChannel> otw;
+    otw.reset();
+    world = std::make_unique<scene::World>(sc);
+    otw = std::make_unique<OtwChannel>(*world, sc.channels[0]);
+    Image radiance;
+    tbb::task_arena arena(threads);
+    arena.execute([&] { otw->Render(world->State(0), radiance); });
+    if (keep) *keep = otw.get();
+    return radiance;
+}
+
+TEST(OtwChannel, SunBehindACloudIsAttenuatedByExpMinusTau) {
+    const scene::Scenario clear = SunViewScenario();
+    scene::Scenario cloudy = clear;
+    const double tauVertical = 2.0;
+    cloudy.environment.clouds = {UniformSlab(tauVertical, 800.0)};
+    const Image a = RenderOtw(clear, 2);
+    OtwChannel* otw = nullptr;
+    const Image b = RenderOtw(cloudy, 2, &otw);
+    const ChannelCamera& cam = otw->Camera();
+    const int sx = cam.SampleWidth() / 2, sy = cam.SampleHeight() / 2;
+    const glm::dvec3 d = cam.SampleDirection(sx, sy);
+    // The sample is on the sun's disc; the one 10 samples (0.6°) left is off it.
+    const glm::dvec3 sun = scene::DirectionFromAzimuthElevation(1.0, 40.0 * M_PI / 180.0);
+    ASSERT_GT(glm::dot(d, sun), std::cos(radiometry::kSunAngularRadius_rad));
+    ASSERT_LT(glm::dot(cam.SampleDirection(sx - 10, sy), sun),
+              std::cos(radiometry::kSunAngularRadius_rad));
+    // Analytic slab: τ = τ_v / sin(elevation of the ray); the field's own trace agrees.
+    const double tau = tauVertical / d.z;
+    const scene::World world(cloudy);
+    const scene::CloudHit hit = world.Clouds()->Trace(cam.worldFromCamera.position_m, d, 0.0);
+    EXPECT_NEAR(hit.opticalDepth, tau, 1e-9 * tau);
+    // The disc's excess over the sky beside it is the direct beam: scaled by e^−τ (the cloud's
+    // own light is nearly the same in both samples and cancels).
+    for (int c = 0; c < 3; ++c) {
+        const double clearDisc = a.At(sx, sy)[c] - a.At(sx - 10, sy)[c];
+        const double cloudyDisc = b.At(sx, sy)[c] - b.At(sx - 10, sy)[c];
+        ASSERT_GT(clearDisc, 1e8);
+        EXPECT_NEAR(cloudyDisc / clearDisc, std::exp(-tau), 1e-3 * std::exp(-tau)) << c;
+        EXPECT_NEAR(cloudyDisc / clearDisc, hit.transmittance, 1e-3 * hit.transmittance) << c;
+    }
+}
+
+TEST(OtwChannel, ThickOvercastBaseIsDarkerAndSendsNoMoreLightThanItReceives) {
+    scene::Scenario sc = SunViewScenario();
+    sc.eyepoint.attitude.pitch_rad = 0.5 * M_PI;  // the zenith
+    double previous = std::numeric_limits<double>::infinity();
+    for (double tau : {5.0, 20.0, 80.0}) {
+        sc.environment.clouds = {UniformSlab(tau, 800.0)};
+        OtwChannel* otw = nullptr;
+        const Image L = RenderOtw(sc, 2, &otw);
+        const float* p = L.At(L.width / 2, L.height / 2);
+        const double Y = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+        // Lambertian base: π L at most the light falling on the top (direct sun on the level
+        // top plus the clear sky dome), here about 8.9e4 lx.
+        const double top = 1e5 * std::sin(40.0 * M_PI / 180.0) + 3e4;
+        EXPECT_GT(Y, 0.0);
+        EXPECT_LT(M_PI * Y, top) << tau;
+        EXPECT_LT(Y, previous) << tau;
+        previous = Y;
+    }
+}
+
+TEST(OtwChannel, CloudsAreTheSameForOneAndTwoThreadsAndAnEmptyLayerChangesNothing) {
+    scene::Scenario sc = SunViewScenario();
+    sc.eyepoint.attitude.pitch_rad = 10.0 * M_PI / 180.0;
+    sc.channels[0].hfov_rad = 60.0 * M_PI / 180.0;
+    sc.channels[0].width = 160;
+    sc.channels[0].height = 120;
+    sc.channels[0].supersampling = 2;
+    const Image clear = RenderOtw(sc, 2);
+    scene::CloudLayerSettings cumulus;
+    cumulus.type = scene::CloudType::Cumulus;
+    cumulus.coverage = 0.4;
+    cumulus.base_m = 900.0;
+    cumulus.thickness_m = 800.0;
+    scene::CloudLayerSettings empty = cumulus;
+    empty.coverage = 0.0;
+    sc.environment.clouds = {empty};
+    const Image none = RenderOtw(sc, 2);
+    EXPECT_EQ(
+        std::memcmp(none.pixels.data(), clear.pixels.data(), clear.pixels.size() * sizeof(float)),
+        0);
+    sc.environment.clouds = {cumulus, UniformSlab(1.0, 7000.0)};
+    const Image one = RenderOtw(sc, 1);
+    const Image two = RenderOtw(sc, 2);
+    EXPECT_EQ(std::memcmp(one.pixels.data(), two.pixels.data(), one.pixels.size() * sizeof(float)),
+              0);
+    EXPECT_NE(
+        std::memcmp(one.pixels.data(), clear.pixels.data(), one.pixels.size() * sizeof(float)), 0);
 }
 
 }  // namespace

@@ -641,5 +641,61 @@ TEST_F(ScenarioLoaderTest, PlumeErrorsNameTheKey) {
                 "plumes.stabilty");
 }
 
+TEST_F(ScenarioLoaderTest, CloudLayersAreReadInSiUnits) {
+    EXPECT_TRUE(LoadScenario(Write(valid_)).environment.clouds.empty());
+    const std::string text = Replace(valid_, "  visibility_m: 20000\n",
+                                     "  visibility_m: 20000\n"
+                                     "  clouds:\n"
+                                     "    - {type: stratocumulus, coverage_oktas: 6, base_m: 900,\n"
+                                     "       thickness_m: 400, drift_east_mps: 4}\n"
+                                     "    - {type: cirrus, coverage: 0.3, base_m: 8000, "
+                                     "thickness_m: 1500, optical_depth: 0.5, cell_m: 3000}\n");
+    const std::vector<CloudLayerSettings> clouds = LoadScenario(Write(text)).environment.clouds;
+    ASSERT_EQ(clouds.size(), 2u);
+    EXPECT_EQ(clouds[0].type, CloudType::Stratocumulus);
+    EXPECT_DOUBLE_EQ(clouds[0].coverage, 0.75);  // 6 oktas of 8
+    EXPECT_DOUBLE_EQ(clouds[0].base_m, 900.0);
+    EXPECT_DOUBLE_EQ(clouds[0].thickness_m, 400.0);
+    EXPECT_DOUBLE_EQ(clouds[0].drift_mps.x, 4.0);
+    EXPECT_TRUE(std::isnan(clouds[0].opticalDepth));  // the type's default, filled by the field
+    EXPECT_EQ(clouds[1].type, CloudType::Cirrus);
+    EXPECT_DOUBLE_EQ(clouds[1].coverage, 0.3);
+    EXPECT_DOUBLE_EQ(clouds[1].opticalDepth, 0.5);
+    EXPECT_DOUBLE_EQ(clouds[1].cellSize_m, 3000.0);
+}
+
+TEST_F(ScenarioLoaderTest, CloudErrorsNameTheKey) {
+    const auto withClouds = [&](const std::string& layers) {
+        return Replace(valid_, "  visibility_m: 20000\n",
+                       "  visibility_m: 20000\n  clouds:\n" + layers);
+    };
+    const auto expectError = [&](const std::string& text, const std::string& context,
+                                 const std::string& part, const std::string& keyPath) {
+        const std::string message = ErrorFor(text);
+        EXPECT_TRUE(message.starts_with(At(text, context, part, keyPath))) << message;
+        return message;
+    };
+    const std::string misspelt =
+        withClouds("    - {type: stratus, coverage: 1, bsae_m: 300, thickness_m: 200}\n");
+    const std::string message = ErrorFor(misspelt);
+    EXPECT_NE(message.find("environment.clouds[0]"), std::string::npos) << message;
+    EXPECT_NE(message.find("did you mean 'base_m'"), std::string::npos) << message;
+    expectError(withClouds("    - {type: stratos, coverage: 1, base_m: 300, thickness_m: 200}\n"),
+                "type: stratos", "stratos", "environment.clouds[0].type");
+    expectError(withClouds("    - {type: stratus, coverage: 1.5, base_m: 300, thickness_m: 200}\n"),
+                "coverage: 1.5", "1.5", "environment.clouds[0].coverage");
+    expectError(withClouds("    - {type: stratus, coverage: 1, coverage_oktas: 8, base_m: 300, "
+                           "thickness_m: 200}\n"),
+                "coverage_oktas", "8", "environment.clouds[0].coverage_oktas");
+    expectError(
+        withClouds("    - {type: cirrus, coverage: 0.2, base_m: 19000, thickness_m: 2000}\n"),
+        "thickness_m: 2000", "2000", "environment.clouds[0].thickness_m");
+    expectError(withClouds("    - {type: stratus, coverage: 1, base_m: 300, thickness_m: 200}\n"
+                           "    - {type: cumulus, coverage: 0.5, base_m: 900, thickness_m: 800,"
+                           " drift_north_mps: 900}\n"),
+                "drift_north_mps", "900", "environment.clouds[1].drift_north_mps");
+    expectError(withClouds("    []\n"), "clouds:", "[]", "environment.clouds");
+}
+
 }  // namespace
 }  // namespace seasense::scene

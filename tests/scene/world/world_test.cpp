@@ -178,5 +178,70 @@ TEST(World, ComposeRejectsAStateOfAnotherScenario) {
     EXPECT_THROW(world.Compose(f), InputError);
 }
 
+// One full-cover layer of the given type and vertical optical depth.
+CloudLayerSettings Overcast(CloudType type, double opticalDepth) {
+    CloudLayerSettings layer;
+    layer.type = type;
+    layer.coverage = 1.0;
+    layer.base_m = 600.0;
+    layer.thickness_m = 400.0;
+    layer.opticalDepth = opticalDepth;
+    return layer;
+}
+
+TEST(World, CloudsDivideTheSunAndMoonByTheCircular171SkyCondition) {
+    Scenario clear = BaseScenario();
+    clear.environment.sun.elevation_rad = 40.0 * M_PI / 180.0;
+    clear.environment.sun.azimuth_rad = 1.0;
+    clear.environment.sun.illuminance_lux = 9.0e4;
+    const World clearWorld(clear);
+    EXPECT_EQ(clearWorld.Clouds(), nullptr);
+    // The moon of BaseScenario's night is up at frame 0 (MoonFollowsTheEphemeris… above).
+    const FrameState c = clearWorld.Advance(0);
+    ASSERT_GT(c.moon.elevation_rad, 0.0);
+    // Circular 171 (Janiczek & DeYoung 1987), "sky condition" divisors: thin cloud with the
+    // body visible 2, body hidden by average cloud 3, dark stratus 10 (vertical optical
+    // depths within the ISCCP thin, medium and thick classes along the slant path).
+    struct Case {
+        CloudType type;
+        double tau;
+        double divisor;
+    };
+    for (const Case& k : {Case{CloudType::Cirrus, 1.0, 2.0}, Case{CloudType::Altostratus, 9.0, 3.0},
+                          Case{CloudType::Stratus, 40.0, 10.0}}) {
+        Scenario sc = clear;
+        sc.environment.clouds = {Overcast(k.type, k.tau)};
+        const World world(sc);
+        ASSERT_NE(world.Clouds(), nullptr);
+        const FrameState f = world.Advance(0);
+        EXPECT_DOUBLE_EQ(f.sun.illuminance_lux, c.sun.illuminance_lux / k.divisor) << k.tau;
+        // The moon is lower: a longer slant path, τ / sin(elevation) through the uniform slab.
+        const double moonTau = k.tau / std::sin(c.moon.elevation_rad);
+        const double moonDivisor = moonTau < 3.6 ? 2.0 : moonTau < 23.0 ? 3.0 : 10.0;
+        EXPECT_NEAR(f.moon.illuminance_lux, c.moon.illuminance_lux / moonDivisor,
+                    1e-12 * c.moon.illuminance_lux)
+            << k.tau;
+        // Everything else is the clear world's.
+        EXPECT_EQ(f.sun.direction, c.sun.direction);
+        EXPECT_EQ(f.moon.direction, c.moon.direction);
+        EXPECT_EQ(f.eyepoint.position_m, c.eyepoint.position_m);
+    }
+    // A sun in a gap of a sky less than 70 % covered keeps its light (divisor 1); with 70 % or
+    // more covered, Circular 171 counts even a sun in a gap as "thin cloud" (2).
+    for (double coverage : {0.3, 0.8}) {
+        Scenario sc = clear;
+        CloudLayerSettings layer = Overcast(CloudType::Cumulus, 5.0);
+        layer.coverage = coverage;
+        sc.environment.clouds = {layer};
+        const World world(sc);
+        const FrameState f = world.Advance(0);
+        const double tau =
+            world.Clouds()->Trace(f.eyepoint.position_m, f.sun.direction, f.time_s).opticalDepth;
+        if (tau > 0.0) continue;  // the sun is behind a cloud here: not this case
+        EXPECT_DOUBLE_EQ(f.sun.illuminance_lux,
+                         c.sun.illuminance_lux / (coverage < 0.7 ? 1.0 : 2.0));
+    }
+}
+
 }  // namespace
 }  // namespace seasense::scene
