@@ -129,6 +129,7 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
     const GerstnerOcean::LocalFrame local =
         frame.Gerstner().Local(req.eye_m.x, req.eye_m.y, frame.Time_s());
     const bool gerstner = frame.Gerstner().WaveCount() > 0;
+    const bool surf = frame.Surf() != nullptr;
     tbb::parallel_for(0, rings, [&](int j) {
         const double radius = radii[size_t(j)];
         const double drop = CurvatureDrop_m(radius);
@@ -140,6 +141,7 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
             GeometrySums s{};
             frame.AccumulateFft(req.eye_m.x + rx, req.eye_m.y + ry, filter, s);
             if (gerstner) local.Accumulate(float(rx), float(ry), fp, s.data());
+            if (surf) frame.AccumulateSurf(req.eye_m.x + rx, req.eye_m.y + ry, s);
             out.positions[v] = glm::vec3(float(req.eye_m.x + rx + double(s[kTermDispX])),
                                          float(req.eye_m.y + ry + double(s[kTermDispY])),
                                          float(double(s[kTermHeight]) - drop));

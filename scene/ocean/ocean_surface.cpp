@@ -13,6 +13,7 @@
 #include <numbers>
 
 #include "scene/core/check.h"
+#include "scene/core/rng.h"
 #include "scene/ocean/sea_state.h"
 
 namespace seasense::scene {
@@ -23,6 +24,9 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Frames kept by OceanSurface::At: the current frame time and the one before, so the host's
 // wave riding and a renderer's mesh of one frame share a synthesis.
 constexpr size_t kCachedFrames = 2;
+// Random streams of the surf components (apart from the FFT's, which use small stream ids).
+constexpr uint64_t kSurfDirectionStream = 0x53555246'00000001ULL;
+constexpr uint64_t kSurfPhaseStream = 0x53555246'00000002ULL;
 
 // Bilinear lookup of mip level `level` of a cascade texture at rest position (x0, y0), weighted
 // by `weight`, added to sums. Texel i of level l is centred on the mean of the nodes it averages,
@@ -113,10 +117,65 @@ void OceanSurfaceFrame::BuildTextures() {
     }
 }
 
+namespace {
+
+// Seabed under the displaced point and its slope (central differences over 0.1 m), for the clamp.
+glm::dvec3 SeabedWithSlope(const Bathymetry& b, double x, double y) {
+    constexpr double d = 0.05;
+    return {b.SeabedZ_m(x, y), (b.SeabedZ_m(x + d, y) - b.SeabedZ_m(x - d, y)) / (2.0 * d),
+            (b.SeabedZ_m(x, y + d) - b.SeabedZ_m(x, y - d)) / (2.0 * d)};
+}
+
+}  // namespace
+
 SurfaceTerms OceanSurfaceFrame::Terms(double x0, double y0) const {
     SurfaceTerms t = gerstner_.Terms(x0, y0, t_s_);
     if (hasFft_) t += fft_.Terms(x0, y0);
+    if (!surf_) return t;
+    SurfPointInfo info;
+    const SurfaceTerms s = surf_->Terms(x0, y0, t_s_, &info);
+    if (info.deepWeight != 1.0) {
+        const double w = info.deepWeight;
+        t.displacement *= w;
+        t.dxx *= w, t.dyy *= w, t.dxy *= w, t.sx *= w, t.sy *= w;
+        t.velocity_mps *= w;
+    }
+    t += s;
+    t.displacement.z += surf_->Bathy().Tide_m();
+    // The water never lies below the seabed (seed 003): where it would, it lies on it, still.
+    const double zBed = surf_->Bathy().SeabedZ_m(x0 + t.displacement.x, y0 + t.displacement.y);
+    if (t.displacement.z < zBed) {
+        const glm::dvec3 bed =
+            SeabedWithSlope(surf_->Bathy(), x0 + t.displacement.x, y0 + t.displacement.y);
+        t.displacement.z = bed.x;
+        t.sx = bed.y, t.sy = bed.z;
+        t.velocity_mps = glm::dvec3(0.0);
+    }
     return t;
+}
+
+void OceanSurfaceFrame::AccumulateSurf(double x0, double y0, GeometrySums& sums) const {
+    if (!surf_) return;
+    SurfPointInfo info;
+    const SurfaceTerms s = surf_->Terms(x0, y0, t_s_, &info);
+    if (info.deepWeight != 1.0)
+        for (float& v : sums) v *= float(info.deepWeight);
+    sums[kTermHeight] += float(s.displacement.z + surf_->Bathy().Tide_m());
+    sums[kTermDispX] += float(s.displacement.x);
+    sums[kTermDispY] += float(s.displacement.y);
+    sums[kTermSlopeX] += float(s.sx);
+    sums[kTermSlopeY] += float(s.sy);
+    sums[kTermDispXX] += float(s.dxx);
+    sums[kTermDispYY] += float(s.dyy);
+    sums[kTermDispXY] += float(s.dxy);
+    const double x = x0 + double(sums[kTermDispX]), y = y0 + double(sums[kTermDispY]);
+    const double zBed = surf_->Bathy().SeabedZ_m(x, y);
+    if (double(sums[kTermHeight]) < zBed) {
+        const glm::dvec3 bed = SeabedWithSlope(surf_->Bathy(), x, y);
+        sums[kTermHeight] = float(bed.x);
+        sums[kTermSlopeX] = float(bed.y);
+        sums[kTermSlopeY] = float(bed.z);
+    }
 }
 
 OceanSample OceanSurfaceFrame::SampleAt(double x, double y, glm::dvec2* rest) const {
@@ -178,6 +237,53 @@ OceanSurface::OceanSurface(const OceanSettings& settings)
         fft_ = std::make_unique<const FftOcean>(*spectrum_, settings_.spectral->fft);
     }
     Summarize();
+    if (settings_.surf) surf_ = MakeSurfWaves();
+}
+
+// The surf components: the spectral sea's variance carried by 12 components around its peak,
+// plus every Gerstner wave as itself (see surf_waves.h for why).
+std::shared_ptr<const SurfWaves> OceanSurface::MakeSurfWaves() const {
+    const Bathymetry bathy(*settings_.surf, settings_.depth_m);
+    std::vector<SurfComponent> components;
+    double peakWavelength = summary_.peakWavelength_m;
+    if (fft_ && spectrum_ && fft_->ModeVariance_m2() > 0.0 &&
+        std::isfinite(summary_.peakPeriod_s)) {
+        constexpr int kComponents = 12;
+        // ±20° about the dominant direction: the half-width of cos^2s spreading with s ≈ 10–25
+        // near the peak (Mitsuyasu et al. 1975; Goda, Random Seas and Design of Maritime
+        // Structures, 2000, §2.3).
+        constexpr double kSpread_rad = 20.0 * std::numbers::pi / 180.0;
+        const double wp = kTwoPi / summary_.peakPeriod_s;
+        const uint64_t seed = settings_.spectral->fft.seed;
+        std::vector<double> weight(kComponents);
+        double total = 0.0;
+        for (int j = 0; j < kComponents; ++j) {
+            const double w = wp * (0.8 + 0.8 * (j + 0.5) / kComponents);
+            weight[size_t(j)] = spectrum_->DensityOmega(w);
+            total += weight[size_t(j)];
+        }
+        for (int j = 0; j < kComponents && total > 0.0; ++j) {
+            SurfComponent c;
+            c.omega_radps = wp * (0.8 + 0.8 * (j + 0.5) / kComponents);
+            // Σ A²/2 = the FFT's variance, shared in proportion to S(ω).
+            c.amplitude_m = std::sqrt(2.0 * fft_->ModeVariance_m2() * weight[size_t(j)] / total);
+            c.direction_rad =
+                summary_.dominantDirection_rad +
+                kSpread_rad * (2.0 * Uniform01(seed, kSurfDirectionStream, uint64_t(j)) - 1.0);
+            c.phase_rad = kTwoPi * Uniform01(seed, kSurfPhaseStream, uint64_t(j));
+            components.push_back(c);
+        }
+    }
+    for (size_t i = 0; i < gerstner_.WaveCount(); ++i) {
+        SurfComponent c;
+        c.amplitude_m = gerstner_.Amplitude_m(i);
+        c.omega_radps = gerstner_.Omega_radps(i);
+        c.direction_rad = gerstner_.Direction_rad(i);
+        c.phase_rad = settings_.waves[i].phase_rad;
+        components.push_back(c);
+    }
+    if (!(peakWavelength > 0.0)) peakWavelength = 100.0;  // flat sea: any fade depth will do
+    return std::make_shared<const SurfWaves>(bathy, std::move(components), peakWavelength);
 }
 
 OceanSurface::~OceanSurface() = default;
@@ -197,6 +303,14 @@ void OceanSurface::Fill(OceanSurfaceFrame& frame, double t, bool withVelocity) c
     }
     frame.maxHeight_m_ += gerstner_.MaxAmplitude_m();
     frame.maxHorizontal_m_ += gerstner_.MaxHorizontal_m();
+    frame.surf_ = surf_;
+    if (surf_) {
+        // Surf crests are capped at γ h / 2 within the fade depth, on top of the tide; their
+        // horizontal orbits at A / tanh(kh) ≤ A / (kh) ~ the depth at most.
+        frame.maxHeight_m_ +=
+            0.5 * surf_->BreakerIndex() * surf_->FadeDeep_m() + std::abs(surf_->Bathy().Tide_m());
+        frame.maxHorizontal_m_ += surf_->FadeDeep_m();
+    }
 }
 
 std::shared_ptr<const OceanSurfaceFrame> OceanSurface::At(double t) const {
@@ -236,6 +350,13 @@ OceanPointQuery OceanSurface::Query(double x, double y, double t) const {
     q.surface = frame->SampleAt(x, y, &q.rest_m);
     q.waterDepth_m = settings_.depth_m;
     q.foamCoverage = FoamCoverage(q.surface);
+    if (surf_) {
+        surf_->Terms(q.rest_m.x, q.rest_m.y, t, &q.surf);
+        q.hasSurf = true;
+        q.waterDepth_m = surf_->Bathy().Depth_m(x, y);
+        // Breaking white water: the larger of the depth-limited breaking and the Jacobian foam.
+        q.foamCoverage = std::max(q.foamCoverage, q.surf.breaking.intensity);
+    }
     return q;
 }
 

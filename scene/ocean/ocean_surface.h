@@ -16,6 +16,7 @@
 #include "scene/ocean/spectrum.h"
 #include "scene/ocean/surface_terms.h"
 #include "scene/scenario/scenario.h"
+#include "scene/surf/surf_waves.h"
 
 namespace seasense::scene {
 
@@ -93,6 +94,14 @@ class OceanSurfaceFrame {
     // (per sample, with the sample's footprint on the sea), seed 001's normal-map idea.
     glm::vec3 DetailNormal(double x0, double y0, float footprint_m) const;
 
+    // With a surf zone: scales the deep sea's sums (FFT and Gerstner, already in sums) by the
+    // deep weight at rest position (x0, y0), adds the surf components and the tide, and clamps
+    // the height to the seabed under the displaced point. The mesh path; Terms does the same.
+    void AccumulateSurf(double x0, double y0, GeometrySums& sums) const;
+
+    // The surf components (nullptr without environment.ocean.surf).
+    const SurfWaves* Surf() const { return surf_.get(); }
+
     // The Gerstner part (possibly without waves) and, for the spectral model, the FFT fields.
     const GerstnerOcean& Gerstner() const { return gerstner_; }
     const FftOceanFrame* Fft() const { return hasFft_ ? &fft_ : nullptr; }
@@ -123,6 +132,7 @@ class OceanSurfaceFrame {
     GerstnerOcean gerstner_;
     bool hasFft_ = false;
     FftOceanFrame fft_;
+    std::shared_ptr<const SurfWaves> surf_;
     std::vector<CascadeTexture> textures_;
     double maxHeight_m_ = 0.0;
     double maxHorizontal_m_ = 0.0;
@@ -158,6 +168,10 @@ struct OceanPointQuery {
     // Jacobian, 0 where its smaller eigenvalue is at or above the scenario's foam_threshold τ,
     // rising linearly to 1 where the surface folds (eigenvalue ≤ 0): 1 − λ_min / τ, clamped.
     double foamCoverage = 0.0;
+    // With a surf zone: the point's surf information (depth, weights, breaking, the local
+    // dominant component's direction, phase and speeds); waterDepth_m is then the local depth.
+    bool hasSurf = false;
+    SurfPointInfo surf;
 };
 
 class OceanSurface {
@@ -188,15 +202,18 @@ class OceanSurface {
     const WaveSpectrum* Spectrum() const { return spectrum_.get(); }
     const FftOcean* Fft() const { return fft_.get(); }
     const GerstnerOcean& Gerstner() const { return gerstner_; }
+    const SurfWaves* Surf() const { return surf_.get(); }
 
   private:
     void Fill(OceanSurfaceFrame& frame, double t_s, bool withVelocity) const;
     void Summarize();
+    std::shared_ptr<const SurfWaves> MakeSurfWaves() const;
 
     OceanSettings settings_;
     GerstnerOcean gerstner_;
     std::unique_ptr<const WaveSpectrum> spectrum_;
     std::unique_ptr<const FftOcean> fft_;
+    std::shared_ptr<const SurfWaves> surf_;
     SeaSummary summary_;
     struct Cache;
     std::unique_ptr<Cache> cache_;

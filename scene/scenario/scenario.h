@@ -14,6 +14,7 @@
 #include "scene/plumes/plume_settings.h"
 #include "scene/sky/clouds.h"
 #include "scene/sky/lightning.h"
+#include "scene/surf/surf_settings.h"
 
 namespace seasense::scene {
 
@@ -65,6 +66,10 @@ struct OceanSettings {
     // Foam coverage reported by queries rises from 0 where the Jacobian's smaller eigenvalue is
     // this value to 1 where the surface folds (eigenvalue 0); in (0, 1).
     double foamThreshold = 0.3;
+    // environment.ocean.surf: the surf zone (shoreline, bathymetry, sandbars). Absent: open water
+    // of depth_m everywhere. It lives in the ocean section because it reshapes the same sea
+    // surface (OceanSurface is built from these settings) and falls offshore to depth_m.
+    std::optional<SurfSettings> surf;
 };
 
 struct EnvironmentSettings {

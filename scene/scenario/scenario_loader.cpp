@@ -137,7 +137,8 @@ SpectralOceanSettings ReadSpectralOcean(const ConfigValue& value, const Environm
     return s;
 }
 
-EnvironmentSettings ReadEnvironment(ConfigMap& map, const WorldSettings& world) {
+EnvironmentSettings ReadEnvironment(ConfigMap& map, const WorldSettings& world,
+                                    const std::filesystem::path& folder) {
     EnvironmentSettings env;
     ReadMap(map.Require("environment", "a mapping"), [&](ConfigMap& e) {
         const ConfigValue sunValue =
@@ -210,6 +211,10 @@ EnvironmentSettings ReadEnvironment(ConfigMap& map, const WorldSettings& world) 
             }
             env.ocean.foamThreshold = ocean.GetDouble("foam_threshold", NumberRange::Open(0.0, 1.0),
                                                       env.ocean.foamThreshold);
+            if (const std::optional<ConfigValue> surf = ocean.Find("surf"))
+                env.ocean.surf = ReadMap(*surf, [&](ConfigMap& m) {
+                    return ParseSurfSettings(m, folder, env.ocean.depth_m);
+                });
         });
     });
     return env;
@@ -428,7 +433,7 @@ Scenario LoadScenario(const std::filesystem::path& file) {
 
     ReadMap(document.root, [&](ConfigMap& root) {
         scenario.world = ReadWorld(root);
-        scenario.environment = ReadEnvironment(root, scenario.world);
+        scenario.environment = ReadEnvironment(root, scenario.world, folder);
 
         const std::filesystem::path materialFile =
             FindMaterialFile(root, folder, document.root.Location());

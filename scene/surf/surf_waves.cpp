@@ -1,0 +1,238 @@
+// Depth-aware surf components: cross-shore phase tables, depth tables of k and cg, and the
+// per-point evaluation with shoaling, refraction, the breaker cap and Gerstner steepening.
+#include "scene/surf/surf_waves.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <complex>
+#include <limits>
+#include <numbers>
+
+#include "scene/core/check.h"
+#include "scene/ocean/gerstner.h"
+#include "scene/ocean/spectrum.h"
+
+namespace seasense::scene {
+namespace {
+
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+// Shallowest depth the dispersion tables resolve: below it the waves are capped to nothing.
+constexpr double kMinDepth_m = 0.01;
+// Largest cross-shore table (samples): 0.5 m steps over 20 km.
+constexpr int kMaxSamples = 40000;
+
+double Interp(const std::vector<double>& t, double x) {
+    if (x <= 0.0) return t.front();
+    const double last = double(t.size() - 1);
+    if (x >= last) return t.back();
+    const size_t i = size_t(x);
+    const double f = x - double(i);
+    return t[i] + f * (t[i + 1] - t[i]);
+}
+
+}  // namespace
+
+SurfWaves::SurfWaves(const Bathymetry& bathymetry, std::vector<SurfComponent> components,
+                     double peakWavelength_m, const SurfWaveSettings& settings)
+    : bathy_(bathymetry), components_(std::move(components)), settings_(settings) {
+    CHECK(peakWavelength_m > 0.0);
+    CHECK(components_.size() <= kMaxSurfComponents);
+    const double tide = bathy_.Tide_m();
+    const double offshoreDepth = tide + bathy_.OceanDepth_m();
+    fadeDeep_m_ = std::min(0.5 * peakWavelength_m, offshoreDepth);
+    fadeShallow_m_ = 0.5 * fadeDeep_m_;
+
+    // Cross-shore table: from the fade's deep end (plane beach) landward past the waterline.
+    auto profileDepth = [&](double s) { return tide - bathy_.ProfileZ_m(s); };
+    sRef_m_ = 0.0;
+    while (profileDepth(sRef_m_) < fadeDeep_m_ && sRef_m_ < ds_m_ * kMaxSamples) sRef_m_ += 1.0;
+    sShore_m_ = sRef_m_;
+    while (profileDepth(sShore_m_) > 0.0 && sShore_m_ > sRef_m_ - ds_m_ * kMaxSamples)
+        sShore_m_ -= 1.0;
+    const int samples = int(std::ceil((sRef_m_ - sShore_m_ + 10.0) / ds_m_)) + 1;
+
+    depthSamples_ = int(std::ceil(fadeDeep_m_ / dh_m_)) + 2;
+    const double depthForDeep = bathy_.OceanDepth_m();
+    tracks_.resize(components_.size());
+    size_t dominant = 0;
+    for (size_t j = 0; j < components_.size(); ++j) {
+        const SurfComponent& c = components_[j];
+        if (c.amplitude_m > components_[dominant].amplitude_m) dominant = j;
+        Track& tr = tracks_[j];
+        tr.k0 = WavenumberForOmega(c.omega_radps, depthForDeep);
+        tr.cg0 = GroupSpeed(tr.k0, depthForDeep);
+        const glm::dvec2 dir{std::sin(c.direction_rad), std::cos(c.direction_rad)};
+        const glm::dvec2 shore = bathy_.Frame().ShoreFromWorldDirection(tr.k0 * dir);
+        tr.ks0 = shore.x;
+        tr.ku = shore.y;
+        tr.incoming = tr.ks0 < 0.0;
+        tr.cos0 = std::abs(tr.ks0) / tr.k0;
+        tr.phaseOrigin = tr.k0 * glm::dot(dir, bathy_.Frame().Origin_m()) + c.phase_rad;
+        tr.k.resize(size_t(depthSamples_));
+        tr.cg.resize(size_t(depthSamples_));
+        for (int i = 0; i < depthSamples_; ++i) {
+            const double h = std::max(i * dh_m_, kMinDepth_m);
+            tr.k[size_t(i)] = WavenumberForOmega(c.omega_radps, h);
+            tr.cg[size_t(i)] = GroupSpeed(tr.k[size_t(i)], h);
+        }
+        // ∫ k_s ds from sRef landward (trapezoids); k_s < 0 for incoming waves.
+        tr.phase.assign(size_t(samples), 0.0);
+        double prev = 0.0;
+        for (int i = 0; i < samples; ++i) {
+            const double h = std::max(profileDepth(sRef_m_ - i * ds_m_), kMinDepth_m);
+            const double k = DepthTable(tr.k, h);
+            const double ks = -std::sqrt(std::max(k * k - tr.ku * tr.ku, 0.0));
+            if (i > 0) tr.phase[size_t(i)] = tr.phase[size_t(i - 1)] - ds_m_ * 0.5 * (prev + ks);
+            prev = ks;
+        }
+    }
+
+    // Mean breaker line: where H_rms of the unbroken shoaled waves reaches γ h on the plane
+    // beach, walking landward; group travel time from it with the dominant component.
+    sBreak_m_ = -std::numeric_limits<double>::infinity();
+    if (components_.empty()) sBreak_m_ = std::numeric_limits<double>::infinity();
+    breakTime_s_.assign(size_t(samples), -1.0);
+    int iBreak = samples;
+    for (int i = 0; i < samples && !components_.empty(); ++i) {
+        const double h = profileDepth(sRef_m_ - i * ds_m_);
+        if (h <= kMinDepth_m) {
+            iBreak = i;
+            break;
+        }
+        double sum = 0.0;
+        for (size_t j = 0; j < components_.size(); ++j) {
+            const Track& tr = tracks_[j];
+            if (!tr.incoming) continue;
+            const double k = DepthTable(tr.k, h), cg = DepthTable(tr.cg, h);
+            const double cosT = std::sqrt(std::max(k * k - tr.ku * tr.ku, 0.0)) / k;
+            const double a = components_[j].amplitude_m * std::sqrt(tr.cg0 / cg) *
+                             std::sqrt(tr.cos0 / std::max(cosT, 1e-3));
+            sum += a * a;
+        }
+        if (2.0 * std::sqrt(sum) >= settings_.breakerIndex * h) {
+            iBreak = i;
+            break;
+        }
+    }
+    if (!components_.empty() && iBreak < samples) {
+        sBreak_m_ = sRef_m_ - iBreak * ds_m_;
+        const Track& tr = tracks_[dominant];
+        double time = 0.0;
+        for (int i = iBreak; i < samples; ++i) {
+            breakTime_s_[size_t(i)] = time;
+            const double h = std::max(profileDepth(sRef_m_ - i * ds_m_), kMinDepth_m);
+            time += ds_m_ / DepthTable(tr.cg, h);
+        }
+        time = 0.0;  // seaward of the line: minus the travel time still to go
+        for (int i = iBreak - 1; i >= 0; --i) {
+            const double h = std::max(profileDepth(sRef_m_ - i * ds_m_), kMinDepth_m);
+            time -= ds_m_ / DepthTable(tr.cg, h);
+            breakTime_s_[size_t(i)] = time;
+        }
+    }
+}
+
+double SurfWaves::DepthTable(const std::vector<double>& t, double h) const {
+    return Interp(t, h / dh_m_);
+}
+
+void SurfWaves::Weights(double depth_m, double& deep, double& surf) const {
+    if (depth_m >= fadeDeep_m_) {
+        deep = 1.0, surf = 0.0;
+    } else if (depth_m <= fadeShallow_m_) {
+        deep = 0.0, surf = 1.0;
+    } else {
+        // Angle from 0 (deep end) to π/2 (shallow end): deep² + surf² = 1 conserves variance.
+        const double a =
+            0.5 * std::numbers::pi * (fadeDeep_m_ - depth_m) / (fadeDeep_m_ - fadeShallow_m_);
+        deep = std::cos(a), surf = std::sin(a);
+    }
+}
+
+SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* info) const {
+    SurfaceTerms out;
+    const ShorePoint p = bathy_.Frame().ShoreFromWorld(x0, y0);
+    const double zBed = bathy_.SeabedZAtShore_m(p.s_m, p.u_m);
+    const double h = bathy_.Tide_m() - zBed;
+    double deep = 1.0, surf = 0.0;
+    Weights(h, deep, surf);
+    SurfPointInfo local;
+    local.depth_m = h;
+    local.seabedZ_m = zBed;
+    local.deepWeight = deep;
+    local.surfWeight = surf;
+    const double tableIndex = (sRef_m_ - p.s_m) / ds_m_;
+    if (!breakTime_s_.empty() && std::isfinite(sBreak_m_)) {
+        local.breaking.broken = p.s_m <= sBreak_m_;
+        local.breaking.timeSinceBreaking_s = Interp(breakTime_s_, tableIndex);
+    }
+    if (surf <= 0.0 || h <= 0.0 || components_.empty()) {
+        if (info) *info = local;
+        return out;
+    }
+
+    const double hh = std::max(h, kMinDepth_m);
+    struct Local {
+        double a, psi, k, kx, ku, tanhKh, omega, cg;
+    };
+    std::array<Local, kMaxSurfComponents> waves;
+    size_t count = 0;
+    std::complex<double> envelope(0.0, 0.0);
+    for (size_t j = 0; j < components_.size(); ++j) {
+        const Track& tr = tracks_[j];
+        if (!tr.incoming) continue;  // waves going out to sea are left to the deep sea (faded)
+        const SurfComponent& c = components_[j];
+        const double k = DepthTable(tr.k, hh), cg = DepthTable(tr.cg, hh);
+        const double kx = -std::sqrt(std::max(k * k - tr.ku * tr.ku, 0.0));
+        const double cosT = std::max(-kx / k, 1e-3);
+        const double a = c.amplitude_m * std::sqrt(tr.cg0 / cg) * std::sqrt(tr.cos0 / cosT);
+        const double crossPhase =
+            p.s_m >= sRef_m_ ? tr.ks0 * p.s_m : tr.ks0 * sRef_m_ + Interp(tr.phase, tableIndex);
+        const double psi = tr.phaseOrigin + tr.ku * p.u_m + crossPhase - c.omega_radps * t;
+        waves[count++] = {a, psi, k, kx, tr.ku, std::tanh(k * hh), c.omega_radps, cg};
+        envelope += a * std::complex<double>(std::cos(psi), std::sin(psi));
+    }
+    const double A = std::abs(envelope);
+    const double gammaH = settings_.breakerIndex * h;
+    const double cap = 2.0 * A > gammaH ? gammaH / (2.0 * A) : 1.0;
+    // Steepening: Q rises from its deep value to 1 (the trochoid's cusp) as the group height
+    // approaches the breaker height.
+    const double q = settings_.deepSteepness + (1.0 - settings_.deepSteepness) *
+                                                   std::min(1.0, 2.0 * A / std::max(gammaH, 1e-9));
+    const double w = surf * cap;
+    double best = -1.0;
+    for (size_t i = 0; i < count; ++i) {
+        const Local& v = waves[i];
+        const double a = v.a * w;
+        // World unit direction of travel from the local shore wavevector.
+        const glm::dvec2 kw = bathy_.Frame().WorldFromShoreDirection({v.kx, v.ku});
+        const glm::dvec2 d = kw / v.k;
+        const double cs = std::cos(v.psi), sn = std::sin(v.psi);
+        const double hor = q * a / v.tanhKh;
+        out.displacement += glm::dvec3(-d.x * hor * sn, -d.y * hor * sn, a * cs);
+        out.sx += -a * sn * kw.x;
+        out.sy += -a * sn * kw.y;
+        out.dxx += -d.x * hor * cs * kw.x;
+        out.dyy += -d.y * hor * cs * kw.y;
+        out.dxy += -d.x * hor * cs * kw.y;
+        out.velocity_mps +=
+            glm::dvec3(d.x * hor * v.omega * cs, d.y * hor * v.omega * cs, a * v.omega * sn);
+        if (v.a > best) {
+            best = v.a;
+            local.direction_rad = std::atan2(d.x, d.y);
+            if (local.direction_rad < 0.0) local.direction_rad += kTwoPi;
+            local.phaseSpeed_mps = v.omega / v.k;
+            local.groupSpeed_mps = v.cg;
+            local.phase_rad = std::fmod(v.psi, kTwoPi);
+            if (local.phase_rad < 0.0) local.phase_rad += kTwoPi;
+        }
+    }
+    local.envelope_m = A * cap;
+    local.unbrokenHeight_m = 2.0 * A;
+    local.breaking.intensity = cap < 1.0 ? 1.0 - cap * cap : 0.0;
+    if (info) *info = local;
+    return out;
+}
+
+}  // namespace seasense::scene

@@ -1,0 +1,129 @@
+// Depth-aware surf waves: a few discrete components carried from deep water over the bathymetry
+// with finite-depth dispersion, shoaling, refraction, depth-limited breaking and the seabed clamp.
+//
+// Design (why a handful of components and a cross-fade). The FFT cascades are periodic patches
+// with one dispersion relation for the whole patch; they cannot slow down, shorten or turn their
+// waves where the water shoals. So the sea is split by depth: in deep water (local depth above
+// fadeDeep = ½ L_p, where tanh(kh) > 0.996 for the peak and shoaling is < 1 %) the surface is
+// exactly the FFT + Gerstner sea of the scenario, bit for bit; below fadeShallow = ¼ L_p it is a
+// sum of discrete components that carry the sea's whole variance (the FFT's mode variance and
+// each Gerstner wave's A²/2) with local-depth physics; in between the two are cross-faded with
+// weights cos and sin of the same angle, so the variance of the sum (the two are independent) is
+// conserved through the fade: Hs does not dip. The short waves of the FFT fade out in shallow
+// water as they do in nature (they break and dissipate first). 12 spectral components spaced in
+// frequency around the peak (0.8–1.6 ω_p) beat against each other: wave groups and surf beat
+// come for free.
+//
+// Each component keeps its frequency ω and (for parallel contours, Snell) its alongshore
+// wavenumber k_u; its local wavenumber follows ω² = g k tanh(k h), its cross-shore wavenumber is
+// k_s = −√(k² − k_u²) and its phase ∫ k_s ds is tabulated along the cross-shore profile of the
+// plane beach; amplitude follows energy-flux conservation A = A0 √(cg0 / cg) √(cos θ0 / cos θ)
+// with the local depth (so a bar raises the crests), and is capped by the depth-limited breaker
+// criterion on the local wave-group envelope: 2|Σ A e^{iψ}| ≤ γ h (McCowan γ = 0.78), which tapers
+// the height to zero at zero depth. Horizontal displacement (Gerstner, Q rising to 1 as the
+// waves near breaking) steepens the fronts.
+#pragma once
+
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <vector>
+
+#include "scene/ocean/surface_terms.h"
+#include "scene/surf/bathymetry.h"
+
+namespace seasense::scene {
+
+// At most this many components (12 spectral + the scenario's 64 Gerstner waves at most).
+inline constexpr size_t kMaxSurfComponents = 80;
+
+// One deep-water wave train that the surf carries shoreward.
+struct SurfComponent {
+    double amplitude_m = 0.0;    // deep-water amplitude
+    double omega_radps = 0.0;    // angular frequency
+    double direction_rad = 0.0;  // deep-water direction of travel, azimuth from north clockwise
+    double phase_rad = 0.0;  // phase at the world origin at t = 0: η = A cos(k·x − ωt + φ)
+};
+
+// The breaking state at a point and instant.
+struct SurfBreaking {
+    // Fraction of the local wave energy lost to depth-limited breaking right now: 1 − (γh / 2A)²
+    // where the local envelope height 2A exceeds γh, else 0; A is the wave-group envelope.
+    double intensity = 0.0;
+    // Whether the point lies shoreward of the mean breaker line (where H_rms of the unbroken
+    // waves reaches γ h on the plane beach), and the group travel time from that line (s): foam
+    // left by broken waves is that old at most. Negative seaward of the line.
+    bool broken = false;
+    double timeSinceBreaking_s = -1.0;
+};
+
+// What the surf adds at a rest position, beside the terms.
+struct SurfPointInfo {
+    double depth_m = 0.0;     // still-water depth (tide − seabed), negative on land
+    double seabedZ_m = 0.0;   // ENU z of the seabed
+    double deepWeight = 1.0;  // weight of the FFT + Gerstner sea (cos of the fade angle)
+    double surfWeight = 0.0;  // weight of the surf components (sin of it)
+    double envelope_m = 0.0;  // local wave-group envelope amplitude |Σ A e^{iψ}| (saturated)
+    double unbrokenHeight_m = 0.0;  // 2 × envelope before the breaker cap
+    SurfBreaking breaking;
+    // The dominant (largest local amplitude) component: direction of travel (azimuth), phase
+    // speed and group speed at the local depth, its phase (rad, in [0, 2π)).
+    double direction_rad = 0.0;
+    double phaseSpeed_mps = 0.0;
+    double groupSpeed_mps = 0.0;
+    double phase_rad = 0.0;
+};
+
+struct SurfWaveSettings {
+    double breakerIndex = 0.78;  // McCowan (1894): H_b / h_b
+    double deepSteepness = 0.5;  // Gerstner Q of the surf components in deep water
+};
+
+// Immutable after construction; pure and thread-safe.
+class SurfWaves {
+  public:
+    // peakWavelength_m sets the fade depths (¼ and ½ of it).
+    SurfWaves(const Bathymetry& bathymetry, std::vector<SurfComponent> components,
+              double peakWavelength_m, const SurfWaveSettings& settings = {});
+
+    const Bathymetry& Bathy() const { return bathy_; }
+    const std::vector<SurfComponent>& Components() const { return components_; }
+    double FadeDeep_m() const { return fadeDeep_m_; }
+    double FadeShallow_m() const { return fadeShallow_m_; }
+    double BreakerIndex() const { return settings_.breakerIndex; }
+
+    // Deep/surf weights at a still-water depth h (m).
+    void Weights(double depth_m, double& deep, double& surf) const;
+
+    // The surf components' terms at rest position (x0, y0), time t (already weighted by the surf
+    // weight), and the point's information. Velocity is included.
+    SurfaceTerms Terms(double x0, double y0, double t_s, SurfPointInfo* info = nullptr) const;
+
+    // Mean breaker line (cross-shore s, m) of the plane beach: +∞ if no component, −∞ if the waves
+    // never break before the shore.
+    double BreakerLine_m() const { return sBreak_m_; }
+
+  private:
+    struct Track {                             // per component
+        double k0 = 0.0, ks0 = 0.0, ku = 0.0;  // deep wavenumber and its shore components
+        double cg0 = 0.0, cos0 = 1.0;
+        double phaseOrigin = 0.0;  // k0 · shoreline origin + φ
+        bool incoming = false;
+        std::vector<double> phase;  // ∫ k_s ds from sRef_m_ at s = sRef − i ds
+        std::vector<double> k;      // k at depth index (h = i dh)
+        std::vector<double> cg;     // group speed at depth index
+    };
+    double DepthTable(const std::vector<double>& t, double h) const;
+
+    Bathymetry bathy_;
+    std::vector<SurfComponent> components_;
+    SurfWaveSettings settings_;
+    double fadeDeep_m_ = 0.0, fadeShallow_m_ = 0.0;
+    double sRef_m_ = 0.0, sShore_m_ = 0.0, ds_m_ = 0.5;
+    double dh_m_ = 0.02;
+    int depthSamples_ = 0;
+    std::vector<Track> tracks_;
+    double sBreak_m_ = 0.0;
+    std::vector<double> breakTime_s_;  // group travel time from the breaker line, per s sample
+};
+
+}  // namespace seasense::scene

@@ -1,0 +1,200 @@
+// Surf waves against linear wave theory computed here independently: phase speed at 2 m depth,
+// shoaling by energy-flux conservation and Green's law, Snell refraction, McCowan breaking onset;
+// the surface never below the seabed over 1000 frames, and deep water untouched.
+#include "scene/surf/surf_waves.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "scene/ocean/ocean_surface.h"
+
+namespace seasense::scene {
+namespace {
+
+constexpr double kG = 9.80665;
+constexpr double kPi = std::numbers::pi;
+
+// k from ω² = g k tanh(k h) by bisection (independent of the library's solver).
+double K(double omega, double h) {
+    double lo = 1e-8, hi = 1e3;
+    for (int i = 0; i < 200; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        (kG * mid * std::tanh(mid * h) < omega * omega ? lo : hi) = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+double Cg(double omega, double h) {
+    const double k = K(omega, h);
+    return 0.5 * omega / k * (1.0 + 2.0 * k * h / std::sinh(2.0 * k * h));
+}
+
+// Shoreline running north at x = 0 (sea to the east), all zones at one slope, or a flat shelf.
+SurfSettings Beach(double slope) {
+    SurfSettings s;
+    s.lowTide_m = -1.0;
+    s.highTide_m = 1.0;
+    s.intertidal = {slope, 0.0};
+    s.supralittoral = {slope, 50.0};
+    s.sublittoral = {slope, 400.0};
+    s.offshoreSlope = slope;
+    return s;
+}
+
+SurfComponent Wave(double amplitude, double period, double direction_deg) {
+    return {amplitude, 2.0 * kPi / period, direction_deg * kPi / 180.0, 0.3};
+}
+
+// Height (max − min of η) at rest point (x, 0) over one period, 200 samples.
+double Height(const SurfWaves& w, double x, double period, double y = 0.0) {
+    double lo = 1e9, hi = -1e9;
+    for (int i = 0; i < 200; ++i) {
+        const double z = w.Terms(x, y, period * i / 200.0).displacement.z;
+        lo = std::min(lo, z), hi = std::max(hi, z);
+    }
+    return hi - lo;
+}
+
+// x of the beach (slope, still-water line at 0, tide 0) where the depth is h.
+double XAtDepth(double slope, double h) { return h / slope; }
+
+TEST(SurfWaves, PhaseSpeedAtTwoMetresFollowsFiniteDepthDispersion) {
+    SurfSettings s = Beach(0.05);
+    s.lowTide_m = -2.0;  // a flat shelf 2 m deep from x = 40 m out to 2040 m
+    s.sublittoral = {0.0, 2000.0};
+    const Bathymetry b(s, 10.0);
+    const double period = 8.0, omega = 2.0 * kPi / period;
+    const SurfWaves w(b, {Wave(0.05, period, 270.0)}, 100.0);  // travelling west, to the shore
+    // A zero up-crossing of η along x near x = 600 at t and t + dt; the crest pattern moves west.
+    auto crossing = [&](double t) {
+        double x = 600.0, prev = w.Terms(x, 0.0, t).displacement.z;
+        for (; x > 500.0; x -= 0.01) {
+            const double z = w.Terms(x - 0.01, 0.0, t).displacement.z;
+            if (prev < 0.0 && z >= 0.0) return x - 0.01 * prev / (prev - z);
+            prev = z;
+        }
+        return std::nan("");
+    };
+    const double dt = 0.5;
+    const double c = (crossing(0.0) - crossing(dt)) / dt;
+    const double k = K(omega, 2.0);
+    EXPECT_NEAR(c, std::sqrt(kG / k * std::tanh(k * 2.0)), 0.01 * c);
+}
+
+TEST(SurfWaves, ShoalingConservesEnergyFluxAndFollowsGreensLaw) {
+    const double slope = 0.02, period = 10.0, omega = 2.0 * kPi / period, a0 = 0.03;
+    const Bathymetry b(Beach(slope), 30.0);
+    const SurfWaves w(b, {Wave(a0, period, 270.0)}, 156.0);
+    const double cg0 = Cg(omega, 30.0);
+    for (const double h : {12.0, 8.0, 4.0, 2.0, 1.0}) {
+        const double expected = 2.0 * a0 * std::sqrt(cg0 / Cg(omega, h));
+        EXPECT_NEAR(Height(w, XAtDepth(slope, h), period), expected, 0.03 * expected) << h;
+    }
+    // Green's law in shallow water: H ∝ h^(−1/4).
+    const double h1 = Height(w, XAtDepth(slope, 0.8), period);
+    const double h2 = Height(w, XAtDepth(slope, 0.4), period);
+    EXPECT_NEAR(h2 / h1, std::pow(0.5, -0.25), 0.03 * std::pow(0.5, -0.25));
+}
+
+TEST(SurfWaves, RefractionFollowsSnellsLaw) {
+    const double slope = 0.02, period = 9.0, omega = 2.0 * kPi / period;
+    const Bathymetry b(Beach(slope), 40.0);
+    // 35° off the shore normal (travelling west-south-west).
+    const SurfWaves w(b, {Wave(0.05, period, 270.0 - 35.0)}, 126.0);
+    const double c0 = omega / K(omega, 40.0);
+    for (const double h : {10.0, 5.0, 2.0}) {
+        SurfPointInfo info;
+        w.Terms(XAtDepth(slope, h), 0.0, 0.0, &info);
+        const double c = omega / K(omega, h);
+        const double theta = std::asin(std::sin(35.0 * kPi / 180.0) * c / c0);
+        // Direction of travel from north: 270° − θ for a wave turned θ off the westward normal.
+        const double expected = 270.0 - theta * 180.0 / kPi;
+        EXPECT_NEAR(info.direction_rad * 180.0 / kPi, expected, 0.5) << h;
+    }
+}
+
+TEST(SurfWaves, BreakingStartsWhereHeightReachesMcCowansIndex) {
+    const double slope = 0.02, period = 8.0;
+    const Bathymetry b(Beach(slope), 30.0);
+    const SurfWaves w(b, {Wave(0.5, period, 270.0)}, 100.0);
+    // Walk shoreward until the breaking intensity first rises; the unbroken height there is
+    // the surface's height just seaward of that point.
+    double xBreak = -1.0;
+    for (double x = 600.0; x > 1.0; x -= 0.25) {
+        SurfPointInfo info;
+        w.Terms(x, 0.0, 0.0, &info);
+        if (info.breaking.intensity > 0.0) {
+            xBreak = x + 0.25;
+            break;
+        }
+    }
+    ASSERT_GT(xBreak, 0.0);
+    const double h = slope * xBreak;
+    EXPECT_NEAR(Height(w, xBreak, period) / h, 0.78, 0.05);
+    // Shoreward of the break the height is saturated at γ h and tapers to zero with the depth.
+    for (const double hs : {1.0, 0.5, 0.1, 0.02})
+        EXPECT_NEAR(Height(w, XAtDepth(slope, hs), period), 0.78 * hs, 0.03 * 0.78 * hs) << hs;
+}
+
+OceanSettings SpectralBeach(bool surf) {
+    OceanSettings o;
+    o.depth_m = 80.0;
+    SpectralOceanSettings sp;
+    sp.sea.spectrum.windSpeed_mps = 10.0;
+    sp.sea.spectrum.windDirection_rad = 250.0 * kPi / 180.0;
+    sp.fft.gridSize = 64;
+    sp.fft.seed = 7;
+    o.spectral = sp;
+    if (surf) {
+        SurfSettings s = Beach(0.03);
+        s.tide_m = 0.0;
+        SurfRegionSettings r;
+        r.width_m = 300.0;
+        r.sandbar = SandbarSettings{20.0, 150.0, 1.0, 80.0, 15.0};
+        s.regions = {r};
+        o.surf = s;
+    }
+    return o;
+}
+
+TEST(SurfWaves, SurfaceNeverBelowTheSeabedAndTapersToZeroDepth) {
+    const OceanSurface sea(SpectralBeach(true));
+    ASSERT_NE(sea.Surf(), nullptr);
+    const Bathymetry& b = sea.Surf()->Bathy();
+    double worst = 1e9;
+    for (int f = 0; f < 1000; ++f) {
+        const auto frame = sea.At(f / 30.0);
+        for (double x = -20.0; x < 400.0; x += 2.1) {
+            for (const double y : {0.0, 150.0}) {
+                const SurfaceTerms t = frame->Terms(x, y);
+                const double zBed = b.SeabedZ_m(x + t.displacement.x, y + t.displacement.y);
+                worst = std::min(worst, t.displacement.z - zBed);
+                const double h = b.Depth_m(x, y);
+                if (h > 0.0 && h < 0.2) {  // crests capped at γ h / 2 (+ the clamp)
+                    EXPECT_LE(std::abs(t.displacement.z), 0.39 * h + 1e-9) << x;
+                }
+            }
+        }
+    }
+    EXPECT_GE(worst, -1e-9);
+}
+
+TEST(SurfWaves, DeepWaterIsTheSeaWithoutSurf) {
+    const OceanSurface plain(SpectralBeach(false)), surf(SpectralBeach(true));
+    const double fadeDeep = surf.Surf()->FadeDeep_m();
+    const Bathymetry& b = surf.Surf()->Bathy();
+    const auto a = plain.At(12.5), c = surf.At(12.5);
+    int checked = 0;
+    for (double x = 0.0; x < 5000.0; x += 37.0) {
+        if (b.Depth_m(x, 0.0) < fadeDeep + 1.0) continue;
+        const SurfaceTerms p = a->Terms(x, 10.0), q = c->Terms(x, 10.0);
+        EXPECT_EQ(p.displacement.z, q.displacement.z);
+        EXPECT_EQ(p.displacement.x, q.displacement.x);
+        ++checked;
+    }
+    EXPECT_GT(checked, 10);
+}
+
+}  // namespace
+}  // namespace seasense::scene
