@@ -8,9 +8,37 @@
 
 namespace seasense::channels {
 
-FlashLight DrawLightning(const ChannelCamera& cam, const VisibilityBuffer& vis,
-                         const scene::Lightning& lightning, double t0_s, double t1_s, double beta,
-                         Image& radiance) {
+LitFlashes FindLitFlashes(const scene::Lightning& lightning, double t0_s, double t1_s) {
+    LitFlashes lit;
+    lit.t0_s = t0_s;
+    lit.t1_s = t1_s;
+    lit.flashes = lightning.FlashesBetween(t0_s, t1_s);
+    lit.bolts.reserve(lit.flashes.size());
+    for (const scene::Flash& flash : lit.flashes) lit.bolts.push_back(lightning.GrowBolt(flash));
+    return lit;
+}
+
+FlashLight FlashLightAt(const scene::Lightning& lightning, const LitFlashes& lit,
+                        const glm::dvec3& point_m, double beta) {
+    FlashLight light;
+    glm::dvec3 weighted(0.0);
+    for (size_t i = 0; i < lit.flashes.size(); ++i) {
+        const scene::Flash& flash = lit.flashes[i];
+        const scene::Bolt& bolt = lit.bolts[i];
+        const double e =
+            lightning.MeanIlluminance_lux(flash, bolt, point_m, lit.t0_s, lit.t1_s, beta);
+        if (e <= 0.0) continue;
+        ++light.flashes;
+        light.illuminance_lux += e;
+        weighted += e * glm::normalize(0.5 * (flash.root_m + bolt.strike_m) - point_m);
+    }
+    if (light.illuminance_lux > 0.0) light.direction = glm::normalize(weighted);
+    return light;
+}
+
+void DrawLightning(const ChannelCamera& cam, const VisibilityBuffer& vis,
+                   const scene::Lightning& lightning, const LitFlashes& lit, double beta,
+                   Image& radiance) {
     const int sw = cam.SampleWidth(), sh = cam.SampleHeight();
     CHECK(radiance.width == sw && radiance.height == sh && radiance.channels == 3);
     CHECK(vis.width == sw && vis.height == sh);
@@ -23,15 +51,10 @@ FlashLight DrawLightning(const ChannelCamera& cam, const VisibilityBuffer& vis,
         sy = 0.5 * (1.0 - b.z / b.y / tanV) * sh;
     };
 
-    FlashLight light;
-    glm::dvec3 weighted(0.0);
-    for (const scene::Flash& flash : lightning.FlashesBetween(t0_s, t1_s)) {
-        const scene::Bolt bolt = lightning.GrowBolt(flash);
-        const double e = lightning.MeanIlluminance_lux(flash, bolt, eye, t0_s, t1_s, beta);
-        if (e <= 0.0) continue;
-        ++light.flashes;
-        light.illuminance_lux += e;
-        weighted += e * glm::normalize(0.5 * (flash.root_m + bolt.strike_m) - eye);
+    const double t0_s = lit.t0_s, t1_s = lit.t1_s;
+    for (size_t i = 0; i < lit.flashes.size(); ++i) {
+        const scene::Flash& flash = lit.flashes[i];
+        const scene::Bolt& bolt = lit.bolts[i];
         for (const scene::BoltSegment& seg : bolt.segments) {
             const double intensity =
                 lightning.MeanSegmentIntensity_cdPerM(flash, bolt, seg, t0_s, t1_s);
@@ -65,8 +88,6 @@ FlashLight DrawLightning(const ChannelCamera& cam, const VisibilityBuffer& vis,
             }
         }
     }
-    if (light.illuminance_lux > 0.0) light.direction = glm::normalize(weighted);
-    return light;
 }
 
 }  // namespace seasense::channels

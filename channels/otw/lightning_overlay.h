@@ -3,6 +3,7 @@
 #pragma once
 
 #include <glm/glm.hpp>
+#include <vector>
 
 #include "channels/camera/channel_camera.h"
 #include "channels/raster/rasterizer.h"
@@ -18,15 +19,26 @@ struct FlashLight {
     int flashes = 0;                      // flashes lit in the window
 };
 
-// Draws every flash lit during [t0_s, t1_s] (simulation seconds; the frame's exposure) into the
-// supersampled radiance image (rgb cd/m², white: equal components). The channel is optically
-// thin, so each element dl radiates isotropically with intensity I_l dl
-// (Lightning::MeanSegmentIntensity_cdPerM): it adds I_l dl exp(−β d) / (d² Ω) to the sample it
-// projects into, Ω that sample's solid angle, unless the visibility buffer holds something
-// nearer there. Elements are at most half a sample apart on screen. Returns the flash light at
-// the eye with the same extinction (Lightning::MeanIlluminance_lux).
-FlashLight DrawLightning(const ChannelCamera& camera, const VisibilityBuffer& vis,
-                         const scene::Lightning& lightning, double t0_s, double t1_s,
-                         double extinction_perM, Image& radiance);
+// The flashes lit during a frame's exposure [t0_s, t1_s] (simulation seconds) with their bolts.
+struct LitFlashes {
+    double t0_s = 0.0, t1_s = 0.0;
+    std::vector<scene::Flash> flashes;
+    std::vector<scene::Bolt> bolts;  // bolts[i] grown from flashes[i]
+};
+LitFlashes FindLitFlashes(const scene::Lightning& lightning, double t0_s, double t1_s);
+
+// The flash light at point_m (ENU m) over the exposure: Lightning::MeanIlluminance_lux summed
+// over the lit flashes, with extinction_perM (1/m) along each path.
+FlashLight FlashLightAt(const scene::Lightning& lightning, const LitFlashes& lit,
+                        const glm::dvec3& point_m, double extinction_perM);
+
+// Draws the lit flashes into the supersampled radiance image (rgb cd/m², white: equal
+// components). The channel is optically thin, so each element dl radiates isotropically with
+// intensity I_l dl (Lightning::MeanSegmentIntensity_cdPerM): it adds I_l dl exp(−β d) / (d² Ω)
+// to the sample it projects into, Ω that sample's solid angle, unless the visibility buffer
+// holds something nearer there. Elements are at most half a sample apart on screen.
+void DrawLightning(const ChannelCamera& camera, const VisibilityBuffer& vis,
+                   const scene::Lightning& lightning, const LitFlashes& lit, double extinction_perM,
+                   Image& radiance);
 
 }  // namespace seasense::channels

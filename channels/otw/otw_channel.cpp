@@ -123,6 +123,13 @@ glm::vec3 ShadowRayOrigin(const glm::vec3& p, const glm::vec3& n) {
 // display step; at the five-channel run's time scale (10) the table is rebuilt every ~7 frames.
 constexpr double kSkySunStep_rad = 0.01 * M_PI / 180.0;
 
+// A distant light: unit direction toward it (ENU) and its illuminance on a surface normal to
+// that direction (lx, Rec.709 RGB).
+struct DirectionalLight {
+    glm::vec3 dir{0.0f, 0.0f, 1.0f};
+    glm::vec3 E{0.0f};
+};
+
 // Samples per shading chunk: the chunk's arrays stay in L1.
 constexpr size_t kChunk = 256;
 
@@ -138,10 +145,10 @@ struct SeaChunk {
     alignas(16) float outR[kChunk], outG[kChunk], outB[kChunk];
 };
 
-// Sea radiance: Fresnel-weighted sky reflection plus water-leaving radiance, Cox–Munk sun
-// glint, Koschmieder fog; the constants of one frame.
+// Sea radiance: Fresnel-weighted sky reflection plus water-leaving radiance, Cox–Munk glint of
+// the key light (sun or moon), Koschmieder fog; the constants of one frame.
 struct SeaShading {
-    glm::vec3 eye, sunDir, sunE, downwelling;
+    glm::vec3 eye, keyDir, keyE, downwelling;
     float beta, slopeVar;
     const radiometry::FresnelTable& fresnel;
     const radiometry::AnalyticSky& sky;
@@ -176,9 +183,9 @@ struct SeaShading {
             _mm_store_ps(ch.range + i, range);
             _mm_store_ps(ch.cosV + i, Max4(ndv, Set4(1e-3f)));
             _mm_store_ps(ch.cosS + i,
-                         Dot4(Nx, Ny, Nz, Set4(sunDir.x), Set4(sunDir.y), Set4(sunDir.z)));
-            const F4 wx = _mm_add_ps(vx, Set4(sunDir.x)), wy = _mm_add_ps(vy, Set4(sunDir.y)),
-                     wz = _mm_add_ps(vz, Set4(sunDir.z));
+                         Dot4(Nx, Ny, Nz, Set4(keyDir.x), Set4(keyDir.y), Set4(keyDir.z)));
+            const F4 wx = _mm_add_ps(vx, Set4(keyDir.x)), wy = _mm_add_ps(vy, Set4(keyDir.y)),
+                     wz = _mm_add_ps(vz, Set4(keyDir.z));
             const F4 inv = _mm_div_ps(Set4(1.0f), _mm_sqrt_ps(Dot4(wx, wy, wz, wx, wy, wz)));
             const F4 hx = _mm_mul_ps(wx, inv), hy = _mm_mul_ps(wy, inv), hz = _mm_mul_ps(wz, inv);
             const F4 cosB = Max4(Dot4(hx, hy, hz, Nx, Ny, Nz), Set4(1e-3f));
@@ -224,9 +231,9 @@ struct SeaShading {
                 L = _mm_add_ps(_mm_mul_ps(L, t), _mm_mul_ps(_mm_load_ps(horC + i), oneMinusT));
                 _mm_store_ps(outC + i, L);
             };
-            channel(ch.skyR, ch.horR, kSeaRrs.r, downwelling.r, sunE.r, ch.outR);
-            channel(ch.skyG, ch.horG, kSeaRrs.g, downwelling.g, sunE.g, ch.outG);
-            channel(ch.skyB, ch.horB, kSeaRrs.b, downwelling.b, sunE.b, ch.outB);
+            channel(ch.skyR, ch.horR, kSeaRrs.r, downwelling.r, keyE.r, ch.outR);
+            channel(ch.skyG, ch.horG, kSeaRrs.g, downwelling.g, keyE.g, ch.outG);
+            channel(ch.skyB, ch.horB, kSeaRrs.b, downwelling.b, keyE.b, ch.outB);
         }
     }
 };
@@ -384,7 +391,10 @@ void Interpolate(const CachedTriangle& tri, float b1, float b2, F4& p, F4& nSum)
 
 // One frame's lighting and shading constants.
 struct FrameShading {
-    glm::vec3 eye, sunDir, sunE, sunL, skyE, downwelling;
+    // The sun (its disc), the key light (the brighter of sun and moon: shadowed, glints), the
+    // fill lights (the dimmer body and lightning flashes: unshadowed) and the sky.
+    glm::vec3 eye, sunDir, sunL, keyDir, keyE, skyE, downwelling;
+    std::vector<DirectionalLight> fill;
     F4 eye4;  // eye as (x, y, z, 0)
     float cosSunRadius;
     // A pixel whose centre ray is farther than the sun's radius plus the pixel's half diagonal
@@ -591,7 +601,7 @@ class BlockClassifier {
         const glm::vec3 nrm(sc_.seaNx[e], sc_.seaNy[e], sc_.seaNz[e]);
         for (int s = 0; s < count; ++s) {
             const glm::vec3 origin = ShadowRayOrigin(Store3(samples[s]), nrm);
-            if (f_.casters.MayHit(origin) && f_.occlusion.MayOcclude(origin, f_.sunDir, 1e30f)) {
+            if (f_.casters.MayHit(origin) && f_.occlusion.MayOcclude(origin, f_.keyDir, 1e30f)) {
                 sc_.origins.push_back(origin);
                 sc_.originOwner.push_back(kSeaOwner | uint32_t(e));
             }
@@ -626,7 +636,7 @@ class BlockClassifier {
         sc_.modelLit.push_back(1);
         if (tri.shadowable) {
             const glm::vec3 o = ShadowRayOrigin(position, nrm);
-            if (f_.casters.MayHit(o) && f_.occlusion.MayOcclude(o, f_.sunDir, 1e30f)) {
+            if (f_.casters.MayHit(o) && f_.occlusion.MayOcclude(o, f_.keyDir, 1e30f)) {
                 sc_.origins.push_back(o);
                 sc_.originOwner.push_back(uint32_t(e));
             }
@@ -650,7 +660,7 @@ class BlockClassifier {
 uint64_t TraceSunVisibility(const FrameShading& f, int n, BlockScratch& sc) {
     if (sc.origins.empty()) return 0;
     sc.vis.resize(sc.origins.size());
-    f.occlusion.DirectionalVisibility(sc.origins, f.sunDir, 0.0f, sc.vis);
+    f.occlusion.DirectionalVisibility(sc.origins, f.keyDir, 0.0f, sc.vis);
     for (size_t r = 0; r < sc.origins.size(); ++r) {
         const uint32_t owner = sc.originOwner[r];
         if (owner & kSeaOwner)
@@ -710,8 +720,8 @@ void ShadeSea(const FrameShading& f, const FrameGeometry& g, BlockScratch& sc, f
     }
 }
 
-// Model radiance, sample by sample (a small fraction of the frame): Lambertian under sun
-// (shadowed), sky and light reflected by the sea; Koschmieder fog.
+// Model radiance, sample by sample (a small fraction of the frame): Lambertian under the key
+// light (shadowed), the fill lights, sky and light reflected by the sea; Koschmieder fog.
 void ShadeModels(const FrameShading& f, const FrameGeometry& g, const BlockScratch& sc,
                  float* out) {
     for (size_t i = 0; i < sc.modelK.size(); ++i) {
@@ -721,9 +731,10 @@ void ShadeModels(const FrameShading& f, const FrameGeometry& g, const BlockScrat
         const glm::vec3 v = toEye / range;
         const float sunVis = float(sc.modelLit[i]);
         const glm::vec3 rho(f.reflectance[size_t(sc.modelMesh[i]) - 1]);
-        const glm::vec3 E = f.sunE * std::max(glm::dot(nrm, f.sunDir), 0.0f) * sunVis +
-                            f.skyE * (0.5f * (1.0f + nrm.z)) +
-                            kSeaAlbedo * f.downwelling * (0.5f * (1.0f - nrm.z));
+        glm::vec3 E = f.keyE * std::max(glm::dot(nrm, f.keyDir), 0.0f) * sunVis +
+                      f.skyE * (0.5f * (1.0f + nrm.z)) +
+                      kSeaAlbedo * f.downwelling * (0.5f * (1.0f - nrm.z));
+        for (const DirectionalLight& l : f.fill) E += l.E * std::max(glm::dot(nrm, l.dir), 0.0f);
         glm::vec3 L = rho * E * float(1.0 / M_PI);
         // Koschmieder: the horizon sky is the airlight a long path converges to.
         const float t = std::exp(-f.beta * range);
@@ -801,13 +812,41 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     const glm::vec3 sunDir(state.sun.direction);
     const glm::dvec3 sunIlluminance =
         radiometry::SunIlluminanceRgb(state.sun.direction, state.sun.illuminance_lux);
-    const glm::vec3 sunE(sunIlluminance);
-    const glm::vec3 skyE(sky.HorizontalSkyIlluminance());
-    // Downwelling irradiance on the sea surface (lx): direct sun on a level surface plus sky.
-    const glm::vec3 downwelling = sunE * std::max(sunDir.z, 0.0f) + skyE;
     const float beta = float(ExtinctionFromVisibility(env.visibility_m));
-    static const radiometry::FresnelTable fresnel(radiometry::kSeaWaterIndexVisible);
     const glm::vec3 eye(cam.worldFromCamera.position_m);
+
+    // Direct light: the brighter of sun and moon is the key light (shadows, glint); the dimmer
+    // one is a fill light without shadow or glint — by day the moon is 1e-6 of the sun, and
+    // once the sun is down its direct light is 0, so the key light is always the one that
+    // matters. The moon's light is given the sun's colour; the moon is in fact redder (B−V 0.92
+    // against the sun's 0.65, Allen's Astrophysical Quantities), so moonlit blue is about 20 %
+    // too strong against green here.
+    const DirectionalLight sunLight{sunDir, glm::vec3(sunIlluminance)};
+    const DirectionalLight moonLight{
+        glm::vec3(state.moon.direction),
+        glm::vec3(radiometry::SunIlluminanceRgb(state.moon.direction, state.moon.illuminance_lux))};
+    const bool moonKey = moonLight.E.g > sunLight.E.g;
+    const DirectionalLight& key = moonKey ? moonLight : sunLight;
+    std::vector<DirectionalLight> fill;
+    if (const DirectionalLight& dim = moonKey ? sunLight : moonLight; dim.E.g > 0.0f)
+        fill.push_back(dim);
+    // Lightning lit during the frame's exposure (one frame period of scene time ending at this
+    // frame's instant): its light at the eye lights the scene as one more fill light, from the
+    // illuminance-weighted direction of the bolts (channels/otw/lightning_overlay).
+    const scene::Lightning* lightning = world_.GetLightning();
+    const double exposure_s = sc.world.timeScale / sc.world.frameRate_hz;
+    LitFlashes flashes;
+    if (lightning) {
+        flashes = FindLitFlashes(*lightning, state.time_s - exposure_s, state.time_s);
+        const FlashLight flash = FlashLightAt(*lightning, flashes, glm::dvec3(eye), beta);
+        if (flash.illuminance_lux > 0.0)
+            fill.push_back({glm::vec3(flash.direction), glm::vec3(float(flash.illuminance_lux))});
+    }
+    const glm::vec3 skyE(sky.HorizontalSkyIlluminance());
+    // Downwelling irradiance on the sea surface (lx): direct light on a level surface plus sky.
+    glm::vec3 downwelling = key.E * std::max(key.dir.z, 0.0f) + skyE;
+    for (const DirectionalLight& l : fill) downwelling += l.E * std::max(l.dir.z, 0.0f);
+    static const radiometry::FresnelTable fresnel(radiometry::kSeaWaterIndexVisible);
 
     FrameGeometry g{vis,
                     {},
@@ -831,19 +870,21 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     const double pixelTan = n * (2.0 * g.tanH / sw + 2.0 * g.tanV / sh);
     const FrameShading f{eye,
                          sunDir,
-                         sunE,
                          glm::vec3(sunIlluminance / radiometry::SunDiscSolidAngle_sr()),
+                         key.dir,
+                         key.E,
                          skyE,
                          downwelling,
+                         fill,
                          Load3(eye),
                          float(std::cos(radiometry::kSunAngularRadius_rad)),
                          float(std::cos(radiometry::kSunAngularRadius_rad + pixelTan)),
                          beta,
-                         settings_.shadows && !occlusion.Empty() && sunDir.z > 0.0f,
+                         settings_.shadows && !occlusion.Empty() && key.dir.z > 0.0f,
                          sky,
                          occlusion,
-                         RayBoxTest(geometry_.CasterMin(), geometry_.CasterMax(), sunDir),
-                         SeaShading{eye, sunDir, sunE, downwelling, beta,
+                         RayBoxTest(geometry_.CasterMin(), geometry_.CasterMax(), key.dir),
+                         SeaShading{eye, key.dir, key.E, downwelling, beta,
                                     CoxMunkSlopeVariance(env.windSpeed_mps), fresnel, sky},
                          reflectance_};
 
@@ -883,12 +924,7 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     observer.height_m = state.eyepoint.position_m.z;
     AddMoonAndStars(cam, vis, MakeMoonDisc(state.moon, state.sun),
                     scene::VisibleStars(stars_, state.utc, observer), radiance);
-    if (const scene::Lightning* lightning = world_.GetLightning()) {
-        // The frame's exposure: one frame period of scene time ending at this frame's instant.
-        const double exposure_s = sc.world.timeScale / sc.world.frameRate_hz;
-        DrawLightning(cam, vis, *lightning, state.time_s - exposure_s, state.time_s, beta,
-                      radiance);
-    }
+    if (lightning) DrawLightning(cam, vis, *lightning, flashes, beta, radiance);
 
     // Plumes (channels/plume) over the finished radiance.
     plumes_->CompositeOtw(state, cam, vis, sky, radiance);

@@ -80,8 +80,7 @@ sensors::ImageMetadata FrameMetadata(const scene::World& world, const scene::Cha
     if (ch.kind == scene::ChannelKind::Otw) {
         md.Set("seasense:units", std::string("cd/m^2 (linear Rec.709 D65 RGB; Y = luminance)"));
         md.Set("seasense:exposure_ev", float(ev));
-        md.Set("seasense:exposure_mode",
-               std::string(ch.exposure.mode == scene::ExposureMode::Auto ? "auto" : "manual"));
+        md.Set("seasense:exposure_mode", std::string(ToString(ch.exposure.mode)));
         md.Set("seasense:ocio_view", ch.ocioView);
         md.Set("oiio:ColorSpace", std::string("Linear Rec.709 (sRGB)"));
     }
@@ -176,9 +175,17 @@ FrameRecord ChannelPipeline::Render(const scene::FrameState& frame) {
 
     t0 = std::chrono::steady_clock::now();
     sensors::IntegrateFootprint(samples_, channel_.supersampling, pixels_);
-    ev_ = channel_.exposure.mode == scene::ExposureMode::Auto
-              ? sensors::AutoExposureEv(pixels_, channel_.exposure.keyValue)
-              : channel_.exposure.ev;
+    switch (channel_.exposure.mode) {
+        case scene::ExposureMode::Auto:
+            ev_ = sensors::AutoExposureEv(pixels_, channel_.exposure.keyValue);
+            break;
+        case scene::ExposureMode::Adapted:
+            ev_ = sensors::AdaptedExposureEv(pixels_);
+            break;
+        case scene::ExposureMode::Manual:
+            ev_ = channel_.exposure.ev;
+            break;
+    }
     rec.exposureEv = ev_;
     displayValid_ = false;
     rec.sensorMs = MsSince(t0);

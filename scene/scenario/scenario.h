@@ -112,12 +112,18 @@ enum class ChannelKind { Otw, Flir, Nvg };
 // Spectral band of an infrared (flir) channel.
 enum class InfraredBand { Lwir, Mwir };
 
-enum class ExposureMode { Manual, Auto };
+enum class ExposureMode { Manual, Auto, Adapted };
+inline const char* ToString(ExposureMode mode) {
+    return mode == ExposureMode::Manual ? "manual"
+           : mode == ExposureMode::Auto ? "auto"
+                                        : "adapted";
+}
 
 struct ExposureSettings {
     ExposureMode mode = ExposureMode::Auto;
     // Manual: display value = scene-linear × 2^ev. Auto: ev chosen so that the frame's
-    // log-average luminance maps to keyValue (Reinhard et al. 2002 key).
+    // log-average luminance maps to keyValue (Reinhard et al. 2002 key). Adapted: the key
+    // follows the log-average luminance (sensors::AdaptedKey), so dim scenes display dim.
     double ev = 0.0;
     double keyValue = 0.18;
 };

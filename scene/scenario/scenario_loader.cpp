@@ -32,7 +32,7 @@ constexpr size_t kMaxEntities = 100000;
 const std::vector<std::string> kChannelKinds = {"otw", "flir", "nvg"};
 // In the order of InfraredBand.
 const std::vector<std::string> kInfraredBands = {"lwir", "mwir"};
-const std::vector<std::string> kExposureModes = {"auto", "manual"};
+const std::vector<std::string> kExposureModes = {"auto", "manual", "adapted"};
 const std::vector<std::string> kOutputFormats = {"exr", "png", "tiff"};
 // Flir channels also write the imager's 16-bit raw ADC counts.
 const std::vector<std::string> kFlirOutputFormats = {"exr", "png", "tiff", "raw_png", "raw_tiff"};
@@ -269,9 +269,11 @@ ExposureSettings ReadExposure(const ConfigValue& value) {
         if (kExposureModes[mode] == "auto") {
             exposure.mode = ExposureMode::Auto;
             exposure.keyValue = x.GetDouble("key", NumberRange::Open(0, 1), exposure.keyValue);
-        } else {
+        } else if (kExposureModes[mode] == "manual") {
             exposure.mode = ExposureMode::Manual;
             exposure.ev = x.GetDouble("ev", NumberRange::Any("EV"));
+        } else {
+            exposure.mode = ExposureMode::Adapted;
         }
     });
     return exposure;

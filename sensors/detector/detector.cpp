@@ -78,4 +78,14 @@ double AutoExposureEv(const Image& rgb, double key) {
     return std::log2(key / LogAverageLuminance(rgb));
 }
 
+double AdaptedKey(double Lavg_cdm2) {
+    CHECK(Lavg_cdm2 >= 0.0);
+    return 1.03 - 2.0 / (2.0 + std::log10(Lavg_cdm2 + 1.0));
+}
+
+double AdaptedExposureEv(const Image& rgb) {
+    const double Lavg = LogAverageLuminance(rgb);
+    return std::log2(AdaptedKey(Lavg) / Lavg);
+}
+
 }  // namespace seasense::sensors

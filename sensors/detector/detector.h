@@ -21,4 +21,13 @@ double LogAverageLuminance(const Image& rgb);
 // display-referred input = scene-linear · 2^ev.
 double AutoExposureEv(const Image& rgb, double key);
 
+// Key of a scene adapted to log-average luminance Lavg_cdm2 (cd/m²): Krawczyk, Myszkowski &
+// Seidel, "Lightness Perception in Tone Reproduction for HDR Images", Eurographics 2005,
+// eq. 11: α = 1.03 − 2 / (2 + log10(Lavg + 1)). Bright scenes get a high key, dim ones a low
+// key (0.63 at 1000 cd/m², 0.18 near 1.25 cd/m², 0.04 at 0.01 cd/m²), so night stays dark.
+double AdaptedKey(double Lavg_cdm2);
+
+// Exposure value mapping the log-average luminance to AdaptedKey of it.
+double AdaptedExposureEv(const Image& rgb);
+
 }  // namespace seasense::sensors

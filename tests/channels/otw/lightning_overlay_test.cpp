@@ -50,14 +50,15 @@ TEST(LightningOverlay, DrawnBoltSendsTheLineSourceIlluminanceToTheEye) {
     const ChannelCamera cam = NorthCamera();
     for (double beta : {0.0, 3.912 / 20000.0}) {
         Image radiance(cam.SampleWidth(), cam.SampleHeight(), 3);
-        const FlashLight light =
-            DrawLightning(cam, Empty(cam, 0.0f), lightning, t0, t1, beta, radiance);
+        const LitFlashes lit = FindLitFlashes(lightning, t0, t1);
+        DrawLightning(cam, Empty(cam, 0.0f), lightning, lit, beta, radiance);
+        const glm::dvec3 eye = cam.worldFromCamera.position_m;
+        const FlashLight light = FlashLightAt(lightning, lit, eye, beta);
         ASSERT_GE(light.flashes, 1);
         double E = 0.0;
         for (int y = 0; y < radiance.height; ++y)
             for (int x = 0; x < radiance.width; ++x)
                 E += radiance.At(x, y)[1] * SampleSolidAngle_sr(cam, x, y);
-        const glm::dvec3 eye = cam.worldFromCamera.position_m;
         // Exact line-source integral (Lightning::MeanIlluminance_lux, extinction at each
         // segment's midpoint) against the drawn elements: within 1 %.
         EXPECT_NEAR(E, light.illuminance_lux, 0.01 * light.illuminance_lux) << beta;
@@ -73,15 +74,16 @@ TEST(LightningOverlay, NearerGeometryHidesTheBoltAndNoFlashDrawsNothing) {
     const ChannelCamera cam = NorthCamera();
     // A wall 100 m in front of the camera everywhere: depth = near / 100 m.
     Image radiance(cam.SampleWidth(), cam.SampleHeight(), 3);
-    DrawLightning(cam, Empty(cam, float(cam.near_m / 100.0)), lightning, flash.start_s,
-                  flash.start_s + 0.04, 0.0, radiance);
+    DrawLightning(cam, Empty(cam, float(cam.near_m / 100.0)), lightning,
+                  FindLitFlashes(lightning, flash.start_s, flash.start_s + 0.04), 0.0, radiance);
     for (float v : radiance.pixels) EXPECT_EQ(v, 0.0f);
     // A frame in which no flash is lit draws nothing and sheds no light.
     double quiet = 0.0;
     while (!lightning.FlashesBetween(quiet, quiet + 0.04).empty()) quiet += 0.04;
     Image dark(cam.SampleWidth(), cam.SampleHeight(), 3);
-    const FlashLight none =
-        DrawLightning(cam, Empty(cam, 0.0f), lightning, quiet, quiet + 0.04, 0.0, dark);
+    const LitFlashes unlit = FindLitFlashes(lightning, quiet, quiet + 0.04);
+    DrawLightning(cam, Empty(cam, 0.0f), lightning, unlit, 0.0, dark);
+    const FlashLight none = FlashLightAt(lightning, unlit, cam.worldFromCamera.position_m, 0.0);
     EXPECT_EQ(none.flashes, 0);
     EXPECT_EQ(none.illuminance_lux, 0.0);
     for (float v : dark.pixels) EXPECT_EQ(v, 0.0f);

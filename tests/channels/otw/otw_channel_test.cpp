@@ -130,6 +130,124 @@ TEST(OtwChannel, BoxShadowOnAPlateHasLengthHeightOverTanElevation) {
     std::filesystem::remove_all(dir);
 }
 
+TEST(OtwChannel, MoonlightCastsTheShadowOfAKeyLightAtTheMoonsElevation) {
+    // After sunset the moon is the key light: the box's shadow on the plate reaches
+    // h / tan(e_moon) beyond the box (along the ray from the box's centre directly away from
+    // the moon: h / tan(e) plus the distance to the top square's edge, 1 / max(|dx|, |dy|)).
+    const std::filesystem::path dir =
+        std::filesystem::temp_directory_path() / ("seasense_moon_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    const double h = 4.0, plateTop = 0.2;
+    WriteBoxObj(dir / "plate.obj", {-30, -30, 0}, {30, 30, float(plateTop)});
+    WriteBoxObj(dir / "box.obj", {-1, -1, float(plateTop)}, {1, 1, float(plateTop + h)});
+    scene::Scenario sc = CalmSeaScenario(100.0, 12.0);
+    // An evening waxing gibbous moon 41° up in the east from 34° N (the sun is
+    // given fixed below the horizon; the moon always follows the ephemeris).
+    sc.world.latitude_deg = 34.0;
+    sc.world.longitude_deg = 0.0;
+    sc.world.start = *scene::ParseIso8601("2026-11-21T18:00:00Z");
+    sc.environment.sun.elevation_rad = -0.5;
+    sc.materials = {{"grey", glm::dvec3(0.5)}};
+    sc.entities.push_back({"plate", dir / "plate.obj", {0, 0, 0}, {}, 1.0, "grey"});
+    sc.entities.push_back({"box", dir / "box.obj", {0, 0, 0}, {}, 1.0, "grey"});
+    sc.eyepoint.attitude.pitch_rad = -0.5 * M_PI;  // looking straight down, image up = north
+    scene::ChannelSettings& ch = sc.channels[0];
+    ch.width = 640;
+    ch.height = 480;
+    ch.shadows = true;
+    const scene::World world(sc);
+    const scene::SceneState state = world.State(0);
+    ASSERT_GT(state.moon.elevation_rad, 20.0 * M_PI / 180.0);
+    ASSERT_LT(state.moon.elevation_rad, 60.0 * M_PI / 180.0);
+    ASSERT_GT(state.moon.illuminance_lux, 0.01);
+    OtwChannel otw(world, ch);
+    Image radiance;
+    tbb::task_arena arena(2);
+    arena.execute([&] { otw.Render(state, radiance); });
+    const ChannelCamera& cam = otw.Camera();
+    const double gsd = 2.0 * (100.0 - plateTop) * cam.TanHalfH() / cam.width;
+    // Away from the moon (azimuth from north through east), ground metres east and north.
+    const glm::dvec2 d(-std::sin(state.moon.azimuth_rad), -std::cos(state.moon.azimuth_rad));
+    const auto at = [&](double s) {
+        const int px = int(std::floor(s * d.x / gsd + cam.width / 2.0));
+        const int py = int(std::floor(-s * d.y / gsd + cam.height / 2.0));
+        return radiance.At(px, py)[1];
+    };
+    // Lit plate far from the box on the moon's side; the plate's moonlit luminance is
+    // ρ/π (E_moon sin e + E_sky) > 0, the shadow below half of it.
+    const float lit = at(-25.0);
+    ASSERT_GT(lit, 0.0f);
+    const double inside = 1.0 / std::max(std::abs(d.x), std::abs(d.y));
+    double lastShadow = -1.0;
+    for (double s = inside + 0.2; s < 28.0; s += 0.25 * gsd)
+        if (at(s) < 0.5f * lit) lastShadow = s;
+    ASSERT_GT(lastShadow, 0.0) << "no moon shadow";
+    const double expectedEnd = inside + h / std::tan(state.moon.elevation_rad);
+    EXPECT_NEAR(lastShadow, expectedEnd, 1.5 * gsd);
+    std::filesystem::remove_all(dir);
+}
+
+TEST(OtwChannel, LightningFlashAddsItsIlluminanceToALambertianPlate) {
+    // A flash raises the light on the scene for its duration: a level Lambertian plate of
+    // reflectance ρ seen from above gains ρ E cos θ / π, E the flash's line-source illuminance
+    // at the eye (Lightning::SceneIlluminance_lux) and θ the bolt's zenith angle.
+    const std::filesystem::path dir =
+        std::filesystem::temp_directory_path() / ("seasense_flash_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    WriteBoxObj(dir / "plate.obj", {-30, -30, 0}, {30, 30, 0.2f});
+    scene::Scenario sc = CalmSeaScenario(100.0, 12.0);
+    sc.world.start = *scene::ParseIso8601("2026-11-10T00:00:00Z");  // new moon, below the horizon
+    sc.environment.sun.elevation_rad = -0.5;
+    sc.materials = {{"grey", glm::dvec3(0.5)}};
+    sc.entities.push_back({"plate", dir / "plate.obj", {0, 0, 0}, {}, 1.0, "grey"});
+    sc.eyepoint.attitude.pitch_rad = -0.5 * M_PI;
+    scene::LightningSettings storm;
+    scene::StormCellSettings cell;
+    cell.center_m = {0.0, 6000.0, 0.0};
+    cell.radius_m = 800.0;
+    cell.cloudBase_m = 1500.0;
+    cell.flashRate_perMin = 20.0;
+    storm.cells.push_back(cell);
+    sc.environment.lightning = storm;
+    sc.channels[0].width = 64;
+    sc.channels[0].height = 48;
+    const scene::World world(sc);
+    const scene::Lightning& lightning = *world.GetLightning();
+    const double frame_s = 1.0 / sc.world.frameRate_hz;
+    // The first frame whose exposure holds one flash, and one without.
+    int64_t litFrame = -1, darkFrame = -1;
+    for (int64_t k = 1; k < 100000 && (litFrame < 0 || darkFrame < 0); ++k) {
+        const size_t n = lightning.FlashesBetween((k - 1) * frame_s, k * frame_s).size();
+        if (n == 1 && litFrame < 0) litFrame = k;
+        if (n == 0 && darkFrame < 0) darkFrame = k;
+    }
+    ASSERT_GT(litFrame, 0);
+    ASSERT_GT(darkFrame, 0);
+    OtwChannel otw(world, sc.channels[0]);
+    Image dark, lit;
+    tbb::task_arena arena(2);
+    const scene::SceneState litState = world.State(litFrame);
+    arena.execute([&] {
+        otw.Render(world.State(darkFrame), dark);
+        otw.Render(litState, lit);
+    });
+    const glm::dvec3 eye = sc.eyepoint.position_m;
+    const double t0 = litState.time_s - frame_s, t1 = litState.time_s;
+    const double beta = 3.912 / sc.environment.visibility_m;
+    const double E = lightning.SceneIlluminance_lux(eye, t0, t1, beta);
+    ASSERT_GT(E, 0.0);
+    // The bolt's direction: toward the middle of its main channel.
+    const scene::Flash flash = lightning.FlashesBetween(t0, t1).front();
+    const scene::Bolt bolt = lightning.GrowBolt(flash);
+    const double cosTheta = glm::normalize(0.5 * (flash.root_m + bolt.strike_m) - eye).z;
+    const double expected = 0.5 * E * cosTheta / M_PI;
+    const int cx = lit.width / 2, cy = lit.height / 2;
+    // The plate is seen through 100 m of air: Koschmieder transmittance.
+    const double gain = (lit.At(cx, cy)[1] - dark.At(cx, cy)[1]) / std::exp(-beta * 99.8);
+    EXPECT_NEAR(gain, expected, 0.01 * expected);
+    std::filesystem::remove_all(dir);
+}
+
 TEST(OtwChannel, PoleOnTheBorderOfAdjacentChannelsLinesUp) {
     // Contiguous channels (−60° and 0° heading, 60° wide each) meet at −30°. A 2 m wide,
     // 30 m tall pole 200 m away on that border shows its left half at the right edge of the

@@ -5,8 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 
 #include "scene/core/error.h"
+#include "scene/scenario/scenario_loader.h"
 #include "scene/sky/ephemeris.h"
 
 namespace seasense::scene {
@@ -145,6 +147,25 @@ TEST(World, MoonFollowsTheEphemerisWithItsPhaseAndLight) {
     }
     EXPECT_TRUE(sawUp);
     EXPECT_TRUE(sawDown);  // it sets during the 6.5 h
+}
+
+TEST(World, EveryShippedScenarioLoadsAndComposesItsFirstFrame) {
+    // The scenarios in configs/ are what users start from: each must load, build its world
+    // and compose a frame (materials.yaml is the material table, not a scenario).
+    int scenarios = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(
+             std::filesystem::path(SEASENSE_SOURCE_DIR) / "configs")) {
+        if (entry.path().extension() != ".yaml" || entry.path().filename() == "materials.yaml")
+            continue;
+        SCOPED_TRACE(entry.path().string());
+        const Scenario sc = LoadScenario(entry.path());
+        const World world(sc);
+        const SceneState state = world.State(0);
+        EXPECT_TRUE(std::isfinite(state.sun.elevation_rad));
+        EXPECT_FALSE(sc.channels.empty());
+        ++scenarios;
+    }
+    EXPECT_GE(scenarios, 7);
 }
 
 TEST(World, ComposeRejectsAStateOfAnotherScenario) {

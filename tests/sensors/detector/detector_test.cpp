@@ -59,5 +59,28 @@ TEST(Detector, AutoExposureMapsGeometricMeanLuminanceToKey) {
     EXPECT_NEAR(AutoExposureEv(img, 0.18), std::log2(0.18 / 100.0), 1e-5);
 }
 
+TEST(Detector, AdaptedExposureKeepsNightDarkerThanDay) {
+    // Krawczyk et al. 2005, eq. 11: α(L) = 1.03 − 2 / (2 + log10(L + 1)). At L = 99 cd/m²
+    // log10(L + 1) = 2 and α = 0.53; at L = 0 α = 0.03 (the formula's floor); α rises with L.
+    EXPECT_NEAR(AdaptedKey(99.0), 0.53, 1e-12);
+    EXPECT_NEAR(AdaptedKey(0.0), 0.03, 1e-12);
+    // A uniform daylight scene (100 cd/m²) and the same scene a million times dimmer
+    // (moonlight): auto exposure shows both as mid-grey, adaptation shows the night darker,
+    // with display values α(L) each.
+    Image day(2, 2, 3), night(2, 2, 3);
+    for (size_t i = 0; i < day.pixels.size(); ++i) day.pixels[i] = 100.0f;
+    for (size_t i = 0; i < night.pixels.size(); ++i) night.pixels[i] = 1e-4f;
+    const auto display = [](const Image& img, double ev) {
+        return LogAverageLuminance(img) * std::exp2(ev);
+    };
+    EXPECT_NEAR(display(day, AutoExposureEv(day, 0.18)),
+                display(night, AutoExposureEv(night, 0.18)), 1e-6);
+    const double dayKey = display(day, AdaptedExposureEv(day));
+    const double nightKey = display(night, AdaptedExposureEv(night));
+    EXPECT_NEAR(dayKey, 1.03 - 2.0 / (2.0 + std::log10(100.0 + 1e-4 + 1.0)), 1e-6);
+    EXPECT_LT(nightKey, 0.05);
+    EXPECT_GT(dayKey, 10.0 * nightKey);
+}
+
 }  // namespace
 }  // namespace seasense::sensors
