@@ -87,6 +87,19 @@ void RunQueryOcean(const QueryOceanOptions& opt) {
                     {"group_speed_mps", Number(s.groupSpeed_mps)},
                     {"wind_speed_mps", Number(s.windSpeed_mps)},
                     {"wind_direction_deg", Number(AzimuthDeg(s.windDirection_rad))}};
+        if (q.hasSurf) {
+            const scene::SurfPointInfo& f = q.surf;
+            j["surf"] = {{"seabed_z_m", f.seabedZ_m},
+                         {"surf_weight", f.surfWeight},
+                         {"wave_height_m", 2.0 * f.envelope_m},
+                         {"breaking_intensity", f.breaking.intensity},
+                         {"broken", f.breaking.broken},
+                         {"time_since_breaking_s", f.breaking.timeSinceBreaking_s},
+                         {"direction_deg", AzimuthDeg(f.direction_rad)},
+                         {"phase_deg", f.phase_rad * 180.0 / M_PI},
+                         {"phase_speed_mps", f.phaseSpeed_mps},
+                         {"group_speed_mps", f.groupSpeed_mps}};
+        }
         std::cout << j.dump(2) << "\n";
         return;
     }
@@ -105,6 +118,17 @@ void RunQueryOcean(const QueryOceanOptions& opt) {
                 s.peakPeriod_s, s.peakWavelength_m, AzimuthDeg(s.dominantDirection_rad));
     std::printf("speeds            phase %.3f m/s, group %.3f m/s\n", s.phaseSpeed_mps,
                 s.groupSpeed_mps);
+    if (q.hasSurf) {
+        const scene::SurfPointInfo& f = q.surf;
+        std::printf("surf              seabed z %.2f m, surf weight %.2f, group height %.3f m\n",
+                    f.seabedZ_m, f.surfWeight, 2.0 * f.envelope_m);
+        std::printf("breaking          intensity %.3f, %s, %.1f s since the breaker line\n",
+                    f.breaking.intensity, f.breaking.broken ? "broken" : "unbroken",
+                    f.breaking.timeSinceBreaking_s);
+        std::printf("local wave        toward %.1f deg, phase %.1f deg, c %.3f m/s, cg %.3f m/s\n",
+                    AzimuthDeg(f.direction_rad), f.phase_rad * 180.0 / M_PI, f.phaseSpeed_mps,
+                    f.groupSpeed_mps);
+    }
     if (s.spectral)
         std::printf("wind              %.2f m/s toward %.1f deg\n", s.windSpeed_mps,
                     AzimuthDeg(s.windDirection_rad));

@@ -124,7 +124,12 @@ SurfWaves::SurfWaves(const Bathymetry& bathymetry, std::vector<SurfComponent> co
             const double h = std::max(profileDepth(sRef_m_ - i * ds_m_), kMinDepth_m);
             time += ds_m_ / DepthTable(tr.cg, h);
         }
-        for (int i = 0; i < iBreak; ++i) breakTime_s_[size_t(i)] = -(iBreak - i) * ds_m_;
+        time = 0.0;  // seaward of the line: minus the travel time still to go
+        for (int i = iBreak - 1; i >= 0; --i) {
+            const double h = std::max(profileDepth(sRef_m_ - i * ds_m_), kMinDepth_m);
+            time -= ds_m_ / DepthTable(tr.cg, h);
+            breakTime_s_[size_t(i)] = time;
+        }
     }
 }
 
