@@ -307,8 +307,8 @@ struct BlockScratch {
     std::vector<uint32_t> skyK, seaK, modelK;                     // see kPixelEntry
     std::vector<float> skyX, skyY, skyZ;                          // view directions of sky entries
     std::vector<float> seaPx, seaPy, seaPz, seaNx, seaNy, seaNz;  // unit normals
-    std::vector<float> seaDepth, seaWet, seaFoam;  // OceanAttributes interpolated
-    std::vector<float> seaLit;                     // lit fraction of a sea entry's samples
+    std::vector<float> seaDepth, seaWet, seaFoam;                 // OceanAttributes interpolated
+    std::vector<float> seaLit;      // lit fraction of a sea entry's samples
     std::vector<uint8_t> seaUnlit;  // samples of a sea entry found in shadow
     std::vector<glm::vec3> modelPosition, modelNormal;
     std::vector<int> modelMesh;
@@ -323,9 +323,8 @@ struct BlockScratch {
     // Empties the lists and makes the sky and sea lists hold at least n entries.
     void Reset(size_t n) {
         if (skyK.size() < n) {
-            for (std::vector<float>* v :
-                 {&skyX, &skyY, &skyZ, &seaPx, &seaPy, &seaPz, &seaNx, &seaNy, &seaNz, &seaLit, &seaDepth,
-                  &seaWet, &seaFoam})
+            for (std::vector<float>* v : {&skyX, &skyY, &skyZ, &seaPx, &seaPy, &seaPz, &seaNx,
+                                          &seaNy, &seaNz, &seaLit, &seaDepth, &seaWet, &seaFoam})
                 v->resize(n);
             skyK.resize(n), seaK.resize(n), seaUnlit.resize(n);
         }
@@ -343,7 +342,7 @@ struct CachedTriangle {
     int mesh = 0;
     F4 p0 = _mm_setzero_ps(), p1 = p0, p2 = p0, n0 = p0, n1 = p0, n2 = p0;
     F4 a0 = p0, a1 = p0, a2 = p0;  // sea vertex attributes (ViewGeometry::OceanAttributes)
-    bool shadowable = false;  // a shadow ray from some point of it may meet a caster
+    bool shadowable = false;       // a shadow ray from some point of it may meet a caster
 };
 
 F4 Load3(const glm::vec3& v) { return _mm_setr_ps(v.x, v.y, v.z, 0.0f); }
@@ -574,8 +573,8 @@ class BlockClassifier {
             cMin = std::min(cMin, c), cMax = std::max(cMax, c);
         }
         if (!CosSpreadSmall(cMin, cMax, std::sqrt(Dot3(toEye, toEye)))) return false;
-        const size_t e = AddSea(k | kPixelEntry, p, nSum,
-                                InterpolateAttributes(tri, b1Sum * inv, b2Sum * inv));
+        const size_t e =
+            AddSea(k | kPixelEntry, p, nSum, InterpolateAttributes(tri, b1Sum * inv, b2Sum * inv));
         if (tri.shadowable) {
             F4 samples[kMaxSupersampling * kMaxSupersampling], unused;
             for (int s = 0; s < count; ++s) Interpolate(tri, b1[s], b2[s], samples[s], unused);

@@ -59,7 +59,8 @@ inline simd4::F4 WaterPathFactor4(simd4::F4 cosV, float n) {
 // Radiance (cd/m², one channel) of a surf-zone point before fog:
 //   water:  reflected + (1 − F)·[ρ_wet E/π · T + R_rs E_d · (1 − T)],  T = e^{−K d (1 + 1/cos θ_t)}
 //   sand:   ρ_sand E/π,  ρ_sand from dry to wet by wetness
-//   surface = sand + (water − sand)·min(d / kSwashFilm_m, 1);  result = surface + (foam − surface)·c
+//   surface = sand + (water − sand)·min(d / kSwashFilm_m, 1);  result = surface + (foam −
+//   surface)·c
 // reflected = F·L_sky + glint (the surface's specular part), oneMinusF the Fresnel
 // transmittance, pathFactor from WaterPathFactor4, depth the column d (m), wet in [0, 1], foam
 // coverage c in [0, 1], E the irradiance on the surface (Lambertian: key, fill and sky, lx),
@@ -76,8 +77,7 @@ inline simd4::F4 ShoreRadiance4(const ShoreChannel& c, simd4::F4 reflected, simd
     const F4 water = _mm_add_ps(
         reflected,
         _mm_mul_ps(oneMinusF, _mm_add_ps(deep, _mm_mul_ps(_mm_sub_ps(bottom, deep), T))));
-    const F4 rhoSand =
-        _mm_add_ps(Set4(c.rhoDry), _mm_mul_ps(Set4(c.rhoWet - c.rhoDry), wet));
+    const F4 rhoSand = _mm_add_ps(Set4(c.rhoDry), _mm_mul_ps(Set4(c.rhoWet - c.rhoDry), wet));
     const F4 sand = _mm_mul_ps(rhoSand, lambert);
     const F4 film = _mm_min_ps(_mm_mul_ps(depth, Set4(1.0f / kSwashFilm_m)), Set4(1.0f));
     const F4 surface = _mm_add_ps(sand, _mm_mul_ps(_mm_sub_ps(water, sand), film));

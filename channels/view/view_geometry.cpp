@@ -166,7 +166,7 @@ void ViewGeometry::UpdateOceanAttributes(double time_s) {
                     scene::SurfPointInfo info;
                     surf->Terms(x0, y0, time_s, &info);
                     a.z = std::max(a.z, float(scene::SurfFoamCoverage(info, x0, y0, time_s,
-                                                                       bathy.Settings().foam)));
+                                                                      bathy.Settings().foam)));
                 }
             }
             oceanAttributes_[v] = a;

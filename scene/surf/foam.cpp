@@ -46,8 +46,8 @@ double FoamStreaks(double x0, double y0, double t_s, double direction_rad, doubl
     const double ex = std::sin(direction_rad), ey = std::cos(direction_rad);
     const double along = x0 * ex + y0 * ey - drift_mps * t_s;
     const double across = -x0 * ey + y0 * ex;
-    const double n = FoamNoise(along / (s.streakWidth_m * s.streakElongation),
-                               across / s.streakWidth_m, s.seed);
+    const double n =
+        FoamNoise(along / (s.streakWidth_m * s.streakElongation), across / s.streakWidth_m, s.seed);
     // Soft threshold: noise below 0.35 is a gap, above 0.6 full foam.
     const double t = std::clamp((n - 0.35) / 0.25, 0.0, 1.0);
     return SmoothStep(t);
