@@ -13,6 +13,7 @@
 #include "channels/otw/celestial.h"
 #include "channels/otw/cloud_layer.h"
 #include "channels/otw/lightning_overlay.h"
+#include "channels/otw/shore_shading.h"
 #include "channels/plume/plume_composite.h"
 #include "radiometry/sky/analytic_sky.h"
 #include "radiometry/surface/fresnel.h"
@@ -29,6 +30,13 @@ using namespace simd4;
 // Rec.709 primaries' dominant wavelengths (≈ 610, 550, 465 nm); order of magnitude from
 // Mobley, "Light and Water" (1994), Fig. 11.x and Morel & Maritorena (2001) for chl ≈ 0.1 mg/m³.
 constexpr glm::vec3 kSeaRrs{0.0003f, 0.0015f, 0.0050f};
+
+// Diffuse attenuation coefficient K_d (m⁻¹) of coastal water at the Rec.709 primaries' dominant
+// wavelengths (≈ 610, 550, 465 nm): Jerlov coastal type 1 (N. G. Jerlov, "Marine Optics",
+// Elsevier 1976, the K_d spectra of the coastal water types; tabulated again by Solonenko &
+// Mobley, Appl. Opt. 54(17), 5392, 2015). Coastal water is clearest in the green, unlike
+// oceanic water (blue): the red is absorbed by water itself, the blue by dissolved matter.
+constexpr glm::vec3 kCoastalK_perm{0.28f, 0.10f, 0.13f};
 
 // Albedo of the sea for light reflected up onto models (Payne 1972, J. Atmos. Sci. 29: ≈ 0.06).
 constexpr float kSeaAlbedo = 0.06f;
@@ -74,25 +82,6 @@ float CoxMunkSlopeVariance(double windSpeed_mps) {
 // Four-lane (SSE2, the x86-64 baseline) arithmetic for the sky and sea passes. Each lane does
 // the scalar code's operations in the scalar code's order, so a sample's result does not
 // depend on its neighbours, the batch size or the thread count.
-
-// e^x for x ≤ 0 (0 below −87, where e^x leaves float's normal range). Cody & Waite range
-// reduction ("Software Manual for the Elementary Functions", 1980): x = k ln 2 + r with
-// |r| ≤ ln 2 / 2 and ln 2 split into a 16-bit head (k·head exact) and a tail; e^r from its
-// Taylor series to r⁷ (truncation < 1e-8 relative, below float precision); 2^k through the
-// exponent bits. Within a few ulp of std::exp, and four lanes wide where libm is scalar.
-F4 ExpNonPositive4(F4 x) {
-    const F4 underflow = _mm_cmplt_ps(x, Set4(-87.0f));
-    x = Max4(x, Set4(-87.0f));
-    const I4 k = _mm_cvtps_epi32(_mm_mul_ps(x, Set4(1.44269504f)));  // round(x / ln 2)
-    const F4 kf = _mm_cvtepi32_ps(k);
-    const F4 r = _mm_sub_ps(_mm_sub_ps(x, _mm_mul_ps(kf, Set4(0.693145751953125f))),
-                            _mm_mul_ps(kf, Set4(1.428606765330187e-6f)));
-    F4 p = Set4(1.0f / 5040.0f);
-    const float c[] = {1.0f / 720.0f, 1.0f / 120.0f, 1.0f / 24.0f, 1.0f / 6.0f, 0.5f, 1.0f, 1.0f};
-    for (float ci : c) p = _mm_add_ps(_mm_mul_ps(p, r), Set4(ci));
-    const F4 twoK = _mm_castsi128_ps(_mm_slli_epi32(_mm_add_epi32(k, _mm_set1_epi32(127)), 23));
-    return _mm_andnot_ps(underflow, _mm_mul_ps(p, twoK));
-}
 
 // Normalizes count directions in place: v · (1 / √(v·v)), as glm::normalize.
 void Normalize(size_t count, float* x, float* y, float* z) {
@@ -144,6 +133,9 @@ struct SeaChunk {
     alignas(16) float skyR[kChunk], skyG[kChunk], skyB[kChunk];
     alignas(16) float horR[kChunk], horG[kChunk], horB[kChunk];
     alignas(16) float outR[kChunk], outG[kChunk], outB[kChunk];
+    // Surf zone: Lambertian irradiance without the key light, cos of the key light on the normal
+    // (≥ 0), the water path factor 1 + 1/cos θ_t.
+    alignas(16) float ambR[kChunk], ambG[kChunk], ambB[kChunk], keyCos[kChunk], path[kChunk];
 };
 
 // Sea radiance: Fresnel-weighted sky reflection plus water-leaving radiance, Cox–Munk glint of
@@ -153,11 +145,18 @@ struct SeaShading {
     float beta, slopeVar;
     const radiometry::FresnelTable& fresnel;
     const radiometry::AnalyticSky& sky;
+    // Surf zone and foam (channels/otw/shore_shading.h): sky irradiance on a level surface, the
+    // fill lights, the optics of each colour channel.
+    glm::vec3 skyE;
+    const std::vector<DirectionalLight>* fill;
+    ShoreChannel shore[3];
 
     // Shades count ≤ kChunk samples at positions p (m, world) with unit normals n, sun
-    // visibility ch.sunVis; radiance (cd/m²) to ch.outR/G/B.
+    // visibility ch.sunVis, water column depth (m), sand wetness and foam coverage; radiance
+    // (cd/m²) to ch.outR/G/B.
     void Shade(size_t count, const float* px, const float* py, const float* pz, const float* nx,
-               const float* ny, const float* nz, SeaChunk& ch) const {
+               const float* ny, const float* nz, const float* depth, const float* wet,
+               const float* foam, SeaChunk& ch) const {
         // Geometry: view vector v, reflected ray r, glint half vector h.
         for (size_t i = 0; i < count; i += 4) {
             const size_t lanes = std::min<size_t>(4, count - i);
@@ -194,6 +193,24 @@ struct SeaShading {
             _mm_store_ps(ch.cos2 + i, cos2);
             _mm_store_ps(ch.tan2 + i, _mm_div_ps(_mm_sub_ps(Set4(1.0f), cos2), cos2));
             _mm_store_ps(ch.vh + i, Dot4(vx, vy, vz, hx, hy, hz));
+            // Lambertian irradiance of sand and foam: sky as on a plane tilted to the normal,
+            // (1 + n_z)/2 of the level-surface sky irradiance, and the fill lights.
+            const F4 skyView = _mm_mul_ps(Set4(0.5f), _mm_add_ps(Set4(1.0f), Nz));
+            F4 aR = _mm_mul_ps(Set4(skyE.r), skyView), aG = _mm_mul_ps(Set4(skyE.g), skyView),
+               aB = _mm_mul_ps(Set4(skyE.b), skyView);
+            for (const DirectionalLight& l : *fill) {
+                const F4 c = Max4(Dot4(Nx, Ny, Nz, Set4(l.dir.x), Set4(l.dir.y), Set4(l.dir.z)),
+                                  _mm_setzero_ps());
+                aR = _mm_add_ps(aR, _mm_mul_ps(Set4(l.E.r), c));
+                aG = _mm_add_ps(aG, _mm_mul_ps(Set4(l.E.g), c));
+                aB = _mm_add_ps(aB, _mm_mul_ps(Set4(l.E.b), c));
+            }
+            _mm_store_ps(ch.ambR + i, aR);
+            _mm_store_ps(ch.ambG + i, aG);
+            _mm_store_ps(ch.ambB + i, aB);
+            _mm_store_ps(ch.keyCos + i, Max4(_mm_load_ps(ch.cosS + i), _mm_setzero_ps()));
+            _mm_store_ps(ch.path + i, WaterPathFactor4(Max4(ndv, Set4(1e-3f)),
+                                                       float(radiometry::kSeaWaterIndexVisible)));
         }
         sky.LookUp(count, ch.rx, ch.ry, ch.rz, ch.skyR, ch.skyG, ch.skyB);
         sky.HorizonLookUp(count, ch.mvx, ch.mvy, ch.horR, ch.horG, ch.horB);
@@ -223,18 +240,24 @@ struct SeaShading {
             // Koschmieder: the horizon sky is the airlight a long path converges to.
             const F4 t = ExpNonPositive4(_mm_mul_ps(Set4(-beta), _mm_load_ps(ch.range + i)));
             const F4 oneMinusT = _mm_sub_ps(one, t);
-            const auto channel = [&](const float* skyC, const float* horC, float rrs, float dw,
-                                     float sunEC, float* outC) {
-                F4 L = _mm_add_ps(_mm_mul_ps(F, _mm_load_ps(skyC + i)),
-                                  _mm_mul_ps(_mm_mul_ps(oneMinusF, Set4(rrs)), Set4(dw)));
-                L = Select4(glint, _mm_add_ps(L, _mm_mul_ps(_mm_mul_ps(Set4(sunEC), g), sunVis)),
-                            L);
+            const size_t lanes = std::min<size_t>(4, count - i);
+            const F4 d = LoadLanes(depth + i, lanes, kDeepColumn_m);
+            const F4 w = LoadLanes(wet + i, lanes, 0.0f), c = LoadLanes(foam + i, lanes, 0.0f);
+            const F4 path = _mm_load_ps(ch.path + i);
+            const F4 keyLit = _mm_mul_ps(_mm_load_ps(ch.keyCos + i), sunVis);
+            const auto channel = [&](const ShoreChannel& sh, const float* skyC, const float* horC,
+                                     const float* ambC, float dw, float sunEC, float* outC) {
+                F4 R = _mm_mul_ps(F, _mm_load_ps(skyC + i));
+                R = Select4(glint, _mm_add_ps(R, _mm_mul_ps(_mm_mul_ps(Set4(sunEC), g), sunVis)),
+                            R);
+                const F4 E = _mm_add_ps(_mm_load_ps(ambC + i), _mm_mul_ps(Set4(sunEC), keyLit));
+                F4 L = ShoreRadiance4(sh, R, oneMinusF, path, d, w, c, E, Set4(dw));
                 L = _mm_add_ps(_mm_mul_ps(L, t), _mm_mul_ps(_mm_load_ps(horC + i), oneMinusT));
                 _mm_store_ps(outC + i, L);
             };
-            channel(ch.skyR, ch.horR, kSeaRrs.r, downwelling.r, keyE.r, ch.outR);
-            channel(ch.skyG, ch.horG, kSeaRrs.g, downwelling.g, keyE.g, ch.outG);
-            channel(ch.skyB, ch.horB, kSeaRrs.b, downwelling.b, keyE.b, ch.outB);
+            channel(shore[0], ch.skyR, ch.horR, ch.ambR, downwelling.r, keyE.r, ch.outR);
+            channel(shore[1], ch.skyG, ch.horG, ch.ambG, downwelling.g, keyE.g, ch.outG);
+            channel(shore[2], ch.skyB, ch.horB, ch.ambB, downwelling.b, keyE.b, ch.outB);
         }
     }
 };
@@ -285,6 +308,7 @@ struct BlockScratch {
     std::vector<uint32_t> skyK, seaK, modelK;                     // see kPixelEntry
     std::vector<float> skyX, skyY, skyZ;                          // view directions of sky entries
     std::vector<float> seaPx, seaPy, seaPz, seaNx, seaNy, seaNz;  // unit normals
+    std::vector<float> seaDepth, seaWet, seaFoam;                 // OceanAttributes interpolated
     std::vector<float> seaLit;      // lit fraction of a sea entry's samples
     std::vector<uint8_t> seaUnlit;  // samples of a sea entry found in shadow
     std::vector<glm::vec3> modelPosition, modelNormal;
@@ -300,8 +324,8 @@ struct BlockScratch {
     // Empties the lists and makes the sky and sea lists hold at least n entries.
     void Reset(size_t n) {
         if (skyK.size() < n) {
-            for (std::vector<float>* v :
-                 {&skyX, &skyY, &skyZ, &seaPx, &seaPy, &seaPz, &seaNx, &seaNy, &seaNz, &seaLit})
+            for (std::vector<float>* v : {&skyX, &skyY, &skyZ, &seaPx, &seaPy, &seaPz, &seaNx,
+                                          &seaNy, &seaNz, &seaLit, &seaDepth, &seaWet, &seaFoam})
                 v->resize(n);
             skyK.resize(n), seaK.resize(n), seaUnlit.resize(n);
         }
@@ -318,7 +342,8 @@ struct CachedTriangle {
     uint32_t prim = kNoPrimitive;
     int mesh = 0;
     F4 p0 = _mm_setzero_ps(), p1 = p0, p2 = p0, n0 = p0, n1 = p0, n2 = p0;
-    bool shadowable = false;  // a shadow ray from some point of it may meet a caster
+    F4 a0 = p0, a1 = p0, a2 = p0;  // sea vertex attributes (ViewGeometry::OceanAttributes)
+    bool shadowable = false;       // a shadow ray from some point of it may meet a caster
 };
 
 F4 Load3(const glm::vec3& v) { return _mm_setr_ps(v.x, v.y, v.z, 0.0f); }
@@ -345,6 +370,7 @@ struct MeshRef {
     const glm::vec3* P;
     const glm::vec3* N;
     const uint32_t* I;
+    const glm::vec4* A = nullptr;  // per-vertex attributes (the sea only)
 };
 
 // One frame's visibility buffer, meshes and view rays.
@@ -378,6 +404,10 @@ struct FrameGeometry {
         tri.prim = prim, tri.mesh = mesh;
         tri.p0 = Load3(m.P[i0]), tri.p1 = Load3(m.P[i1]), tri.p2 = Load3(m.P[i2]);
         tri.n0 = Load3(m.N[i0]), tri.n1 = Load3(m.N[i1]), tri.n2 = Load3(m.N[i2]);
+        if (m.A) {
+            tri.a0 = _mm_loadu_ps(&m.A[i0].x), tri.a1 = _mm_loadu_ps(&m.A[i1].x);
+            tri.a2 = _mm_loadu_ps(&m.A[i2].x);
+        }
     }
 };
 
@@ -388,6 +418,11 @@ void Interpolate(const CachedTriangle& tri, float b1, float b2, F4& p, F4& nSum)
     const F4 w0 = Set4(b0), w1 = Set4(b1), w2 = Set4(b2);
     p = Interpolate3(w0, w1, w2, tri.p0, tri.p1, tri.p2);
     nSum = Interpolate3(w0, w1, w2, tri.n0, tri.n1, tri.n2);
+}
+
+// Vertex attributes at barycentrics (1 − b1 − b2, b1, b2) of triangle tri.
+F4 InterpolateAttributes(const CachedTriangle& tri, float b1, float b2) {
+    return Interpolate3(Set4(1.0f - b1 - b2), Set4(b1), Set4(b2), tri.a0, tri.a1, tri.a2);
 }
 
 // One frame's lighting and shading constants.
@@ -539,7 +574,8 @@ class BlockClassifier {
             cMin = std::min(cMin, c), cMax = std::max(cMax, c);
         }
         if (!CosSpreadSmall(cMin, cMax, std::sqrt(Dot3(toEye, toEye)))) return false;
-        const size_t e = AddSea(k | kPixelEntry, p, nSum);
+        const size_t e =
+            AddSea(k | kPixelEntry, p, nSum, InterpolateAttributes(tri, b1Sum * inv, b2Sum * inv));
         if (tri.shadowable) {
             F4 samples[kMaxSupersampling * kMaxSupersampling], unused;
             for (int s = 0; s < count; ++s) Interpolate(tri, b1[s], b2[s], samples[s], unused);
@@ -554,7 +590,7 @@ class BlockClassifier {
         const int n = g_.n, count = n * n;
         if (!DepthsClose(x0)) return false;
         F4 p[kMaxSupersampling * kMaxSupersampling], nrm[kMaxSupersampling * kMaxSupersampling];
-        F4 pSum = _mm_setzero_ps(), nSum = _mm_setzero_ps();
+        F4 pSum = _mm_setzero_ps(), nSum = _mm_setzero_ps(), aSum = _mm_setzero_ps();
         bool shadowable = false;
         for (int j = 0; j < n; ++j) {
             for (int i = 0; i < n; ++i) {
@@ -562,6 +598,8 @@ class BlockClassifier {
                 const int s = j * n + i;
                 const CachedTriangle& tri = Triangle(g_.vis.primitive[index]);
                 Interpolate(tri, g_.vis.b1[index], g_.vis.b2[index], p[s], nrm[s]);
+                aSum = _mm_add_ps(aSum,
+                                  InterpolateAttributes(tri, g_.vis.b1[index], g_.vis.b2[index]));
                 shadowable |= tri.shadowable;
                 pSum = _mm_add_ps(pSum, p[s]);
                 nSum = _mm_add_ps(nSum, nrm[s]);
@@ -575,22 +613,25 @@ class BlockClassifier {
             cMin = std::min(cMin, c), cMax = std::max(cMax, c);
         }
         if (!CosSpreadSmall(cMin, cMax, std::sqrt(Dot3(toEye, toEye)))) return false;
-        const size_t e = AddSea(k | kPixelEntry, mean, nSum);
+        const size_t e =
+            AddSea(k | kPixelEntry, mean, nSum, _mm_mul_ps(aSum, Set4(1.0f / float(count))));
         if (shadowable) SeaShadowRays(e, p, count);
         return true;
     }
 
     // A lit sea entry at position p with normal nSum (normalized here); returns its index.
-    size_t AddSea(uint32_t k, F4 p, F4 nSum) {
+    size_t AddSea(uint32_t k, F4 p, F4 nSum, F4 attributes) {
         // glm::normalize: v · (1 / √(v·v)).
         const F4 inv = _mm_div_ss(Set4(1.0f), _mm_sqrt_ss(_mm_set_ss(Dot3(nSum, nSum))));
-        alignas(16) float pf[4], nf[4];
+        alignas(16) float pf[4], nf[4], af[4];
         _mm_store_ps(pf, p);
+        _mm_store_ps(af, attributes);
         _mm_store_ps(nf, _mm_mul_ps(nSum, _mm_shuffle_ps(inv, inv, 0)));
         const size_t e = sc_.seaCount++;
         sc_.seaK[e] = k;
         sc_.seaPx[e] = pf[0], sc_.seaPy[e] = pf[1], sc_.seaPz[e] = pf[2];
         sc_.seaNx[e] = nf[0], sc_.seaNy[e] = nf[1], sc_.seaNz[e] = nf[2];
+        sc_.seaDepth[e] = af[0], sc_.seaWet[e] = af[1], sc_.seaFoam[e] = af[2];
         sc_.seaLit[e] = 1.0f;
         sc_.seaUnlit[e] = 0;
         return e;
@@ -622,7 +663,8 @@ class BlockClassifier {
         F4 p, nSum;
         Interpolate(tri, g_.vis.b1[index], g_.vis.b2[index], p, nSum);
         if (tri.mesh == 0) {
-            const size_t e = AddSea(k, p, nSum);
+            const size_t e =
+                AddSea(k, p, nSum, InterpolateAttributes(tri, g_.vis.b1[index], g_.vis.b2[index]));
             if (tri.shadowable) SeaShadowRays(e, &p, 1);
             return;
         }
@@ -715,7 +757,7 @@ void ShadeSea(const FrameShading& f, const FrameGeometry& g, BlockScratch& sc, f
         SeaChunk& ch = sc.chunk;
         std::copy_n(&sc.seaLit[c], count, ch.sunVis);
         f.sea.Shade(count, &sc.seaPx[c], &sc.seaPy[c], &sc.seaPz[c], &sc.seaNx[c], &sc.seaNy[c],
-                    &sc.seaNz[c], ch);
+                    &sc.seaNz[c], &sc.seaDepth[c], &sc.seaWet[c], &sc.seaFoam[c], ch);
         for (size_t i = 0; i < count; ++i)
             Splat(out, sc.seaK[c + i], g.sampleWidth, g.n, ch.outR[i], ch.outG[i], ch.outB[i]);
     }
@@ -754,6 +796,19 @@ OtwChannel::OtwChannel(const scene::World& world, const scene::ChannelSettings& 
       plumes_(std::make_unique<ChannelPlumes>(world)) {
     for (const scene::EntityState& e : world.State(0).entities)
         reflectance_.push_back(e.reflectanceRgb);
+    // Surf-zone optics per colour channel. Reflectances from configs/materials.yaml (sand_wet,
+    // sand_dry: Oke 1987; foam: Whitlock, Bartlett & Gurganus 1982) when the scenario's material
+    // library has them, else the same published values.
+    const scene::Scenario& scenario = world.GetScenario();
+    const auto reflectance = [&](const char* name, glm::dvec3 published) {
+        const scene::MaterialSettings* m = scenario.FindMaterial(name);
+        return m ? m->reflectanceRgb : published;
+    };
+    const glm::dvec3 wet = reflectance("sand_wet", {0.28, 0.24, 0.17});
+    const glm::dvec3 dry = reflectance("sand_dry", {0.45, 0.39, 0.30});
+    const glm::dvec3 foam = reflectance("foam", {0.50, 0.53, 0.55});
+    for (int c = 0; c < 3; ++c)
+        shore_[c] = {kSeaRrs[c], kCoastalK_perm[c], float(wet[c]), float(dry[c]), float(foam[c])};
     stars_ = scene::LoadStarCatalog(scene::DefaultStarCatalogPath());
 }
 
@@ -873,7 +928,9 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
                     cam.TanHalfV(),
                     glm::vec3(0.0f)};
     g.colStep = glm::vec3(g.R * glm::dvec3(2.0 * g.tanH / sw, 0.0, 0.0));
-    g.meshes.push_back({ocean.positions.data(), ocean.normals.data(), ocean.indices.data()});
+    CHECK(geometry_.OceanAttributes().size() == ocean.positions.size());
+    g.meshes.push_back({ocean.positions.data(), ocean.normals.data(), ocean.indices.data(),
+                        geometry_.OceanAttributes().data()});
     for (const scene::TriangleMesh& m : geometry_.EntityMeshes())
         g.meshes.push_back({m.positions.data(), m.normals.data(), m.indices.data()});
 
@@ -896,8 +953,17 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
                          sky,
                          occlusion,
                          RayBoxTest(geometry_.CasterMin(), geometry_.CasterMax(), key.dir),
-                         SeaShading{eye, key.dir, key.E, downwelling, beta,
-                                    CoxMunkSlopeVariance(env.windSpeed_mps), fresnel, sky},
+                         SeaShading{eye,
+                                    key.dir,
+                                    key.E,
+                                    downwelling,
+                                    beta,
+                                    CoxMunkSlopeVariance(env.windSpeed_mps),
+                                    fresnel,
+                                    sky,
+                                    skyE,
+                                    &fill,
+                                    {shore_[0], shore_[1], shore_[2]}},
                          reflectance_};
 
     if (radiance.width != sw || radiance.height != sh || radiance.channels != 3)

@@ -5,6 +5,7 @@
 #include <memory>
 #include <vector>
 
+#include "channels/otw/shore_shading.h"
 #include "channels/view/view_geometry.h"
 #include "radiometry/sky/analytic_sky.h"
 #include "scene/core/image.h"
@@ -53,6 +54,7 @@ class OtwChannel {
     scene::ChannelSettings settings_;
     ViewGeometry geometry_;
     std::vector<glm::dvec3> reflectance_;  // per entity
+    ShoreChannel shore_[3];                // surf-zone optics per colour channel
     // The sky table depends only on the sun's and moon's directions and turbidity: rebuilt
     // when the quantized sun or moon direction changes.
     std::unique_ptr<radiometry::AnalyticSky> sky_;

@@ -2,12 +2,15 @@
 // channel renderers (moved unchanged out of the OTW channel).
 #include "channels/view/view_geometry.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
 
 #include "scene/core/check.h"
+#include "scene/surf/foam.h"
 
 namespace seasense::channels {
 
@@ -129,6 +132,48 @@ void ViewGeometry::UpdateCasterBounds() {
     casterMax_ = hi + margin_m;
 }
 
+void ViewGeometry::UpdateOceanAttributes(double time_s) {
+    const scene::OceanSurfaceFrame& sea = *oceanFrame_;
+    const scene::SurfWaves* surf = sea.Surf();
+    const double threshold = world_.GetScenario().environment.ocean.foamThreshold;
+    oceanAttributes_.resize(ocean_.positions.size());
+    const int rings = ocean_.rings;
+    const int columns = ocean_.fullCircle ? ocean_.segments : ocean_.segments + 1;
+    if (rings == 0) return;
+    CHECK(size_t(rings) * size_t(columns) == ocean_.positions.size());
+    const double dphi = 2.0 * M_PI / double(ocean_.circleSegments);
+    const glm::dvec3 eye = camera_.worldFromCamera.position_m;
+    tbb::parallel_for(0, rings, [&](int j) {
+        const double radius = ocean_.radii_m[size_t(j)];
+        const double drop = scene::CurvatureDrop_m(radius);
+        for (int i = 0; i < columns; ++i) {
+            const size_t v = size_t(j) * size_t(columns) + size_t(i);
+            glm::vec4 a(std::numeric_limits<float>::infinity(), 0.0f,
+                        float(scene::WhitecapCoverage(ocean_.jacobian[v], threshold)), 0.0f);
+            if (surf) {
+                const scene::Bathymetry& bathy = surf->Bathy();
+                const glm::vec3& p = ocean_.positions[v];
+                // The seabed under the drawn (displaced) point, dropped by the same curvature.
+                const double bed = bathy.SeabedZ_m(p.x, p.y);
+                a.x = float(std::max(0.0, double(p.z) + drop - bed));
+                // Sand at or below high water has been wet by the last tide; above it dries over
+                // the swash's run-up (taken as 0.3 m of elevation).
+                a.y = float(std::clamp(1.0 - (bed - bathy.Settings().highTide_m) / 0.3, 0.0, 1.0));
+                // Surf foam only where the surf components are drawn (depth below the fade).
+                const double az = dphi * double(ocean_.firstColumn + i);
+                const double x0 = eye.x + radius * std::sin(az), y0 = eye.y + radius * std::cos(az);
+                if (bathy.Depth_m(x0, y0) < surf->FadeDeep_m()) {
+                    scene::SurfPointInfo info;
+                    surf->Terms(x0, y0, time_s, &info);
+                    a.z = std::max(a.z, float(scene::SurfFoamCoverage(info, x0, y0, time_s,
+                                                                      bathy.Settings().foam)));
+                }
+            }
+            oceanAttributes_[v] = a;
+        }
+    });
+}
+
 void ViewGeometry::Update(const scene::SceneState& state) {
     camera_ = MakeChannelCamera(state.eyepoint, settings_);
     const ChannelCamera& cam = camera_;
@@ -150,6 +195,7 @@ void ViewGeometry::Update(const scene::SceneState& state) {
     FrustumAzimuthSector(cam, 20.0 * M_PI / 180.0, req.azimuthMin_rad, req.azimuthMax_rad);
     req.minRange_m = NearestVisibleSeaRange_m(cam, sea.MaxHeight_m(), sea.MaxHorizontal_m());
     scene::BuildOceanMesh(sea, req, ocean_);
+    UpdateOceanAttributes(state.time_s);
 
     std::vector<RasterMesh> meshes;
     // The sea is seen from both sides only when a camera dips below it; cull back faces.

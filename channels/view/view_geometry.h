@@ -20,7 +20,7 @@ struct ViewFrameStats {
     uint64_t oceanTriangles = 0;
     uint64_t modelTriangles = 0;
     double oceanMs = 0.0;   // sea surface synthesis for the frame time (0 when already made)
-    double meshMs = 0.0;    // sea mesh for the view
+    double meshMs = 0.0;    // sea mesh for the view, with its vertex attributes
     double rasterMs = 0.0;  // visibility buffer
     RasterStats raster;
 };
@@ -40,6 +40,11 @@ class ViewGeometry {
     // the (i−1)-th entity.
     const VisibilityBuffer& Visibility() const { return vis_; }
     const scene::OceanMesh& Ocean() const { return ocean_; }
+    // Per sea-mesh vertex (same indexing as Ocean().positions): x the water column above the
+    // seabed (m, 0 where the sea lies on the beach; +∞ without a surf zone), y the wetness of
+    // the sand there (1 at or below high water, 0 on dry sand), z the foam coverage in [0, 1]
+    // (surf-zone foam and deep-water whitecaps), w unused (0).
+    const std::vector<glm::vec4>& OceanAttributes() const { return oceanAttributes_; }
     // The sea surface of the last frame (the mesh's source; DetailNormal for shading).
     const scene::OceanSurfaceFrame& OceanFrame() const { return *oceanFrame_; }
     // Entity meshes in the world frame (ENU metres) at the last frame's poses.
@@ -64,7 +69,10 @@ class ViewGeometry {
     std::vector<scene::Pose> entityPoses_;          // the poses worldMeshes_ were built at
     std::vector<uint32_t> occlusionIds_;            // Embree geometry of each entity
     glm::vec3 casterMin_{0.0f}, casterMax_{0.0f};
+    void UpdateOceanAttributes(double time_s);
+
     scene::OceanMesh ocean_;
+    std::vector<glm::vec4> oceanAttributes_;
     std::shared_ptr<const scene::OceanSurfaceFrame> oceanFrame_;
     VisibilityBuffer vis_;
     ViewFrameStats stats_;

@@ -1,6 +1,7 @@
 // The validating reader of environment.ocean.surf.
 #include "scene/surf/surf_settings.h"
 
+#include <limits>
 #include <numbers>
 #include <string>
 
@@ -99,6 +100,20 @@ SurfSettings ParseSurfSettings(ConfigMap& map, const std::filesystem::path& fold
         if (s.tide_m <= -oceanDepth_m)
             tide->Fail("a tide above the ocean floor (> -environment.ocean.depth_m = " +
                        FormatNumber(-oceanDepth_m) + ")");
+    }
+
+    if (const std::optional<ConfigValue> foam = map.Find("foam")) {
+        ReadMap(*foam, [&](ConfigMap& m) {
+            FoamSettings& f = s.foam;
+            f.persistence_s =
+                m.GetDouble("persistence_s", NumberRange::Positive("s"), f.persistence_s);
+            f.streakWidth_m =
+                m.GetDouble("streak_width_m", NumberRange::Positive("m"), f.streakWidth_m);
+            f.streakElongation = m.GetDouble("streak_elongation", NumberRange::Closed(1.0, 100.0),
+                                             f.streakElongation);
+            f.seed =
+                uint64_t(m.GetInt("seed", 0, std::numeric_limits<int64_t>::max(), int64_t(f.seed)));
+        });
     }
 
     if (const std::optional<ConfigValue> grid = map.Find("depth_grid")) {

@@ -67,6 +67,20 @@ struct DepthGridSettings {
     std::shared_ptr<const DepthGrid> grid;  // read by the scenario reader
 };
 
+// environment.ocean.surf.foam: the white water the breakers leave (scene/surf/foam.h).
+struct FoamSettings {
+    // e-folding time (s) of the foam left behind the breaker line: bubble plumes and surface foam
+    // of breaking waves decay in seconds to tens of seconds (Callaghan, Deane & Stokes 2013,
+    // J. Phys. Oceanogr. 43: foam e-folding times ~ 1-10 s for individual whitecaps; surf-zone
+    // foam lingers longer).
+    double persistence_s = 8.0;
+    // Size (m) of the streaks the foam breaks into, across the direction of travel, and their
+    // elongation along it (length / width).
+    double streakWidth_m = 3.0;
+    double streakElongation = 4.0;
+    uint64_t seed = 1;  // seeds the streak pattern
+};
+
 struct SurfSettings {
     ShorelineSettings shoreline;
     double tide_m = 0.0;  // water level above mean sea level
@@ -84,6 +98,7 @@ struct SurfSettings {
     double offshoreSlope = 0.05;
     std::vector<SurfRegionSettings> regions;  // empty: a plane beach without bars
     std::optional<DepthGridSettings> depthGrid;
+    FoamSettings foam;
 };
 
 // Reads the environment.ocean.surf mapping (every key documented in docs/configuration.md);

@@ -1,0 +1,88 @@
+// Tests of the surf-zone shading: seabed through shallow water (Beer–Lambert along the refracted
+// path), wet sand at zero depth, foam as a Lambertian layer.
+#include "channels/otw/shore_shading.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace seasense::channels {
+namespace {
+
+using namespace simd4;
+
+float Lane0(F4 v) { return _mm_cvtss_f32(v); }
+
+const ShoreChannel kChannel{0.0f, 0.2f, 0.25f, 0.40f, 0.55f};
+
+// A flat sea over a plane sandy bottom seen at 40° from the normal: with no deep-water colour
+// (R_rs = 0) and no reflected sky, the radiance is (1 − F) ρ_wet E/π e^{−K d (1 + 1/cos θ_t)},
+// θ_t from Snell's law (sin θ_t = sin θ_v / n).
+TEST(ShoreShading, BottomAttenuationFollowsRefractedPath) {
+    const double thetaV = 40.0 * M_PI / 180.0, n = 1.34;
+    const double thetaT = std::asin(std::sin(thetaV) / n);
+    const float E = 50000.0f, oneMinusF = 0.97f;
+    const F4 path = WaterPathFactor4(Set4(float(std::cos(thetaV))), float(n));
+    for (double d : {0.5, 2.0, 5.0}) {
+        const float L =
+            Lane0(ShoreRadiance4(kChannel, Set4(0.0f), Set4(oneMinusF), path, Set4(float(d)),
+                                 Set4(1.0f), Set4(0.0f), Set4(E), Set4(E)));
+        const double expected =
+            oneMinusF * 0.25 * E / M_PI * std::exp(-0.2 * (d + d / std::cos(thetaT)));
+        EXPECT_NEAR(L / expected, 1.0, 0.01) << "depth " << d;
+    }
+    // Seen steeply the water is more transparent: the path is shorter.
+    const F4 steep = WaterPathFactor4(Set4(1.0f), float(n));
+    EXPECT_GT(Lane0(ShoreRadiance4(kChannel, Set4(0.0f), Set4(oneMinusF), steep, Set4(2.0f),
+                                   Set4(1.0f), Set4(0.0f), Set4(E), Set4(E))),
+              Lane0(ShoreRadiance4(kChannel, Set4(0.0f), Set4(oneMinusF), path, Set4(2.0f),
+                                   Set4(1.0f), Set4(0.0f), Set4(E), Set4(E))));
+}
+
+// As the depth goes to 0 the water's radiance goes continuously to that of wet sand, ρ_wet E/π;
+// in deep water it goes to the water-leaving radiance R_rs E_d plus the reflection.
+TEST(ShoreShading, ShallowWaterTendsToWetSandAndDeepWaterToSeaColour) {
+    ShoreChannel c = kChannel;
+    c.rrs = 0.002f;
+    const float E = 30000.0f, Ed = 28000.0f, reflected = 40.0f, oneMinusF = 0.95f;
+    const F4 path = WaterPathFactor4(Set4(0.6f), 1.34f);
+    const auto L = [&](float d) {
+        return Lane0(ShoreRadiance4(c, Set4(reflected), Set4(oneMinusF), path, Set4(d), Set4(1.0f),
+                                    Set4(0.0f), Set4(E), Set4(Ed)));
+    };
+    const float wetSand = 0.25f * E / float(M_PI);
+    EXPECT_NEAR(L(0.0f), wetSand, 1e-3f * wetSand);
+    float previous = L(0.0f);
+    for (float d = 0.001f; d < 0.1f; d += 0.001f) {
+        // No jump: successive millimetres change the radiance by well under 10 %.
+        EXPECT_LT(std::abs(L(d) - previous), 0.1f * wetSand) << d;
+        previous = L(d);
+    }
+    EXPECT_NEAR(L(kDeepColumn_m), reflected + oneMinusF * c.rrs * Ed, 1e-3f);
+    // Dry sand (wetness 0) is brighter than wet sand under the same light.
+    EXPECT_NEAR(Lane0(ShoreRadiance4(c, Set4(0.0f), Set4(1.0f), path, Set4(0.0f), Set4(0.0f),
+                                     Set4(0.0f), Set4(E), Set4(Ed))),
+                0.40f * E / float(M_PI), 1e-3f * E);
+}
+
+// Full foam coverage renders at the foam reflectance's Lambertian radiance ρ E / π whatever
+// lies below; half coverage is the mean of foam and water.
+TEST(ShoreShading, FoamIsLambertianLayer) {
+    const float E = 80000.0f;
+    const F4 path = WaterPathFactor4(Set4(0.8f), 1.34f);
+    for (float d : {0.0f, 1.0f, kDeepColumn_m}) {
+        const float L = Lane0(ShoreRadiance4(kChannel, Set4(30.0f), Set4(0.97f), path, Set4(d),
+                                             Set4(1.0f), Set4(1.0f), Set4(E), Set4(E)));
+        EXPECT_NEAR(L, 0.55f * E / float(M_PI), 1e-5f * E);
+    }
+    const float water =
+        Lane0(ShoreRadiance4(kChannel, Set4(30.0f), Set4(0.97f), path, Set4(kDeepColumn_m),
+                             Set4(1.0f), Set4(0.0f), Set4(E), Set4(E)));
+    const float half =
+        Lane0(ShoreRadiance4(kChannel, Set4(30.0f), Set4(0.97f), path, Set4(kDeepColumn_m),
+                             Set4(1.0f), Set4(0.5f), Set4(E), Set4(E)));
+    EXPECT_NEAR(half, 0.5f * (water + 0.55f * E / float(M_PI)), 1e-4f * E);
+}
+
+}  // namespace
+}  // namespace seasense::channels
