@@ -148,8 +148,12 @@ void ViewGeometry::UpdateOceanAttributes(double time_s) {
         const double drop = scene::CurvatureDrop_m(radius);
         for (int i = 0; i < columns; ++i) {
             const size_t v = size_t(j) * size_t(columns) + size_t(i);
-            glm::vec4 a(std::numeric_limits<float>::infinity(), 0.0f,
-                        float(scene::WhitecapCoverage(ocean_.jacobian[v], threshold)), 0.0f);
+            // Without a surf zone the column is optically deep: 1e4 m, where the seabed's share
+            // e^(−K·depth) is 0 in float for any water. Finite, because the rasterizer
+            // interpolates attributes with barycentric weights that can be exactly 0, and
+            // 0 · ∞ is NaN.
+            glm::vec4 a(1.0e4f, 0.0f, float(scene::WhitecapCoverage(ocean_.jacobian[v], threshold)),
+                        0.0f);
             if (surf) {
                 const scene::Bathymetry& bathy = surf->Bathy();
                 const glm::vec3& p = ocean_.positions[v];

@@ -41,7 +41,7 @@ class ViewGeometry {
     const VisibilityBuffer& Visibility() const { return vis_; }
     const scene::OceanMesh& Ocean() const { return ocean_; }
     // Per sea-mesh vertex (same indexing as Ocean().positions): x the water column above the
-    // seabed (m, 0 where the sea lies on the beach; +∞ without a surf zone), y the wetness of
+    // seabed (m, 0 where the sea lies on the beach; 1e4 without a surf zone), y the wetness of
     // the sand there (1 at or below high water, 0 on dry sand), z the foam coverage in [0, 1]
     // (surf-zone foam and deep-water whitecaps), w unused (0).
     const std::vector<glm::vec4>& OceanAttributes() const { return oceanAttributes_; }
