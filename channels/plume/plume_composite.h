@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "channels/camera/channel_camera.h"
+#include "channels/plume/plume_bins.h"
 #include "channels/raster/rasterizer.h"
 #include "radiometry/planck/planck.h"
 #include "radiometry/sky/analytic_sky.h"
@@ -72,6 +73,7 @@ struct PlumeLighting {
 struct PlumeCompositeStats {
     uint64_t pixelsCovered = 0;  // output pixels inside some plume's screen bounds
     uint64_t traces = 0;         // rays traced (one per covered pixel, two at depth edges)
+    uint64_t puffTests = 0;      // puffs looked at by those traces (their lists' lengths)
     double ms = 0.0;             // bounds, traces and compositing
 };
 

@@ -169,6 +169,7 @@ void CompositeFrames(benchmark::State& state, const PlumeField& field, const glm
     state.counters["puffs"] = double(field.PuffCount());
     state.counters["covered_pixels"] = double(stats.pixelsCovered);
     state.counters["traces"] = double(stats.traces);
+    state.counters["puff_tests"] = double(stats.puffTests);
 }
 
 // All twenty plumes of TwentyPlumes in view from (0, −2500, 40).

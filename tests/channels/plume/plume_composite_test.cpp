@@ -150,12 +150,21 @@ TEST(PlumeComposite, PixelsOutsideThePlumesAreUntouched) {
     CompositePlumes(empty, cam, vis, light, same);
     EXPECT_EQ(std::memcmp(same.pixels.data(), before.pixels.data(), before.pixels.size() * 4), 0);
 
-    // A small puff right of centre: changes inside its 3.5 σ cone, none elsewhere.
+    // A small puff right of centre: changes inside the cone where its optical depth can exceed
+    // the tolerance, none elsewhere. Along a ray missing the centre by m σ the optical depth
+    // is τ_c e^(−m²/2), τ_c = α M / (2π σ²) through the centre of a spherical puff, so the
+    // cone's half-width is √(2 ln(τ_c / tolerance)) σ (a sample ray lies within a pixel, under
+    // 1 σ here, of its pixel's centre ray).
     scene::Puff puff;
     puff.centre_m = {30.0, 500.0, 10.0};
     puff.sigmaH_m = puff.sigmaZ_m = 5.0;
     puff.mass_kg = 0.1;
     const scene::PlumeField field = OnePlume(scene::PlumeKind::Smoke, 0.3, {puff});
+    const double tauCentre =
+        scene::KindOptics(scene::PlumeKind::Smoke, 0.3).massExtinction_m2pkg[0] * puff.mass_kg /
+        (2.0 * std::numbers::pi * puff.sigmaH_m * puff.sigmaH_m);
+    const double cone = std::sqrt(2.0 * std::log(tauCentre / kPlumeTransmittanceTolerance));
+    ASSERT_GT(cone, 3.0);
     Image after = before;
     CompositePlumes(field, cam, vis, light, after);
     int changed = 0;
@@ -167,7 +176,7 @@ TEST(PlumeComposite, PixelsOutsideThePlumesAreUntouched) {
             const double miss = glm::length(q - glm::dot(q, d) * d) / puff.sigmaH_m;
             const bool differs = std::memcmp(after.At(x, y), before.At(x, y), 12) != 0;
             changed += differs;
-            if (miss > scene::kPuffCutoffSigmas + 0.5) {
+            if (miss > cone + 1.0) {
                 EXPECT_FALSE(differs) << x << ", " << y;
             }
         }
@@ -230,8 +239,8 @@ TEST(PlumeComposite, SameImageForOneAndTwoThreads) {
               ptrdiff_t(one.pixels.size()));
 }
 
-// Pixels whose trace comes from the interpolation grid stay within the grid's optical-depth
-// tolerance (0.02) of a ray traced through the pixel itself.
+// Pixels whose trace comes from the interpolation grid stay within 0.02 in transmittance (the
+// grid's optical-depth tolerance) of the exact sum over the puffs along the pixel's own ray.
 TEST(PlumeComposite, InterpolatedPixelsMatchTheirOwnTraces) {
     const glm::dvec3 eye{0.0, 0.0, 10.0};
     const ChannelCamera cam = NorthCamera(eye, 160, 120, 1);
@@ -246,6 +255,7 @@ TEST(PlumeComposite, InterpolatedPixelsMatchTheirOwnTraces) {
         puffs.push_back(p);
     }
     const scene::PlumeField field = OnePlume(scene::PlumeKind::Smoke, 0.3, puffs);
+    const double alpha = scene::KindOptics(scene::PlumeKind::Smoke, 0.3).massExtinction_m2pkg[0];
     Image image(cam.SampleWidth(), cam.SampleHeight(), 3);
     std::fill(image.pixels.begin(), image.pixels.end(), 1.0f);
     const PlumeCompositeStats stats = CompositePlumes(field, cam, vis, Dark(), image);
@@ -256,8 +266,12 @@ TEST(PlumeComposite, InterpolatedPixelsMatchTheirOwnTraces) {
     for (int y = 0; y < cam.height; ++y) {
         for (int x = 0; x < cam.width; ++x) {
             const glm::vec3 d(cam.SampleDirection(x, y));
-            const double T = field.Trace(glm::vec3(eye), d, kPlumeSkyRange_m)
-                                 .Transmittance(ObscurantBand::Visible);
+            double tau = 0.0;
+            for (const scene::Puff& p : puffs)
+                tau += alpha * scene::GaussianPuffLineIntegral_kgpm2(
+                                   p.centre_m, p.sigmaH_m, p.sigmaZ_m, p.mass_kg, eye,
+                                   glm::dvec3(d), kPlumeSkyRange_m);
+            const double T = std::exp(-tau);
             worst = std::max(worst, std::abs(double(image.At(x, y)[0]) - T));
             dark += T < 0.9;
         }
