@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <numbers>
 
@@ -79,23 +80,22 @@ PlumeScreenBins::PlumeScreenBins(const scene::PlumeField& field, const ChannelCa
         const double hot = T >= double(scene::kHotPuff_K) ? 1.0 - omega : 0.0;
         kept_.push_back(uint32_t(i));
         rect_.push_back(rect);
-        qx_.push_back(float(eye.x - c.x));
-        qy_.push_back(float(eye.y - c.y));
-        qz_.push_back(float(eye.z - c.z));
-        invVarH_.push_back(puffs.invVarH[i]);
-        invVarZ_.push_back(puffs.invVarZ[i]);
-        cutoff2_.push_back(float(r2));
-        kappa_.push_back(float(alpha * double(puffs.peak_kgpm3[i]) * halfSqrtPi));
-        // Float margins: a little nearer and farther than the box.
-        near_.push_back(float(nearest * 0.999));
+        const float values[kFields] = {
+            float(eye.x - c.x), float(eye.y - c.y), float(eye.z - c.z), puffs.invVarH[i],
+            puffs.invVarZ[i], float(r2), float(alpha * double(puffs.peak_kgpm3[i]) * halfSqrtPi),
+            // Float margins: a little nearer and farther than the box.
+            float(nearest * 0.999), float(omega), float((1.0 - omega) * T), float(hot),
+            float(hot * T), float(omega * optics.asymmetry)};
+        for (int f = 0; f < kFields; ++f) data_[f].push_back(values[f]);
         far_.push_back(float(far * 1.001 + 1.0));
-        wScatter_.push_back(float(omega));
-        wAbsT_.push_back(float((1.0 - omega) * T));
-        wHot_.push_back(float(hot));
-        wHotT_.push_back(float(hot * T));
-        wG_.push_back(float(omega * optics.asymmetry));
         sigmaPixels_.push_back(float(sigmaPixels));
     }
+
+    // The inert puff: a unit sphere at the eye with a negative cutoff, beyond every range.
+    inert_ = uint32_t(kept_.size());
+    const float inert[kFields] = {0, 0, 0, 1, 1, -1, 0, std::numeric_limits<float>::infinity(),
+                                  0, 0, 0, 0, 0};
+    for (int f = 0; f < kFields; ++f) data_[f].push_back(inert[f]);
 
     // Counting sort of (tile, kept position) pairs: per tile in increasing kept position.
     tileStart_.assign(size_t(tilesX_) * size_t(tilesY_) + 1, 0);
@@ -119,7 +119,8 @@ int PlumeScreenBins::TileOf(int px, int py) const {
     return (py / kTile) * tilesX_ + px / kTile;
 }
 
-void PlumeScreenBins::Gather(int x0, int y0, int x1, int y1, float smallPixels, List& out) const {
+void PlumeScreenBins::Gather(int x0, int y0, int x1, int y1, float smallPixels, bool copy,
+                             List& out) const {
     out.count = 0;
     out.index.clear();
     out.near_m = std::numeric_limits<float>::infinity();
@@ -146,7 +147,7 @@ void PlumeScreenBins::Gather(int x0, int y0, int x1, int y1, float smallPixels, 
             const Rect& r = rect_[k];
             if (r.x1 <= x0 || r.x0 >= x1 || r.y1 <= y0 || r.y0 >= y1) return;
             out.index.push_back(k);
-            out.near_m = std::min(out.near_m, near_[k]);
+            out.near_m = std::min(out.near_m, data_[kNear][k]);
             out.far_m = std::max(out.far_m, far_[k]);
             out.small |= sigmaPixels_[k] < smallPixels;
         };
@@ -166,35 +167,21 @@ void PlumeScreenBins::Gather(int x0, int y0, int x1, int y1, float smallPixels, 
     }
     out.count = out.index.size();
     const size_t padded = (out.count + 3) & ~size_t(3);
-    for (std::vector<float>* v :
-         {&out.qx, &out.qy, &out.qz, &out.invVarH, &out.invVarZ, &out.cutoff2, &out.kappa,
-          &out.nearest_m, &out.wScatter, &out.wAbsT, &out.wHot, &out.wHotT, &out.wG})
-        v->resize(padded);
-    for (size_t j = 0; j < out.count; ++j) {
-        const uint32_t k = out.index[j];
-        out.qx[j] = qx_[k];
-        out.qy[j] = qy_[k];
-        out.qz[j] = qz_[k];
-        out.invVarH[j] = invVarH_[k];
-        out.invVarZ[j] = invVarZ_[k];
-        out.cutoff2[j] = cutoff2_[k];
-        out.kappa[j] = kappa_[k];
-        out.nearest_m[j] = near_[k];
-        out.wScatter[j] = wScatter_[k];
-        out.wAbsT[j] = wAbsT_[k];
-        out.wHot[j] = wHot_[k];
-        out.wHotT[j] = wHotT_[k];
-        out.wG[j] = wG_[k];
+    out.index.resize(padded, inert_);
+    out.copied = false;
+    if (copy) Copy(out);
+}
+
+void PlumeScreenBins::Copy(List& list) const {
+    static_assert(std::size(decltype(List::data){}) == kFields);
+    if (list.copied) return;
+    for (int f = 0; f < kFields; ++f) {
+        std::vector<float>& v = list.data[f];
+        v.resize(list.index.size());
+        const float* src = data_[f].data();
+        for (size_t j = 0; j < list.index.size(); ++j) v[j] = src[list.index[j]];
     }
-    // Inert padding: a unit sphere at the eye that no ray may use (cutoff below 0).
-    for (size_t j = out.count; j < padded; ++j) {
-        out.qx[j] = out.qy[j] = out.qz[j] = 0.0f;
-        out.invVarH[j] = out.invVarZ[j] = 1.0f;
-        out.cutoff2[j] = -1.0f;
-        out.kappa[j] = 0.0f;
-        out.nearest_m[j] = std::numeric_limits<float>::infinity();
-        out.wScatter[j] = out.wAbsT[j] = out.wHot[j] = out.wHotT[j] = out.wG[j] = 0.0f;
-    }
+    list.copied = true;
 }
 
 namespace {
@@ -260,16 +247,17 @@ struct BandAccumulator {
        absorptionT = _mm_setzero_ps(), hotAbsorption = _mm_setzero_ps(),
        hotAbsorptionT = _mm_setzero_ps(), scatteringG = _mm_setzero_ps();
 
-    void Add(const PlumeScreenBins::List& l, size_t k, F4 tau) {
-        const F4 ws = _mm_loadu_ps(&l.wScatter[k]);
+    // Weights w[0..4]: scattering, absorption × T, hot absorption, hot absorption × T,
+    // scattering × g per unit optical depth.
+    void Add(const F4 (&w)[5], F4 tau) {
         extinction = _mm_add_ps(extinction, tau);
-        const F4 scattered = _mm_mul_ps(tau, ws);
+        const F4 scattered = _mm_mul_ps(tau, w[0]);
         scattering = _mm_add_ps(scattering, scattered);
         absorption = _mm_add_ps(absorption, _mm_sub_ps(tau, scattered));
-        absorptionT = _mm_add_ps(absorptionT, _mm_mul_ps(tau, _mm_loadu_ps(&l.wAbsT[k])));
-        hotAbsorption = _mm_add_ps(hotAbsorption, _mm_mul_ps(tau, _mm_loadu_ps(&l.wHot[k])));
-        hotAbsorptionT = _mm_add_ps(hotAbsorptionT, _mm_mul_ps(tau, _mm_loadu_ps(&l.wHotT[k])));
-        scatteringG = _mm_add_ps(scatteringG, _mm_mul_ps(tau, _mm_loadu_ps(&l.wG[k])));
+        absorptionT = _mm_add_ps(absorptionT, _mm_mul_ps(tau, w[1]));
+        hotAbsorption = _mm_add_ps(hotAbsorption, _mm_mul_ps(tau, w[2]));
+        hotAbsorptionT = _mm_add_ps(hotAbsorptionT, _mm_mul_ps(tau, w[3]));
+        scatteringG = _mm_add_ps(scatteringG, _mm_mul_ps(tau, w[4]));
     }
 
     BandTrace Result() const {
@@ -292,8 +280,27 @@ struct BandAccumulator {
 // −(A s² + 2 B s + C) / 2, so ∫ over [0, S] = e^(−m²/2) (√π / 2) / √(A/2) · (erf u1 − erf u0),
 // m² the squared Mahalanobis distance of the closest approach s* = −B / A, u0 = −s* √(A/2),
 // u1 = u0 + S √(A/2).
-void PlumeScreenBins::Trace2(const List& l, const glm::vec3& dir, float range_m, float range2_m,
+void PlumeScreenBins::Trace2(const List& list, const glm::vec3& dir, float range_m, float range2_m,
                              BandTrace& first, BandTrace& second) const {
+    if (list.copied)
+        Trace2Impl<true>(list, dir, range_m, range2_m, first, second);
+    else
+        Trace2Impl<false>(list, dir, range_m, range2_m, first, second);
+}
+
+template <bool Copied>
+void PlumeScreenBins::Trace2Impl(const List& l, const glm::vec3& dir, float range_m, float range2_m,
+                                 BandTrace& first, BandTrace& second) const {
+    // Four puffs' values of field f from k on: contiguous in a copied list, else gathered.
+    const auto load = [&](int f, size_t k) {
+        if constexpr (Copied) {
+            return _mm_loadu_ps(l.data[f].data() + k);
+        } else {
+            const float* v = data_[f].data();
+            const uint32_t* i = l.index.data() + k;
+            return _mm_setr_ps(v[i[0]], v[i[1]], v[i[2]], v[i[3]]);
+        }
+    };
     BandAccumulator a1, a2;
     const bool two = range2_m != range_m;
     const F4 dx = _mm_set1_ps(dir.x), dy = _mm_set1_ps(dir.y), dz = _mm_set1_ps(dir.z);
@@ -301,11 +308,9 @@ void PlumeScreenBins::Trace2(const List& l, const glm::vec3& dir, float range_m,
     const F4 end = _mm_set1_ps(std::max(range_m, range2_m));
     const F4 r1 = _mm_set1_ps(range_m), r2 = _mm_set1_ps(range2_m);
     const F4 zero = _mm_setzero_ps(), half = _mm_set1_ps(0.5f);
-    const size_t padded = (l.count + 3) & ~size_t(3);
-    for (size_t k = 0; k < padded; k += 4) {
-        const F4 qx = _mm_loadu_ps(&l.qx[k]), qy = _mm_loadu_ps(&l.qy[k]);
-        const F4 qz = _mm_loadu_ps(&l.qz[k]);
-        const F4 ivh = _mm_loadu_ps(&l.invVarH[k]), ivz = _mm_loadu_ps(&l.invVarZ[k]);
+    for (size_t k = 0; k < l.index.size(); k += 4) {
+        const F4 qx = load(kQx, k), qy = load(kQy, k), qz = load(kQz, k);
+        const F4 ivh = load(kIvh, k), ivz = load(kIvz, k);
         const F4 A = _mm_add_ps(_mm_mul_ps(dh2, ivh), _mm_mul_ps(dz2, ivz));
         const F4 B = _mm_add_ps(_mm_mul_ps(_mm_add_ps(_mm_mul_ps(dx, qx), _mm_mul_ps(dy, qy)), ivh),
                                 _mm_mul_ps(_mm_mul_ps(dz, qz), ivz));
@@ -318,21 +323,23 @@ void PlumeScreenBins::Trace2(const List& l, const glm::vec3& dir, float range_m,
         const F4 m2 =
             _mm_add_ps(_mm_mul_ps(_mm_add_ps(_mm_mul_ps(rx, rx), _mm_mul_ps(ry, ry)), ivh),
                        _mm_mul_ps(_mm_mul_ps(rz, rz), ivz));
-        const F4 use = _mm_and_ps(_mm_cmple_ps(m2, _mm_loadu_ps(&l.cutoff2[k])),
-                                  _mm_cmplt_ps(_mm_loadu_ps(&l.nearest_m[k]), end));
+        const F4 use =
+            _mm_and_ps(_mm_cmple_ps(m2, load(kCutoff2, k)), _mm_cmplt_ps(load(kNear, k), end));
         if (_mm_movemask_ps(use) == 0) continue;
         const F4 scale = _mm_sqrt_ps(_mm_mul_ps(half, A));
         const F4 u0 = _mm_sub_ps(zero, _mm_mul_ps(sStar, scale));
         const F4 amplitude = _mm_div_ps(
-            _mm_mul_ps(_mm_loadu_ps(&l.kappa[k]), Exp4(_mm_mul_ps(_mm_set1_ps(-0.5f), m2))), scale);
+            _mm_mul_ps(load(kKappa, k), Exp4(_mm_mul_ps(_mm_set1_ps(-0.5f), m2))), scale);
         const F4 u1 = _mm_add_ps(u0, _mm_mul_ps(r1, scale));
         const F4 e0 = ErfOrSign4(u0), e1 = ErfOrSign4(u1);
+        const F4 w[5] = {load(kWs, k), load(kWAbsT, k), load(kWHot, k), load(kWHotT, k),
+                         load(kWg, k)};
         const F4 tau1 = _mm_mul_ps(amplitude, _mm_sub_ps(e1, e0));
-        a1.Add(l, k, _mm_and_ps(_mm_and_ps(use, _mm_cmpgt_ps(tau1, zero)), tau1));
+        a1.Add(w, _mm_and_ps(_mm_and_ps(use, _mm_cmpgt_ps(tau1, zero)), tau1));
         if (two) {
             const F4 e2 = ErfOrSign4(_mm_add_ps(u0, _mm_mul_ps(r2, scale)));
             const F4 tau2 = _mm_mul_ps(amplitude, _mm_sub_ps(e2, e0));
-            a2.Add(l, k, _mm_and_ps(_mm_and_ps(use, _mm_cmpgt_ps(tau2, zero)), tau2));
+            a2.Add(w, _mm_and_ps(_mm_and_ps(use, _mm_cmpgt_ps(tau2, zero)), tau2));
         }
     }
     first = a1.Result();

@@ -56,28 +56,29 @@ class PlumeScreenBins {
     size_t BinEntries() const { return tileEntries_.size(); }
 
     // The puffs whose rectangles overlap the pixel rectangle [x0, x1) × [y0, y1) (at most 2 × 2
-    // tiles), gathered as contiguous arrays for Trace, padded with inert entries to a multiple
-    // of 4; with the nearest and farthest range (m) where they can matter and whether any has
-    // σ under smallPixels pixels at its distance.
+    // tiles), in field order, padded with an inert puff to a multiple of 4; with the nearest
+    // and farthest range (m) where they can matter and whether any has σ under smallPixels
+    // pixels at its distance. With copy, their data is also gathered into contiguous arrays
+    // (worth it when the list serves many rays).
     struct List {
-        size_t count = 0;  // puffs; the arrays hold count rounded up to 4
+        size_t count = 0;  // puffs (index and the arrays hold count rounded up to 4)
         float near_m = 0.0f, far_m = 0.0f;
         bool small = false;
-        std::vector<uint32_t> index;    // kept positions, count of them
-        std::vector<float> qx, qy, qz;  // eye − centre, m
-        std::vector<float> invVarH, invVarZ, cutoff2;
-        std::vector<float> kappa;  // α peak √π / 2 (see Trace2)
-        std::vector<float> nearest_m;
-        std::vector<float> wScatter, wAbsT, wHot, wHotT, wG;
+        bool copied = false;
+        std::vector<uint32_t> index;  // kept positions
+        std::vector<float> data[13];  // per field of Arrays, when copied
         size_t size() const { return count; }
     };
-    void Gather(int x0, int y0, int x1, int y1, float smallPixels, List& out) const;
+    void Gather(int x0, int y0, int x1, int y1, float smallPixels, bool copy, List& out) const;
+    // Copies a gathered list's data (no-op when copied already).
+    void Copy(List& list) const;
     // Tile of pixel (px, py).
     int TileOf(int px, int py) const;
 
     // The trace along eye + s·dir, s in [0, range_m], over list (gathered for a pixel rectangle
     // containing the pixel that dir points through); dir must be a unit vector. With a second
-    // range range2_m ≥ range_m the trace to it goes to second in the same pass.
+    // range range2_m ≥ range_m the trace to it goes to second in the same pass. Bit-identical
+    // whether or not the list was copied.
     BandTrace Trace(const List& list, const glm::vec3& dir, float range_m) const;
     void Trace2(const List& list, const glm::vec3& dir, float range_m, float range2_m,
                 BandTrace& first, BandTrace& second) const;
@@ -89,11 +90,34 @@ class PlumeScreenBins {
     int width_ = 0, height_ = 0;  // bin area: (camera width + 1) × (camera height + 1)
     int tilesX_ = 0, tilesY_ = 0;
     float puffTolerance_ = 0.0f;
-    // Kept puffs (field index order) and their data, indexed by kept position.
+    // Per kept puff (field index order, then one inert puff that no ray uses, for padding):
+    // eye − centre (m), 1/σh², 1/σz², the cutoff r², α peak √π / 2 (optical-depth scale), the
+    // nearest range, and the weights of the band's scattering, absorption × T, hot absorption,
+    // hot absorption × T and scattering × g per unit optical depth.
+    enum Field {
+        kQx,
+        kQy,
+        kQz,
+        kIvh,
+        kIvz,
+        kCutoff2,
+        kKappa,
+        kNear,
+        kWs,
+        kWAbsT,
+        kWHot,
+        kWHotT,
+        kWg,
+        kFields
+    };
+    std::vector<float> data_[kFields];
     std::vector<uint32_t> kept_;
     std::vector<Rect> rect_;
-    std::vector<float> qx_, qy_, qz_, invVarH_, invVarZ_, cutoff2_, kappa_, near_, far_;
-    std::vector<float> wScatter_, wAbsT_, wHot_, wHotT_, wG_, sigmaPixels_;
+    std::vector<float> far_, sigmaPixels_;
+    uint32_t inert_ = 0;
+    template <bool Copied>
+    void Trace2Impl(const List& list, const glm::vec3& dir, float range_m, float range2_m,
+                    BandTrace& first, BandTrace& second) const;
     // Per tile, the kept positions of its puffs in increasing order.
     std::vector<uint32_t> tileStart_, tileEntries_;
 };

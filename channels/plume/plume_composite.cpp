@@ -150,13 +150,23 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     const glm::vec3 forward(camera.worldFromCamera.worldFromBody * glm::dvec3(0.0, 1.0, 0.0));
     const float nearM = float(camera.near_m);
     const size_t samples = size_t(N) * size_t(N);
-    const auto PixelDirection = [&](double px, double py) {
-        return glm::vec3(camera.SampleDirection(px * N + 0.5 * (N - 1), py * N + 0.5 * (N - 1)));
+    // Direction through the centre of output pixel (px, py), px in [0, W], py in [0, H]: the
+    // camera-frame vector (a[px], 1, b[py]) turned into the world and normalised.
+    std::vector<float> colA(size_t(W) + 1), rowB(size_t(H) + 1);
+    for (int px = 0; px <= W; ++px)
+        colA[size_t(px)] = float((2.0 * (px + 0.5) / W - 1.0) * camera.TanHalfH());
+    for (int py = 0; py <= H; ++py)
+        rowB[size_t(py)] = float((1.0 - 2.0 * (py + 0.5) / H) * camera.TanHalfV());
+    const glm::mat3 worldFromCamera(camera.worldFromCamera.worldFromBody);
+    const auto PixelDirection = [&](int px, int py) {
+        return glm::normalize(worldFromCamera *
+                              glm::vec3(colA[size_t(px)], 1.0f, rowB[size_t(py)]));
     };
     // Composites one pixel's samples with trace t seen along dir (far: the trace to the
     // farthest surface, for the samples nearer it than the nearest).
     const auto Apply = [&](const BandTrace& t, const glm::vec3& dir, int px, int py,
                            const float* range, float rMin, float rMax, const BandTrace* far) {
+        if (!(t.opticalDepth > 0.0f) && !(far && far->opticalDepth > 0.0f)) return;
         const BandTrace* traces[2] = {&t, far ? far : &t};
         float T[2], Sir[2] = {0.0f, 0.0f};
         glm::vec3 Svis[2];
@@ -185,25 +195,42 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
 
     // Interpolation grid: node (nx, ny) is the centre of pixel (nx·kCell, ny·kCell), the last
     // column and row lying just beyond the image. Every cell works on the puffs whose screen
-    // rectangles overlap its pixels or its far corner node, gathered once per pass; a cell
-    // with none is left alone (every puff adds at most the bins' per-puff tolerance there).
+    // rectangles overlap its pixels or its far corner node, gathered once (pass 1) and kept
+    // for pass 2; a cell with none is left alone (every puff adds at most the bins' per-puff
+    // tolerance there).
     const int nodesX = (W + kCell - 1) / kCell + 1, nodesY = (H + kCell - 1) / kCell + 1;
     const int cellsX = nodesX - 1, cellsY = nodesY - 1;
-    const auto GatherCell = [&](int cx, int cy, PlumeScreenBins::List& list) {
-        bins.Gather(cx * kCell, cy * kCell, cx * kCell + kCell + 1, cy * kCell + kCell + 1,
-                    float(kCell), list);
+    // One row of cells' lists: cell cx has index[start[cx], start[cx + 1]) (padded to 4).
+    struct CellRow {
+        std::vector<uint32_t> index, start, count;
+        std::vector<float> near_m, far_m;
+        std::vector<uint8_t> small;
     };
-    // Pass 1, the nodes traced to the sky: each by the cell it is the near corner of (the
-    // last column's and row's by the cells before them).
+    std::vector<CellRow> cellRows{size_t(cellsY)};
+    // Pass 1, the cells' lists and the nodes traced to the sky: each node by the cell it is
+    // the near corner of (the last column's and row's by the cells before them).
     std::vector<BandTrace> nodes(size_t(nodesX) * size_t(nodesY));
     std::vector<uint64_t> rowCovered(size_t(cellsY), 0), rowTraces(size_t(cellsY), 0),
         rowTests(size_t(cellsY), 0);
     tbb::parallel_for(tbb::blocked_range<int>(0, cellsY, 1), [&](const tbb::blocked_range<int>& r) {
         PlumeScreenBins::List list;
-        for (int cy = r.begin(); cy != r.end(); ++cy)
+        for (int cy = r.begin(); cy != r.end(); ++cy) {
+            CellRow& row = cellRows[size_t(cy)];
+            row.start.assign(size_t(cellsX) + 1, 0);
+            row.count.assign(size_t(cellsX), 0);
+            row.near_m.assign(size_t(cellsX), 0.0f);
+            row.far_m.assign(size_t(cellsX), 0.0f);
+            row.small.assign(size_t(cellsX), 0);
             for (int cx = 0; cx < cellsX; ++cx) {
-                GatherCell(cx, cy, list);
+                bins.Gather(cx * kCell, cy * kCell, cx * kCell + kCell + 1, cy * kCell + kCell + 1,
+                            float(kCell), false, list);
+                row.start[size_t(cx)] = uint32_t(row.index.size());
                 if (list.size() == 0) continue;
+                row.index.insert(row.index.end(), list.index.begin(), list.index.end());
+                row.count[size_t(cx)] = uint32_t(list.count);
+                row.near_m[size_t(cx)] = list.near_m;
+                row.far_m[size_t(cx)] = list.far_m;
+                row.small[size_t(cx)] = list.small;
                 for (int k = 0; k < 4; ++k) {
                     const int nx = cx + k % 2, ny = cy + k / 2;
                     if ((nx > cx && nx < cellsX) || (ny > cy && ny < cellsY)) continue;
@@ -213,6 +240,8 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                     rowTests[size_t(cy)] += list.size();
                 }
             }
+            row.start[size_t(cellsX)] = uint32_t(row.index.size());
+        }
     });
 
     // Pass 2, cells in parallel (a row of cells each); each pixel depends only on its own rays
@@ -222,9 +251,16 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             std::vector<float> range(samples);
             PlumeScreenBins::List list;
             for (int cy = rows.begin(); cy != rows.end(); ++cy) {
+                const CellRow& row = cellRows[size_t(cy)];
                 for (int cx = 0; cx < cellsX; ++cx) {
-                    GatherCell(cx, cy, list);
-                    if (list.size() == 0) continue;
+                    if (row.count[size_t(cx)] == 0) continue;
+                    list.count = row.count[size_t(cx)];
+                    list.index.assign(row.index.begin() + row.start[size_t(cx)],
+                                      row.index.begin() + row.start[size_t(cx) + 1]);
+                    list.near_m = row.near_m[size_t(cx)];
+                    list.far_m = row.far_m[size_t(cx)];
+                    list.small = row.small[size_t(cx)] != 0;
+                    list.copied = false;
                     // The ranges where the cell's puffs can matter.
                     const float dNear = list.near_m, dFar = list.far_m;
                     const bool fine = list.small;
@@ -244,6 +280,10 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                     }
                     const bool smooth = !fine && hi - lo <= kInterpolationTolerance &&
                                         tHi - tLo <= kInterpolationTolerance_K;
+                    // Clear sky at every corner and nothing the corners could miss: the sky
+                    // pixels' blended traces are zero, so only pixels with nearer surfaces
+                    // (which trace their own rays) can change.
+                    const bool clearSky = smooth && hi == 0.0f;
                     for (int py = cy * kCell; py < std::min(H, (cy + 1) * kCell); ++py) {
                         for (int px = cx * kCell; px < std::min(W, (cx + 1) * kCell); ++px) {
                             ++rowCovered[size_t(cy)];
@@ -267,12 +307,14 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                             if (rMax <= dNear) continue;
                             if (rMin >= dFar) {
                                 // Every surface behind the plumes: the sky trace is the trace.
+                                if (clearSky) continue;
                                 if (smooth) {
                                     const float fx = float(px - cx * kCell) / kCell;
                                     const float fy = float(py - cy * kCell) / kCell;
                                     Apply(Bilinear(corner, fx, fy), dir, px, py, range.data(), rMin,
                                           rMax, nullptr);
                                 } else {
+                                    bins.Copy(list);
                                     ++rowTraces[size_t(cy)];
                                     rowTests[size_t(cy)] += list.size();
                                     Apply(bins.Trace(list, dir, kPlumeSkyRange_m), dir, px, py,
@@ -283,6 +325,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                             // One ray to the nearest surface and, at a depth edge, one to the
                             // farthest (the far samples see what lies beyond the near surface),
                             // in one pass over the puffs.
+                            bins.Copy(list);
                             if (rMax > rMin * kDepthEdgeRatio) {
                                 BandTrace nearTrace, farTrace;
                                 bins.Trace2(list, dir, rMin, rMax, nearTrace, farTrace);

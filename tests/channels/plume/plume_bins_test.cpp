@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <numbers>
 
 #include "channels/plume/plume_composite.h"
@@ -58,10 +59,14 @@ Worst CompareWithExact(const scene::PlumeField& field, const ChannelCamera& cam,
     Worst worst;
     for (int py = 0; py <= cam.height; ++py) {
         for (int px = 0; px <= cam.width; ++px) {
-            bins.Gather(px, py, px + 1, py + 1, 0.0f, list);
+            bins.Gather(px, py, px + 1, py + 1, 0.0f, false, list);
             const glm::dvec3 dir = cam.SampleDirection(px, py);
-            const double T =
-                std::exp(-double(bins.Trace(list, glm::vec3(dir), float(range_m)).opticalDepth));
+            const BandTrace gathered = bins.Trace(list, glm::vec3(dir), float(range_m));
+            // The same from the copied list, bit for bit.
+            bins.Copy(list);
+            const BandTrace copied = bins.Trace(list, glm::vec3(dir), float(range_m));
+            EXPECT_EQ(std::memcmp(&gathered, &copied, sizeof(BandTrace)), 0);
+            const double T = std::exp(-double(copied.opticalDepth));
             const double exact = std::exp(-ExactOpticalDepth(field, band, eye, dir, range_m));
             worst.error = std::max(worst.error, std::abs(T - exact));
             worst.dark += exact < 0.8;
