@@ -89,6 +89,7 @@ PlumeScreenBins::PlumeScreenBins(const scene::PlumeField& field, const ChannelCa
         for (int f = 0; f < kFields; ++f) data_[f].push_back(values[f]);
         far_.push_back(float(far * 1.001 + 1.0));
         sigmaPixels_.push_back(float(sigmaPixels));
+        tauMax_.push_back(float(tauMax));
     }
 
     // The inert puff: a unit sphere at the eye with a negative cutoff, beyond every range.
@@ -125,7 +126,7 @@ void PlumeScreenBins::Gather(int x0, int y0, int x1, int y1, float smallPixels, 
     out.index.clear();
     out.near_m = std::numeric_limits<float>::infinity();
     out.far_m = 0.0f;
-    out.small = false;
+    out.smallOpticalDepth = 0.0f;
     x1 = std::min(x1, width_), y1 = std::min(y1, height_);
     if (x0 < x1 && y0 < y1) {
         // The rectangle's tiles; their lists are merged in kept order, each puff once.
@@ -149,7 +150,7 @@ void PlumeScreenBins::Gather(int x0, int y0, int x1, int y1, float smallPixels, 
             out.index.push_back(k);
             out.near_m = std::min(out.near_m, data_[kNear][k]);
             out.far_m = std::max(out.far_m, far_[k]);
-            out.small |= sigmaPixels_[k] < smallPixels;
+            if (sigmaPixels_[k] < smallPixels) out.smallOpticalDepth += tauMax_[k];
         };
         if (lists == 1) {
             for (const uint32_t* p = cur[0]; p != end[0]; ++p) take(*p);

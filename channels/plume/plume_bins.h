@@ -57,13 +57,14 @@ class PlumeScreenBins {
 
     // The puffs whose rectangles overlap the pixel rectangle [x0, x1) × [y0, y1) (at most 2 × 2
     // tiles), in field order, padded with an inert puff to a multiple of 4; with the nearest
-    // and farthest range (m) where they can matter and whether any has σ under smallPixels
-    // pixels at its distance. With copy, their data is also gathered into contiguous arrays
+    // and farthest range (m) where they can matter and the sum of the largest optical depths
+    // (through the centre along the longest axis) of those with σ under smallPixels pixels at
+    // their distance. With copy, their data is also gathered into contiguous arrays
     // (worth it when the list serves many rays).
     struct List {
         size_t count = 0;  // puffs (index and the arrays hold count rounded up to 4)
         float near_m = 0.0f, far_m = 0.0f;
-        bool small = false;
+        float smallOpticalDepth = 0.0f;
         bool copied = false;
         std::vector<uint32_t> index;  // kept positions
         std::vector<float> data[13];  // per field of Arrays, when copied
@@ -113,7 +114,7 @@ class PlumeScreenBins {
     std::vector<float> data_[kFields];
     std::vector<uint32_t> kept_;
     std::vector<Rect> rect_;
-    std::vector<float> far_, sigmaPixels_;
+    std::vector<float> far_, sigmaPixels_, tauMax_;
     uint32_t inert_ = 0;
     template <bool Copied>
     void Trace2Impl(const List& list, const glm::vec3& dir, float range_m, float range2_m,

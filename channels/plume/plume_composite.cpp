@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "channels/flir/flir_channel.h"
@@ -30,8 +31,10 @@ constexpr double kGlowMinT_K = 500.0, kGlowMaxT_K = 3000.0, kGlowStep_K = 10.0;
 
 // Interpolation grid: pixels whose surfaces all lie beyond the plumes take their trace from
 // the sky traces at the corners of their kCell × kCell cell, blended bilinearly, when the
-// corners' optical depths differ by at most kInterpolationTolerance and their temperatures by
-// at most kInterpolationTolerance_K; other pixels are traced one by one.
+// corners' transmittances differ by at most kInterpolationTolerance and their temperatures by
+// at most kInterpolationTolerance_K, and the puffs smaller than a cell that touch it (which
+// the corners could miss) have optical depths adding up to at most kInterpolationTolerance;
+// other pixels are traced one by one.
 constexpr int kCell = 4;
 constexpr float kInterpolationTolerance = 0.02f;
 constexpr float kInterpolationTolerance_K = 10.0f;
@@ -204,7 +207,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     struct CellRow {
         std::vector<uint32_t> index, start, count;
         std::vector<float> near_m, far_m;
-        std::vector<uint8_t> small;
+        std::vector<float> smallOpticalDepth;
     };
     std::vector<CellRow> cellRows{size_t(cellsY)};
     // Pass 1, the cells' lists and the nodes traced to the sky: each node by the cell it is
@@ -220,7 +223,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             row.count.assign(size_t(cellsX), 0);
             row.near_m.assign(size_t(cellsX), 0.0f);
             row.far_m.assign(size_t(cellsX), 0.0f);
-            row.small.assign(size_t(cellsX), 0);
+            row.smallOpticalDepth.assign(size_t(cellsX), 0.0f);
             for (int cx = 0; cx < cellsX; ++cx) {
                 bins.Gather(cx * kCell, cy * kCell, cx * kCell + kCell + 1, cy * kCell + kCell + 1,
                             float(kCell), false, list);
@@ -230,7 +233,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                 row.count[size_t(cx)] = uint32_t(list.count);
                 row.near_m[size_t(cx)] = list.near_m;
                 row.far_m[size_t(cx)] = list.far_m;
-                row.small[size_t(cx)] = list.small;
+                row.smallOpticalDepth[size_t(cx)] = list.smallOpticalDepth;
                 for (int k = 0; k < 4; ++k) {
                     const int nx = cx + k % 2, ny = cy + k / 2;
                     if ((nx > cx && nx < cellsX) || (ny > cy && ny < cellsY)) continue;
@@ -259,49 +262,68 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                                       row.index.begin() + row.start[size_t(cx) + 1]);
                     list.near_m = row.near_m[size_t(cx)];
                     list.far_m = row.far_m[size_t(cx)];
-                    list.small = row.small[size_t(cx)] != 0;
+                    list.smallOpticalDepth = row.smallOpticalDepth[size_t(cx)];
                     list.copied = false;
                     // The ranges where the cell's puffs can matter.
                     const float dNear = list.near_m, dFar = list.far_m;
-                    const bool fine = list.small;
+                    const bool fine = list.smallOpticalDepth > kInterpolationTolerance;
                     const BandTrace* corner[4];
                     for (int k = 0; k < 4; ++k)
                         corner[k] =
                             &nodes[size_t(cy + k / 2) * size_t(nodesX) + size_t(cx + k % 2)];
-                    // The corners agree and no puff smaller than a cell (which the corners
-                    // could miss) touches the cell: bilinear interpolation of the sky traces.
-                    float lo = corner[0]->opticalDepth, hi = lo;
-                    float tLo = corner[0]->temperature_K, tHi = tLo;
-                    for (int k = 1; k < 4; ++k) {
-                        lo = std::min(lo, corner[k]->opticalDepth);
-                        hi = std::max(hi, corner[k]->opticalDepth);
-                        tLo = std::min(tLo, corner[k]->temperature_K);
-                        tHi = std::max(tHi, corner[k]->temperature_K);
+                    // The corners agree and the puffs the corners could miss are faint:
+                    // bilinear interpolation of the sky traces.
+                    // (Temperatures of corners that see absorbing puffs: the others have none.)
+                    float lo = 1.0f, hi = 0.0f, tauHi = 0.0f;
+                    float tLo = std::numeric_limits<float>::infinity(), tHi = 0.0f;
+                    for (int k = 0; k < 4; ++k) {
+                        const float T = std::exp(-corner[k]->opticalDepth);
+                        lo = std::min(lo, T), hi = std::max(hi, T);
+                        tauHi = std::max(tauHi, corner[k]->opticalDepth);
+                        if (corner[k]->temperature_K > 0.0f) {
+                            tLo = std::min(tLo, corner[k]->temperature_K);
+                            tHi = std::max(tHi, corner[k]->temperature_K);
+                        }
                     }
+                    if (tHi == 0.0f) tLo = 0.0f;
                     const bool smooth = !fine && hi - lo <= kInterpolationTolerance &&
                                         tHi - tLo <= kInterpolationTolerance_K;
-                    // Clear sky at every corner and nothing the corners could miss: the sky
-                    // pixels' blended traces are zero, so only pixels with nearer surfaces
-                    // (which trace their own rays) can change.
-                    const bool clearSky = smooth && hi == 0.0f;
+                    // Clear sky at every corner and only faint puffs the corners could miss:
+                    // the sky pixels' blended traces are zero, so only pixels with nearer
+                    // surfaces (which trace their own rays) can change.
+                    const bool clearSky = smooth && tauHi == 0.0f;
                     for (int py = cy * kCell; py < std::min(H, (cy + 1) * kCell); ++py) {
                         for (int px = cx * kCell; px < std::min(W, (cx + 1) * kCell); ++px) {
                             ++rowCovered[size_t(cy)];
-                            const glm::vec3 dir = PixelDirection(px, py);
-                            const float cosForward = std::max(glm::dot(dir, forward), 1e-6f);
-                            float rMin = kPlumeSkyRange_m, rMax = 0.0f;
-                            for (int j = 0; j < N; ++j) {
+                            // Samples that see the sky first (no direction needed for them).
+                            bool allSky = true;
+                            for (int j = 0; j < N; ++j)
                                 for (int i = 0; i < N; ++i) {
                                     const size_t idx = vis.Index(px * N + i, py * N + j);
-                                    // depth = near / w, w the distance along the optical axis.
-                                    const float r =
-                                        vis.primitive[idx] == kNoPrimitive || vis.depth[idx] <= 0.0f
-                                            ? kPlumeSkyRange_m
-                                            : std::min(nearM / vis.depth[idx] / cosForward,
-                                                       kPlumeSkyRange_m);
-                                    range[size_t(j * N + i)] = r;
-                                    rMin = std::min(rMin, r), rMax = std::max(rMax, r);
+                                    const bool sky = vis.primitive[idx] == kNoPrimitive ||
+                                                     vis.depth[idx] <= 0.0f;
+                                    range[size_t(j * N + i)] = sky ? kPlumeSkyRange_m : -1.0f;
+                                    allSky &= sky;
                                 }
+                            if (allSky && clearSky) continue;
+                            const glm::vec3 dir = PixelDirection(px, py);
+                            float rMin = kPlumeSkyRange_m, rMax = 0.0f;
+                            if (allSky) {
+                                rMax = kPlumeSkyRange_m;
+                            } else {
+                                // depth = near / w, w the distance along the optical axis.
+                                const float rangeScale =
+                                    nearM / std::max(glm::dot(dir, forward), 1e-6f);
+                                for (int j = 0; j < N; ++j)
+                                    for (int i = 0; i < N; ++i) {
+                                        float& r = range[size_t(j * N + i)];
+                                        if (r < 0.0f)
+                                            r = std::min(
+                                                rangeScale /
+                                                    vis.depth[vis.Index(px * N + i, py * N + j)],
+                                                kPlumeSkyRange_m);
+                                        rMin = std::min(rMin, r), rMax = std::max(rMax, r);
+                                    }
                             }
                             // Every surface in front of the plumes: nothing to add.
                             if (rMax <= dNear) continue;
