@@ -6,12 +6,14 @@
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <numbers>
 
 #include "radiometry/bands/builtin_bands.h"
 #include "radiometry/planck/planck.h"
+#include "scene/plumes/plume_system.h"
 
 namespace seasense::channels {
 namespace {
@@ -237,6 +239,73 @@ TEST(PlumeComposite, SameImageForOneAndTwoThreads) {
     EXPECT_EQ(std::memcmp(one.pixels.data(), two.pixels.data(), one.pixels.size() * 4), 0);
     EXPECT_NE(std::count(one.pixels.begin(), one.pixels.end(), 100.0f),
               ptrdiff_t(one.pixels.size()));
+}
+
+// Committed plumes (fire with flame, funnel, steam; ~1000 puffs) over sky and sea in the
+// visible and in LWIR: bit-identical images at one, two and three threads.
+TEST(PlumeComposite, CommittedPlumesSameImageForAnyThreadCount) {
+    scene::PlumesSettings settings;
+    const auto add = [&](scene::PlumeKind kind, glm::dvec3 position_m) {
+        scene::PlumeSourceSettings s = scene::DefaultPlumeSource(kind);
+        s.position_m = position_m;
+        s.seed = uint64_t(settings.sources.size() + 1);
+        settings.sources.push_back(s);
+    };
+    add(scene::PlumeKind::Smoke, {-150.0, 1500.0, 0.0});
+    add(scene::PlumeKind::Flame, {-150.0, 1500.0, 0.0});
+    add(scene::PlumeKind::Exhaust, {50.0, 1200.0, 20.0});
+    add(scene::PlumeKind::Steam, {200.0, 1800.0, 10.0});
+    scene::PlumeAmbient ambient;
+    ambient.windSpeed_mps = 5.0;
+    ambient.windDirection_rad = std::numbers::pi / 2;
+    const scene::PlumeSystem system(settings, ambient);
+    scene::PlumeField field = system.MakeField();
+    system.Commit(200.0, field);
+    ASSERT_GT(field.PuffCount(), 300u);
+
+    const glm::dvec3 eye{0.0, 0.0, 10.0};
+    const ChannelCamera cam = NorthCamera(eye, 150, 100, 2);
+    VisibilityBuffer vis = SkyOnly(cam);
+    for (int y = 0; y < cam.SampleHeight(); ++y)
+        for (int x = 0; x < cam.SampleWidth(); ++x) {
+            const glm::dvec3 d = cam.SampleDirection(x, y);
+            if (d.z >= -1e-3) continue;
+            vis.primitive[vis.Index(x, y)] = 0;
+            vis.depth[vis.Index(x, y)] = float(cam.near_m / (eye.z / -d.z * d.y));
+        }
+    const BlackbodyGlowTable glow;
+    const radiometry::Band lwir = radiometry::BuiltinBand("LWIR");
+    const radiometry::BandRadianceTable table(lwir);
+    for (const bool visible : {true, false}) {
+        PlumeLighting light;
+        if (visible) {
+            light.sunDirection = glm::normalize(glm::vec3(0.3f, 1.0f, 0.2f));
+            light.sunIlluminance = glm::vec3(5000.0f);
+            light.ambientRgb = glm::vec3(200.0f);
+            light.glow = &glow;
+        } else {
+            light.kind = PlumeLighting::Kind::Infrared;
+            light.band = ObscurantBand::Lwir;
+            light.planck = &table;
+            light.ambient = float(radiometry::BandRadiance(lwir, 280.0));
+        }
+        const auto render = [&](int threads) {
+            Image image(cam.SampleWidth(), cam.SampleHeight(), visible ? 3 : 1);
+            std::fill(image.pixels.begin(), image.pixels.end(), 10.0f);
+            tbb::task_arena arena(threads);
+            arena.execute([&] { CompositePlumes(field, cam, vis, light, image); });
+            return image;
+        };
+        const Image one = render(1);
+        EXPECT_GT(
+            std::count_if(one.pixels.begin(), one.pixels.end(), [](float v) { return v != 10.0f; }),
+            1000);
+        for (int threads : {2, 3}) {
+            const Image many = render(threads);
+            EXPECT_EQ(std::memcmp(one.pixels.data(), many.pixels.data(), one.pixels.size() * 4), 0)
+                << threads << " threads, visible " << visible;
+        }
+    }
 }
 
 // Pixels whose trace comes from the interpolation grid stay within 0.02 in transmittance (the
