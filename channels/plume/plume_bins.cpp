@@ -15,8 +15,8 @@ namespace seasense::channels {
 PlumeScreenBins::PlumeScreenBins(const scene::PlumeField& field, const ChannelCamera& camera,
                                  scene::ObscurantBand band, float tolerance) {
     CHECK(tolerance > 0.0f);
-    width_ = camera.width + 1;
-    height_ = camera.height + 1;
+    width_ = camera.width + kMargin;
+    height_ = camera.height + kMargin;
     tilesX_ = (width_ + kTile - 1) / kTile;
     tilesY_ = (height_ + kTile - 1) / kTile;
     const scene::PlumeField::PuffArrays puffs = field.Puffs();

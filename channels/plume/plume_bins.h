@@ -41,11 +41,12 @@ inline constexpr float kPlumeTransmittanceTolerance = 1.0e-3f;
 // the ray's end is skipped; everything skipped adds at most ε each, so the trace's optical depth
 // is within tolerance of the exact sum over all puffs and T within tolerance of e^(−τ_exact)
 // (|e^(−a) − e^(−b)| ≤ |a − b|), plus float rounding and the 1.5e-7 error of the erf
-// approximation. Pixel coordinates run over [0, width] × [0, height] inclusive: the extra
-// column and row serve interpolation nodes on the far edges.
+// approximation. Pixel coordinates run over [0, width + kMargin) × [0, height + kMargin): the
+// extra columns and rows serve interpolation nodes beyond the far edges.
 class PlumeScreenBins {
   public:
-    static constexpr int kTile = 32;  // pixels
+    static constexpr int kTile = 32;   // pixels
+    static constexpr int kMargin = 8;  // pixels beyond the image's right and bottom edges
 
     PlumeScreenBins(const scene::PlumeField& field, const ChannelCamera& camera,
                     scene::ObscurantBand band, float tolerance = kPlumeTransmittanceTolerance);
@@ -88,7 +89,7 @@ class PlumeScreenBins {
     struct Rect {
         int x0, y0, x1, y1;
     };
-    int width_ = 0, height_ = 0;  // bin area: (camera width + 1) × (camera height + 1)
+    int width_ = 0, height_ = 0;  // bin area: camera width and height + kMargin
     int tilesX_ = 0, tilesY_ = 0;
     float puffTolerance_ = 0.0f;
     // Per kept puff (field index order, then one inert puff that no ray uses, for padding):

@@ -153,13 +153,18 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     const glm::vec3 forward(camera.worldFromCamera.worldFromBody * glm::dvec3(0.0, 1.0, 0.0));
     const float nearM = float(camera.near_m);
     const size_t samples = size_t(N) * size_t(N);
-    // Direction through the centre of output pixel (px, py), px in [0, W], py in [0, H]: the
-    // camera-frame vector (a[px], 1, b[py]) turned into the world and normalised.
-    std::vector<float> colA(size_t(W) + 1), rowB(size_t(H) + 1);
-    for (int px = 0; px <= W; ++px)
-        colA[size_t(px)] = float((2.0 * (px + 0.5) / W - 1.0) * camera.TanHalfH());
-    for (int py = 0; py <= H; ++py)
-        rowB[size_t(py)] = float((1.0 - 2.0 * (py + 0.5) / H) * camera.TanHalfV());
+    // Interpolation grid: node (nx, ny) is the centre of pixel (nx·kCell, ny·kCell), the last
+    // column and row lying just beyond the image (inside the bins' margin).
+    const int nodesX = (W + kCell - 1) / kCell + 1, nodesY = (H + kCell - 1) / kCell + 1;
+    const int cellsX = nodesX - 1, cellsY = nodesY - 1;
+    static_assert(kCell <= PlumeScreenBins::kMargin);
+    // Direction through the centre of pixel (px, py), grid nodes included: the camera-frame
+    // vector (a[px], 1, b[py]) turned into the world and normalised.
+    std::vector<float> colA(size_t(cellsX) * kCell + 1), rowB(size_t(cellsY) * kCell + 1);
+    for (size_t px = 0; px < colA.size(); ++px)
+        colA[px] = float((2.0 * (double(px) + 0.5) / W - 1.0) * camera.TanHalfH());
+    for (size_t py = 0; py < rowB.size(); ++py)
+        rowB[py] = float((1.0 - 2.0 * (double(py) + 0.5) / H) * camera.TanHalfV());
     const glm::mat3 worldFromCamera(camera.worldFromCamera.worldFromBody);
     const auto PixelDirection = [&](int px, int py) {
         return glm::normalize(worldFromCamera *
@@ -196,13 +201,10 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
         }
     };
 
-    // Interpolation grid: node (nx, ny) is the centre of pixel (nx·kCell, ny·kCell), the last
-    // column and row lying just beyond the image. Every cell works on the puffs whose screen
+    // Every cell works on the puffs whose screen
     // rectangles overlap its pixels or its far corner node, gathered once (pass 1) and kept
     // for pass 2; a cell with none is left alone (every puff adds at most the bins' per-puff
     // tolerance there).
-    const int nodesX = (W + kCell - 1) / kCell + 1, nodesY = (H + kCell - 1) / kCell + 1;
-    const int cellsX = nodesX - 1, cellsY = nodesY - 1;
     // One row of cells' lists: cell cx has index[start[cx], start[cx + 1]) (padded to 4).
     struct CellRow {
         std::vector<uint32_t> index, start, count;

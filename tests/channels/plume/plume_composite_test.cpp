@@ -312,7 +312,7 @@ TEST(PlumeComposite, CommittedPlumesSameImageForAnyThreadCount) {
 // grid's optical-depth tolerance) of the exact sum over the puffs along the pixel's own ray.
 TEST(PlumeComposite, InterpolatedPixelsMatchTheirOwnTraces) {
     const glm::dvec3 eye{0.0, 0.0, 10.0};
-    const ChannelCamera cam = NorthCamera(eye, 160, 120, 1);
+    const ChannelCamera cam = NorthCamera(eye, 162, 121, 1);  // grid nodes beyond both edges
     const VisibilityBuffer vis = SkyOnly(cam);
     std::vector<scene::Puff> puffs;
     for (int i = 0; i < 60; ++i) {
