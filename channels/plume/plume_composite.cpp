@@ -8,9 +8,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "channels/flir/flir_channel.h"
+#include "channels/plume/plume_bins.h"
 #include "radiometry/atmosphere/atmosphere.h"
 #include "radiometry/bands/builtin_bands.h"
 #include "radiometry/color/rec709.h"
@@ -29,124 +31,41 @@ constexpr double kGlowMinT_K = 500.0, kGlowMaxT_K = 3000.0, kGlowStep_K = 10.0;
 
 // Interpolation grid: pixels whose surfaces all lie beyond the plumes take their trace from
 // the sky traces at the corners of their kCell × kCell cell, blended bilinearly, when the
-// corners' optical depths differ by at most kInterpolationTolerance and their temperatures by
-// at most kInterpolationTolerance_K; other pixels are traced one by one.
+// corners' transmittances differ by at most kInterpolationTolerance and their temperatures by
+// at most kInterpolationTolerance_K, and the puffs smaller than a cell that touch it (which
+// the corners could miss) have optical depths adding up to at most kInterpolationTolerance;
+// other pixels are traced one by one.
 constexpr int kCell = 4;
 constexpr float kInterpolationTolerance = 0.02f;
 constexpr float kInterpolationTolerance_K = 10.0f;
 // A pixel whose samples' surface ranges differ by more than this ratio traces a second ray.
 constexpr float kDepthEdgeRatio = 1.1f;
 
-// A screen rectangle of output pixels [x0, x1) × [y0, y1).
-struct PixelRect {
-    int x0, y0, x1, y1;
-};
-
-// Screen rectangle (output pixels) of the world box [lo, hi], widened by one pixel; the whole
-// screen when a corner lies behind the near plane; empty (x0 ≥ x1) when the box is behind.
-PixelRect ProjectBox(const ChannelCamera& cam, const glm::dvec3& lo, const glm::dvec3& hi) {
-    const PixelRect full{0, 0, cam.width, cam.height};
-    const glm::dmat3 cameraFromWorld = glm::transpose(cam.worldFromCamera.worldFromBody);
-    const glm::dvec3 eye = cam.worldFromCamera.position_m;
-    const double tanH = cam.TanHalfH(), tanV = cam.TanHalfV();
-    double xMin = 1e300, xMax = -1e300, yMin = 1e300, yMax = -1e300;
-    int behind = 0;
-    for (int c = 0; c < 8; ++c) {
-        const glm::dvec3 p{c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z};
-        const glm::dvec3 q = cameraFromWorld * (p - eye);  // x right, y forward, z up
-        if (q.y < cam.near_m) {
-            ++behind;
-            continue;
-        }
-        const double x = (q.x / (q.y * tanH) + 1.0) * 0.5 * cam.width;
-        const double y = (1.0 - q.z / (q.y * tanV)) * 0.5 * cam.height;
-        xMin = std::min(xMin, x), xMax = std::max(xMax, x);
-        yMin = std::min(yMin, y), yMax = std::max(yMax, y);
-    }
-    if (behind == 8) return {0, 0, 0, 0};
-    if (behind > 0) return full;
-    const auto clampX = [&](double v) { return int(std::clamp(v, 0.0, double(cam.width))); };
-    const auto clampY = [&](double v) { return int(std::clamp(v, 0.0, double(cam.height))); };
-    return {clampX(std::floor(xMin) - 1.0), clampY(std::floor(yMin) - 1.0),
-            clampX(std::ceil(xMax) + 1.0), clampY(std::ceil(yMax) + 1.0)};
-}
-
-// A plume's screen rectangle and the range (m) from the eye to the nearest and farthest point
-// of its box.
-struct PlumeBounds {
-    PixelRect rect;
-    float near_m, far_m;
-};
-
-std::vector<PlumeBounds> PlumeScreenBounds(const scene::PlumeField& field,
-                                           const ChannelCamera& cam) {
-    const scene::PlumeField::PuffArrays puffs = field.Puffs();
-    const size_t plumes = field.PlumeCount();
-    std::vector<glm::dvec3> lo(plumes, glm::dvec3(1e300)), hi(plumes, glm::dvec3(-1e300));
-    for (size_t i = 0; i < puffs.x.size(); ++i) {
-        const double rh = scene::kPuffCutoffSigmas / std::sqrt(double(puffs.invVarH[i]));
-        const double rz = scene::kPuffCutoffSigmas / std::sqrt(double(puffs.invVarZ[i]));
-        const glm::dvec3 c{puffs.x[i], puffs.y[i], puffs.z[i]}, r{rh, rh, rz};
-        const uint32_t p = puffs.plume[i];
-        lo[p] = glm::min(lo[p], c - r);
-        hi[p] = glm::max(hi[p], c + r);
-    }
-    const glm::dvec3 eye = cam.worldFromCamera.position_m;
-    std::vector<PlumeBounds> bounds;
-    for (size_t p = 0; p < plumes; ++p) {
-        if (lo[p].x > hi[p].x) continue;
-        const PixelRect r = ProjectBox(cam, lo[p], hi[p]);
-        if (r.x0 >= r.x1 || r.y0 >= r.y1) continue;
-        const double nearest = glm::length(glm::clamp(eye, lo[p], hi[p]) - eye);
-        double farthest = 0.0;
-        for (int c = 0; c < 8; ++c) {
-            const glm::dvec3 q{c & 1 ? hi[p].x : lo[p].x, c & 2 ? hi[p].y : lo[p].y,
-                               c & 4 ? hi[p].z : lo[p].z};
-            farthest = std::max(farthest, glm::length(q - eye));
-        }
-        // Float margins: a little nearer and farther than the box.
-        bounds.push_back({r, float(nearest * 0.999), float(farthest * 1.001 + 1.0)});
-    }
-    return bounds;
-}
-
 // Bilinear blend of four traces (corners 00, 10, 01, 11) at fractions fx, fy: optical depths
-// blend linearly; albedo, temperature and asymmetry as optical-depth weighted means.
-scene::PlumeTrace Bilinear(const scene::PlumeTrace& t00, const scene::PlumeTrace& t10,
-                           const scene::PlumeTrace& t01, const scene::PlumeTrace& t11, float fx,
-                           float fy) {
+// blend linearly; albedo, temperatures and asymmetry as the matching depth-weighted means.
+BandTrace Bilinear(const BandTrace* const t[4], float fx, float fy) {
     const float w[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
-    const scene::PlumeTrace* t[4] = {&t00, &t10, &t01, &t11};
-    scene::PlumeTrace out;
-    for (int b = 0; b < scene::kObscurantBands; ++b) {
-        float tau = 0.0f, albedo = 0.0f, temperature = 0.0f, absorbing = 0.0f;
-        for (int k = 0; k < 4; ++k) {
-            const float wt = w[k] * t[k]->opticalDepth[size_t(b)];
-            tau += wt;
-            albedo += wt * t[k]->albedo[size_t(b)];
-            const float wa = wt * (1.0f - t[k]->albedo[size_t(b)]);
-            temperature += wa * t[k]->temperature_K[size_t(b)];
-            absorbing += wa;
-        }
-        out.opticalDepth[size_t(b)] = tau;
-        out.albedo[size_t(b)] = tau > 0.0f ? albedo / tau : 0.0f;
-        out.temperature_K[size_t(b)] = absorbing > 0.0f ? temperature / absorbing : 0.0f;
-        float hot = 0.0f, hotT = 0.0f;
-        for (int k = 0; k < 4; ++k) {
-            const float wh = w[k] * t[k]->opticalDepth[size_t(b)] *
-                             (1.0f - t[k]->albedo[size_t(b)]) * t[k]->hotFraction[size_t(b)];
-            hot += wh;
-            hotT += wh * t[k]->hotTemperature_K[size_t(b)];
-        }
-        out.hotFraction[size_t(b)] = absorbing > 0.0f ? std::min(hot / absorbing, 1.0f) : 0.0f;
-        out.hotTemperature_K[size_t(b)] = hot > 0.0f ? hotT / hot : 0.0f;
-    }
-    float g = 0.0f, scattering = 0.0f;
+    float tau = 0.0f, scattering = 0.0f, absorbing = 0.0f, temperature = 0.0f, hot = 0.0f,
+          hotT = 0.0f, g = 0.0f;
     for (int k = 0; k < 4; ++k) {
-        const float ws = w[k] * t[k]->opticalDepth[0] * t[k]->albedo[0];
-        g += ws * t[k]->asymmetry;
+        const float wt = w[k] * t[k]->opticalDepth;
+        tau += wt;
+        const float ws = wt * t[k]->albedo;
         scattering += ws;
+        g += ws * t[k]->asymmetry;
+        const float wa = wt * (1.0f - t[k]->albedo);
+        absorbing += wa;
+        temperature += wa * t[k]->temperature_K;
+        const float wh = wa * t[k]->hotFraction;
+        hot += wh;
+        hotT += wh * t[k]->hotTemperature_K;
     }
+    BandTrace out;
+    out.opticalDepth = tau;
+    out.albedo = tau > 0.0f ? scattering / tau : 0.0f;
+    out.temperature_K = absorbing > 0.0f ? temperature / absorbing : 0.0f;
+    out.hotFraction = absorbing > 0.0f ? std::min(hot / absorbing, 1.0f) : 0.0f;
+    out.hotTemperature_K = hot > 0.0f ? hotT / hot : 0.0f;
     out.asymmetry = scattering > 0.0f ? g / scattering : 0.0f;
     return out;
 }
@@ -154,9 +73,9 @@ scene::PlumeTrace Bilinear(const scene::PlumeTrace& t00, const scene::PlumeTrace
 // Absorption-weighted emission of the trace's puffs in band b: the hot (flame) part and the
 // rest each at their own mean temperature. emit(T) is the band's blackbody radiance.
 template <class Emission>
-auto ThermalEmission(const scene::PlumeTrace& t, size_t b, const Emission& emit) {
-    const float h = t.hotFraction[b];
-    const float T = t.temperature_K[b], Thot = t.hotTemperature_K[b];
+auto ThermalEmission(const BandTrace& t, const Emission& emit) {
+    const float h = t.hotFraction;
+    const float T = t.temperature_K, Thot = t.hotTemperature_K;
     decltype(emit(T)) sum = emit(0.0f) * 0.0f;
     if (h > 0.0f && Thot > 0.0f) sum = sum + emit(Thot) * h;
     if (h < 1.0f && T > 0.0f) {
@@ -167,24 +86,20 @@ auto ThermalEmission(const scene::PlumeTrace& t, size_t b, const Emission& emit)
     return sum;
 }
 
-glm::vec3 VisibleSource(const scene::PlumeTrace& t, const glm::vec3& toEye,
-                        const PlumeLighting& light) {
-    constexpr size_t kVis = size_t(scene::ObscurantBand::Visible);
-    const float omega = t.albedo[kVis];
+glm::vec3 VisibleSource(const BandTrace& t, const glm::vec3& toEye, const PlumeLighting& light) {
+    const float omega = t.albedo;
     // Light from the sun travels along −sunDirection, light to the eye along toEye.
     const float cosTheta = -glm::dot(light.sunDirection, toEye);
     glm::vec3 S = omega * (light.sunIlluminance * HenyeyGreensteinPhase(cosTheta, t.asymmetry) +
                            light.ambientRgb);
     if (light.glow)
-        S += (1.0f - omega) *
-             ThermalEmission(t, kVis, [&](float T_K) { return (*light.glow)(T_K); });
+        S += (1.0f - omega) * ThermalEmission(t, [&](float T_K) { return (*light.glow)(T_K); });
     return S;
 }
 
-float InfraredSource(const scene::PlumeTrace& t, const PlumeLighting& light) {
-    const size_t b = size_t(light.band);
-    const float omega = t.albedo[b];
-    return omega * light.ambient + (1.0f - omega) * ThermalEmission(t, b, [&](float T_K) {
+float InfraredSource(const BandTrace& t, const PlumeLighting& light) {
+    const float omega = t.albedo;
+    return omega * light.ambient + (1.0f - omega) * ThermalEmission(t, [&](float T_K) {
                                        return T_K > 0.0f ? float(light.planck->Radiance(T_K))
                                                          : 0.0f;
                                    });
@@ -231,26 +146,40 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     CHECK(vis.width == camera.SampleWidth() && vis.height == camera.SampleHeight());
     CHECK(visible || light.planck);
     if (field.PuffCount() == 0) return stats;
-    const std::vector<PlumeBounds> bounds = PlumeScreenBounds(field, camera);
-    if (bounds.empty()) return stats;
+    const PlumeScreenBins bins(field, camera, visible ? scene::ObscurantBand::Visible : light.band);
+    if (bins.KeptPuffs() == 0) return stats;
 
     const glm::vec3 eye(camera.worldFromCamera.position_m);
     const glm::vec3 forward(camera.worldFromCamera.worldFromBody * glm::dvec3(0.0, 1.0, 0.0));
     const float nearM = float(camera.near_m);
-    const size_t band = size_t(visible ? int(scene::ObscurantBand::Visible) : int(light.band));
     const size_t samples = size_t(N) * size_t(N);
-    const auto PixelDirection = [&](double px, double py) {
-        return glm::vec3(camera.SampleDirection(px * N + 0.5 * (N - 1), py * N + 0.5 * (N - 1)));
+    // Interpolation grid: node (nx, ny) is the centre of pixel (nx·kCell, ny·kCell), the last
+    // column and row lying just beyond the image (inside the bins' margin).
+    const int nodesX = (W + kCell - 1) / kCell + 1, nodesY = (H + kCell - 1) / kCell + 1;
+    const int cellsX = nodesX - 1, cellsY = nodesY - 1;
+    static_assert(kCell <= PlumeScreenBins::kMargin);
+    // Direction through the centre of pixel (px, py), grid nodes included: the camera-frame
+    // vector (a[px], 1, b[py]) turned into the world and normalised.
+    std::vector<float> colA(size_t(cellsX) * kCell + 1), rowB(size_t(cellsY) * kCell + 1);
+    for (size_t px = 0; px < colA.size(); ++px)
+        colA[px] = float((2.0 * (double(px) + 0.5) / W - 1.0) * camera.TanHalfH());
+    for (size_t py = 0; py < rowB.size(); ++py)
+        rowB[py] = float((1.0 - 2.0 * (double(py) + 0.5) / H) * camera.TanHalfV());
+    const glm::mat3 worldFromCamera(camera.worldFromCamera.worldFromBody);
+    const auto PixelDirection = [&](int px, int py) {
+        return glm::normalize(worldFromCamera *
+                              glm::vec3(colA[size_t(px)], 1.0f, rowB[size_t(py)]));
     };
-    // Composites one sample with trace t seen along dir.
-    const auto Apply = [&](const scene::PlumeTrace& t, const glm::vec3& dir, int px, int py,
-                           const float* range, float rMin, float rMax,
-                           const scene::PlumeTrace* far) {
-        const scene::PlumeTrace* traces[2] = {&t, far ? far : &t};
+    // Composites one pixel's samples with trace t seen along dir (far: the trace to the
+    // farthest surface, for the samples nearer it than the nearest).
+    const auto Apply = [&](const BandTrace& t, const glm::vec3& dir, int px, int py,
+                           const float* range, float rMin, float rMax, const BandTrace* far) {
+        if (!(t.opticalDepth > 0.0f) && !(far && far->opticalDepth > 0.0f)) return;
+        const BandTrace* traces[2] = {&t, far ? far : &t};
         float T[2], Sir[2] = {0.0f, 0.0f};
         glm::vec3 Svis[2];
         for (int k = 0; k < (far ? 2 : 1); ++k) {
-            T[k] = std::exp(-traces[k]->opticalDepth[band]);
+            T[k] = std::exp(-traces[k]->opticalDepth);
             if (visible)
                 Svis[k] = VisibleSource(*traces[k], -dir, light);
             else
@@ -260,7 +189,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             for (int i = 0; i < N; ++i) {
                 const float r = range[size_t(j * N + i)];
                 const int k = far && (r - rMin > rMax - r) ? 1 : 0;
-                if (!(traces[k]->opticalDepth[band] > 0.0f)) continue;
+                if (!(traces[k]->opticalDepth > 0.0f)) continue;
                 float* o = radiance.At(px * N + i, py * N + j);
                 if (visible) {
                     for (int c = 0; c < 3; ++c)
@@ -272,148 +201,166 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
         }
     };
 
-    // Nodes of the interpolation grid: the centres of every kCell-th pixel, traced to the sky.
-    const int nodesX = (W + kCell - 1) / kCell + 1, nodesY = (H + kCell - 1) / kCell + 1;
-    const int cellsX = nodesX - 1, cellsY = nodesY - 1;
-    const auto CellBounds = [&](int cx, int cy, float& dNear, float& dFar) {
-        dNear = kPlumeSkyRange_m, dFar = 0.0f;
-        const int x0 = cx * kCell, y0 = cy * kCell;
-        bool any = false;
-        for (const PlumeBounds& b : bounds) {
-            if (b.rect.x1 <= x0 || b.rect.x0 >= x0 + kCell || b.rect.y1 <= y0 ||
-                b.rect.y0 >= y0 + kCell)
-                continue;
-            dNear = std::min(dNear, b.near_m), dFar = std::max(dFar, b.far_m);
-            any = true;
-        }
-        return any;
+    // Every cell works on the puffs whose screen
+    // rectangles overlap its pixels or its far corner node, gathered once (pass 1) and kept
+    // for pass 2; a cell with none is left alone (every puff adds at most the bins' per-puff
+    // tolerance there).
+    // One row of cells' lists: cell cx has index[start[cx], start[cx + 1]) (padded to 4).
+    struct CellRow {
+        std::vector<uint32_t> index, start, count;
+        std::vector<float> near_m, far_m;
+        std::vector<float> smallOpticalDepth;
     };
-    std::vector<uint8_t> nodeNeeded(size_t(nodesX) * size_t(nodesY), 0);
-    for (int cy = 0; cy < cellsY; ++cy)
-        for (int cx = 0; cx < cellsX; ++cx) {
-            float dNear, dFar;
-            if (!CellBounds(cx, cy, dNear, dFar)) continue;
-            for (int k = 0; k < 4; ++k)
-                nodeNeeded[size_t(cy + k / 2) * size_t(nodesX) + size_t(cx + k % 2)] = 1;
-        }
-    // Cells that a puff smaller than a cell (σ under kCell pixels) touches are traced pixel by
-    // pixel: the corner nodes could miss it.
-    std::vector<uint8_t> cellFine(size_t(cellsX) * size_t(cellsY), 0);
-    {
-        const scene::PlumeField::PuffArrays puffs = field.Puffs();
-        const glm::dmat3 cameraFromWorld = glm::transpose(camera.worldFromCamera.worldFromBody);
-        const double tanH = camera.TanHalfH(), tanV = camera.TanHalfV();
-        const double pixelAngle = 2.0 * tanH / W;
-        for (size_t i = 0; i < puffs.x.size(); ++i) {
-            const glm::dvec3 q = cameraFromWorld * (glm::dvec3(puffs.x[i], puffs.y[i], puffs.z[i]) -
-                                                    camera.worldFromCamera.position_m);
-            if (q.y <= camera.near_m) continue;
-            const double sh = 1.0 / std::sqrt(double(puffs.invVarH[i]));
-            const double sz = 1.0 / std::sqrt(double(puffs.invVarZ[i]));
-            const double perPixel = 1.0 / (q.y * pixelAngle);
-            if (std::min(sh, sz) * perPixel >= kCell) continue;
-            const double reach = scene::kPuffCutoffSigmas * std::max(sh, sz) * perPixel + 1.0;
-            const double x = (q.x / (q.y * tanH) + 1.0) * 0.5 * W;
-            const double y = (1.0 - q.z / (q.y * tanV)) * 0.5 * H;
-            const int cx0 = std::max(0, int(std::floor((x - reach) / kCell)));
-            const int cx1 = std::min(cellsX - 1, int(std::floor((x + reach) / kCell)));
-            const int cy0 = std::max(0, int(std::floor((y - reach) / kCell)));
-            const int cy1 = std::min(cellsY - 1, int(std::floor((y + reach) / kCell)));
-            for (int cy = cy0; cy <= cy1; ++cy)
-                for (int cx = cx0; cx <= cx1; ++cx)
-                    cellFine[size_t(cy) * size_t(cellsX) + size_t(cx)] = 1;
-        }
-    }
-    std::vector<scene::PlumeTrace> nodes(nodeNeeded.size());
-    std::vector<uint64_t> rowCovered(size_t(cellsY), 0), rowTraces(size_t(cellsY), 0);
-    std::vector<uint64_t> nodeTraces(size_t(nodesY), 0);
-    tbb::parallel_for(tbb::blocked_range<int>(0, nodesY, 1), [&](const tbb::blocked_range<int>& r) {
-        for (int ny = r.begin(); ny != r.end(); ++ny)
-            for (int nx = 0; nx < nodesX; ++nx) {
-                const size_t n = size_t(ny) * size_t(nodesX) + size_t(nx);
-                if (!nodeNeeded[n]) continue;
-                nodes[n] =
-                    field.Trace(eye, PixelDirection(nx * kCell, ny * kCell), kPlumeSkyRange_m);
-                ++nodeTraces[size_t(ny)];
+    std::vector<CellRow> cellRows{size_t(cellsY)};
+    // Pass 1, the cells' lists and the nodes traced to the sky: each node by the cell it is
+    // the near corner of (the last column's and row's by the cells before them).
+    std::vector<BandTrace> nodes(size_t(nodesX) * size_t(nodesY));
+    std::vector<uint64_t> rowCovered(size_t(cellsY), 0), rowTraces(size_t(cellsY), 0),
+        rowTests(size_t(cellsY), 0);
+    tbb::parallel_for(tbb::blocked_range<int>(0, cellsY, 1), [&](const tbb::blocked_range<int>& r) {
+        PlumeScreenBins::List list;
+        for (int cy = r.begin(); cy != r.end(); ++cy) {
+            CellRow& row = cellRows[size_t(cy)];
+            row.start.assign(size_t(cellsX) + 1, 0);
+            row.count.assign(size_t(cellsX), 0);
+            row.near_m.assign(size_t(cellsX), 0.0f);
+            row.far_m.assign(size_t(cellsX), 0.0f);
+            row.smallOpticalDepth.assign(size_t(cellsX), 0.0f);
+            for (int cx = 0; cx < cellsX; ++cx) {
+                bins.Gather(cx * kCell, cy * kCell, cx * kCell + kCell + 1, cy * kCell + kCell + 1,
+                            float(kCell), false, list);
+                row.start[size_t(cx)] = uint32_t(row.index.size());
+                if (list.size() == 0) continue;
+                row.index.insert(row.index.end(), list.index.begin(), list.index.end());
+                row.count[size_t(cx)] = uint32_t(list.count);
+                row.near_m[size_t(cx)] = list.near_m;
+                row.far_m[size_t(cx)] = list.far_m;
+                row.smallOpticalDepth[size_t(cx)] = list.smallOpticalDepth;
+                for (int k = 0; k < 4; ++k) {
+                    const int nx = cx + k % 2, ny = cy + k / 2;
+                    if ((nx > cx && nx < cellsX) || (ny > cy && ny < cellsY)) continue;
+                    nodes[size_t(ny) * size_t(nodesX) + size_t(nx)] =
+                        bins.Trace(list, PixelDirection(nx * kCell, ny * kCell), kPlumeSkyRange_m);
+                    ++rowTraces[size_t(cy)];
+                    rowTests[size_t(cy)] += list.size();
+                }
             }
+            row.start[size_t(cellsX)] = uint32_t(row.index.size());
+        }
     });
 
-    // Cells in parallel (a row of cells each); each pixel depends only on its own rays and the
-    // cell's corner nodes.
+    // Pass 2, cells in parallel (a row of cells each); each pixel depends only on its own rays
+    // and the cell's corner nodes.
     tbb::parallel_for(
         tbb::blocked_range<int>(0, cellsY, 1), [&](const tbb::blocked_range<int>& rows) {
             std::vector<float> range(samples);
+            PlumeScreenBins::List list;
             for (int cy = rows.begin(); cy != rows.end(); ++cy) {
+                const CellRow& row = cellRows[size_t(cy)];
                 for (int cx = 0; cx < cellsX; ++cx) {
-                    float dNear, dFar;
-                    if (!CellBounds(cx, cy, dNear, dFar)) continue;
-                    const scene::PlumeTrace* corner[4];
+                    if (row.count[size_t(cx)] == 0) continue;
+                    list.count = row.count[size_t(cx)];
+                    list.index.assign(row.index.begin() + row.start[size_t(cx)],
+                                      row.index.begin() + row.start[size_t(cx) + 1]);
+                    list.near_m = row.near_m[size_t(cx)];
+                    list.far_m = row.far_m[size_t(cx)];
+                    list.smallOpticalDepth = row.smallOpticalDepth[size_t(cx)];
+                    list.copied = false;
+                    // The ranges where the cell's puffs can matter.
+                    const float dNear = list.near_m, dFar = list.far_m;
+                    const bool fine = list.smallOpticalDepth > kInterpolationTolerance;
+                    const BandTrace* corner[4];
                     for (int k = 0; k < 4; ++k)
                         corner[k] =
                             &nodes[size_t(cy + k / 2) * size_t(nodesX) + size_t(cx + k % 2)];
-                    // The corners agree: bilinear interpolation of the sky traces is accurate.
-                    float lo = corner[0]->opticalDepth[band], hi = lo;
-                    float tLo = corner[0]->temperature_K[band], tHi = tLo;
-                    for (int k = 1; k < 4; ++k) {
-                        lo = std::min(lo, corner[k]->opticalDepth[band]);
-                        hi = std::max(hi, corner[k]->opticalDepth[band]);
-                        tLo = std::min(tLo, corner[k]->temperature_K[band]);
-                        tHi = std::max(tHi, corner[k]->temperature_K[band]);
+                    // The corners agree and the puffs the corners could miss are faint:
+                    // bilinear interpolation of the sky traces.
+                    // (Temperatures of corners that see absorbing puffs: the others have none.)
+                    float lo = 1.0f, hi = 0.0f, tauHi = 0.0f;
+                    float tLo = std::numeric_limits<float>::infinity(), tHi = 0.0f;
+                    for (int k = 0; k < 4; ++k) {
+                        const float T = std::exp(-corner[k]->opticalDepth);
+                        lo = std::min(lo, T), hi = std::max(hi, T);
+                        tauHi = std::max(tauHi, corner[k]->opticalDepth);
+                        if (corner[k]->temperature_K > 0.0f) {
+                            tLo = std::min(tLo, corner[k]->temperature_K);
+                            tHi = std::max(tHi, corner[k]->temperature_K);
+                        }
                     }
-                    const bool smooth = !cellFine[size_t(cy) * size_t(cellsX) + size_t(cx)] &&
-                                        hi - lo <= kInterpolationTolerance &&
+                    if (tHi == 0.0f) tLo = 0.0f;
+                    const bool smooth = !fine && hi - lo <= kInterpolationTolerance &&
                                         tHi - tLo <= kInterpolationTolerance_K;
+                    // Clear sky at every corner and only faint puffs the corners could miss:
+                    // the sky pixels' blended traces are zero, so only pixels with nearer
+                    // surfaces (which trace their own rays) can change.
+                    const bool clearSky = smooth && tauHi == 0.0f;
                     for (int py = cy * kCell; py < std::min(H, (cy + 1) * kCell); ++py) {
                         for (int px = cx * kCell; px < std::min(W, (cx + 1) * kCell); ++px) {
-                            bool covered = false;
-                            for (const PlumeBounds& b : bounds)
-                                covered |= px >= b.rect.x0 && px < b.rect.x1 && py >= b.rect.y0 &&
-                                           py < b.rect.y1;
-                            if (!covered) continue;
                             ++rowCovered[size_t(cy)];
-                            const glm::vec3 dir = PixelDirection(px, py);
-                            const float cosForward = std::max(glm::dot(dir, forward), 1e-6f);
-                            float rMin = kPlumeSkyRange_m, rMax = 0.0f;
-                            for (int j = 0; j < N; ++j) {
+                            // Samples that see the sky first (no direction needed for them).
+                            bool allSky = true;
+                            for (int j = 0; j < N; ++j)
                                 for (int i = 0; i < N; ++i) {
                                     const size_t idx = vis.Index(px * N + i, py * N + j);
-                                    // depth = near / w, w the distance along the optical axis.
-                                    const float r =
-                                        vis.primitive[idx] == kNoPrimitive || vis.depth[idx] <= 0.0f
-                                            ? kPlumeSkyRange_m
-                                            : std::min(nearM / vis.depth[idx] / cosForward,
-                                                       kPlumeSkyRange_m);
-                                    range[size_t(j * N + i)] = r;
-                                    rMin = std::min(rMin, r), rMax = std::max(rMax, r);
+                                    const bool sky = vis.primitive[idx] == kNoPrimitive ||
+                                                     vis.depth[idx] <= 0.0f;
+                                    range[size_t(j * N + i)] = sky ? kPlumeSkyRange_m : -1.0f;
+                                    allSky &= sky;
                                 }
+                            if (allSky && clearSky) continue;
+                            const glm::vec3 dir = PixelDirection(px, py);
+                            float rMin = kPlumeSkyRange_m, rMax = 0.0f;
+                            if (allSky) {
+                                rMax = kPlumeSkyRange_m;
+                            } else {
+                                // depth = near / w, w the distance along the optical axis.
+                                const float rangeScale =
+                                    nearM / std::max(glm::dot(dir, forward), 1e-6f);
+                                for (int j = 0; j < N; ++j)
+                                    for (int i = 0; i < N; ++i) {
+                                        float& r = range[size_t(j * N + i)];
+                                        if (r < 0.0f)
+                                            r = std::min(
+                                                rangeScale /
+                                                    vis.depth[vis.Index(px * N + i, py * N + j)],
+                                                kPlumeSkyRange_m);
+                                        rMin = std::min(rMin, r), rMax = std::max(rMax, r);
+                                    }
                             }
                             // Every surface in front of the plumes: nothing to add.
                             if (rMax <= dNear) continue;
                             if (rMin >= dFar) {
                                 // Every surface behind the plumes: the sky trace is the trace.
+                                if (clearSky) continue;
                                 if (smooth) {
                                     const float fx = float(px - cx * kCell) / kCell;
                                     const float fy = float(py - cy * kCell) / kCell;
-                                    const scene::PlumeTrace t = Bilinear(
-                                        *corner[0], *corner[1], *corner[2], *corner[3], fx, fy);
-                                    Apply(t, dir, px, py, range.data(), rMin, rMax, nullptr);
+                                    Apply(Bilinear(corner, fx, fy), dir, px, py, range.data(), rMin,
+                                          rMax, nullptr);
                                 } else {
-                                    const scene::PlumeTrace t =
-                                        field.Trace(eye, dir, kPlumeSkyRange_m);
+                                    bins.Copy(list);
                                     ++rowTraces[size_t(cy)];
-                                    Apply(t, dir, px, py, range.data(), rMin, rMax, nullptr);
+                                    rowTests[size_t(cy)] += list.size();
+                                    Apply(bins.Trace(list, dir, kPlumeSkyRange_m), dir, px, py,
+                                          range.data(), rMin, rMax, nullptr);
                                 }
                                 continue;
                             }
-                            const scene::PlumeTrace nearTrace = field.Trace(eye, dir, rMin);
-                            ++rowTraces[size_t(cy)];
-                            // Depth edge: the far samples see what lies beyond the near surface.
+                            // One ray to the nearest surface and, at a depth edge, one to the
+                            // farthest (the far samples see what lies beyond the near surface),
+                            // in one pass over the puffs.
+                            bins.Copy(list);
                             if (rMax > rMin * kDepthEdgeRatio) {
-                                const scene::PlumeTrace farTrace = field.Trace(eye, dir, rMax);
-                                ++rowTraces[size_t(cy)];
+                                BandTrace nearTrace, farTrace;
+                                bins.Trace2(list, dir, rMin, rMax, nearTrace, farTrace);
+                                rowTraces[size_t(cy)] += 2;
+                                rowTests[size_t(cy)] += list.size();
                                 Apply(nearTrace, dir, px, py, range.data(), rMin, rMax, &farTrace);
                             } else {
-                                Apply(nearTrace, dir, px, py, range.data(), rMin, rMax, nullptr);
+                                ++rowTraces[size_t(cy)];
+                                rowTests[size_t(cy)] += list.size();
+                                Apply(bins.Trace(list, dir, rMin), dir, px, py, range.data(), rMin,
+                                      rMax, nullptr);
                             }
                         }
                     }
@@ -423,8 +370,8 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     for (int y = 0; y < cellsY; ++y) {
         stats.pixelsCovered += rowCovered[size_t(y)];
         stats.traces += rowTraces[size_t(y)];
+        stats.puffTests += rowTests[size_t(y)];
     }
-    for (uint64_t n : nodeTraces) stats.traces += n;
     stats.ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return stats;

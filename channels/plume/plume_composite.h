@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "channels/camera/channel_camera.h"
+#include "channels/plume/plume_bins.h"
 #include "channels/raster/rasterizer.h"
 #include "radiometry/planck/planck.h"
 #include "radiometry/sky/analytic_sky.h"
@@ -72,6 +73,7 @@ struct PlumeLighting {
 struct PlumeCompositeStats {
     uint64_t pixelsCovered = 0;  // output pixels inside some plume's screen bounds
     uint64_t traces = 0;         // rays traced (one per covered pixel, two at depth edges)
+    uint64_t puffTests = 0;      // puffs looked at by those traces (their lists' lengths)
     double ms = 0.0;             // bounds, traces and compositing
 };
 
@@ -79,20 +81,22 @@ struct PlumeCompositeStats {
 inline constexpr float kPlumeSkyRange_m = 1.0e6f;
 
 // Composites field over radiance, the channel's supersampled image (3 channels for Visible,
-// 1 for Infrared) of camera with visibility buffer vis. Each plume's puffs (centres ± the trace
-// cutoff of kPuffCutoffSigmas σ) bound a box; the box's screen rectangle (the whole screen
-// when the box reaches behind the near plane) marks the output pixels to consider, and its
-// nearest and farthest points bound the ranges where it can matter. Per covered pixel, with
-// the ranges of its samples' surfaces (sky: kPlumeSkyRange_m):
-//  - all surfaces nearer than every plume box: nothing to do;
-//  - all surfaces beyond every plume box: the sky trace, bilinear from traces at the corners
-//    of its 4×4-pixel cell when no puff smaller than a cell touches the cell and the corners
-//    agree within 0.02 in optical depth and 10 K, else traced through the pixel centre;
+// 1 for Infrared) of camera with visibility buffer vis. The puffs are binned on the screen for
+// the channel's band (PlumeScreenBins: each traced ray's transmittance within
+// kPlumeTransmittanceTolerance of the exact sum over all puffs). Every 4×4-pixel cell takes
+// the puffs whose screen rectangles reach it (none: the cell is left alone), and the nearest
+// and farthest points of their boxes bound the ranges where they can matter. Per pixel of such
+// a cell, with the ranges of its samples' surfaces (sky: kPlumeSkyRange_m):
+//  - all surfaces nearer than the cell's puffs: nothing to do;
+//  - all surfaces beyond them: the sky trace, bilinear from traces at the corners of the cell
+//    when the corners' transmittances agree within 0.02 and their temperatures (where they see
+//    absorbing puffs) within 10 K, and the puffs smaller than a cell reaching it could add at
+//    most 0.02 in optical depth; else traced through the pixel centre;
 //  - otherwise one ray through the pixel centre to the nearest surface and, when the ranges
-//    differ by more than 10 %, a second to the farthest; each sample takes the trace whose end
-//    is nearer its own range.
-// Samples outside every rectangle are left bit for bit as they were. Runs in the caller's
-// oneTBB arena; bit-identical for any thread count.
+//    differ by more than 10 %, to the farthest in the same pass; each sample takes the trace
+//    whose end is nearer its own range.
+// Samples whose traces have no optical depth are left bit for bit as they were. Runs in the
+// caller's oneTBB arena; bit-identical for any thread count.
 PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const ChannelCamera& camera,
                                     const VisibilityBuffer& vis, const PlumeLighting& light,
                                     Image& radiance);

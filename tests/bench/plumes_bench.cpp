@@ -1,16 +1,24 @@
-// Plume benchmarks: committing 20 plumes for a frame, the per-pixel transmittance query for a
-// 640x480 view of those 20 plumes (oneTBB, all threads of the process), and the channels'
-// compositing of them (screen bounds, per-pixel traces) at 1 and 2 threads.
+// Plume benchmarks: committing 20 plumes for a frame, the per-frame scene update (clock,
+// ephemeris, sky, 20 plumes), the per-pixel transmittance query for a 640x480 view of those
+// 20 plumes (oneTBB, all threads of the process), and the channels' compositing at 1 and 2
+// threads of a 640x480 view of all twenty and of a view with five of twenty in it.
 #include <benchmark/benchmark.h>
 #include <tbb/task_arena.h>
 
 #include <cmath>
+#include <filesystem>
+#include <memory>
 #include <numbers>
 #include <vector>
 
 #include "channels/plume/plume_composite.h"
+#include "radiometry/sky/analytic_sky.h"
 #include "scene/core/frames.h"
 #include "scene/plumes/plume_system.h"
+#include "scene/scenario/scenario_loader.h"
+#include "scene/sky/illuminance.h"
+#include "scene/sky/stars.h"
+#include "scene/world/world.h"
 
 namespace seasense::scene {
 namespace {
@@ -86,17 +94,41 @@ void BM_PlumeTransmittance640x480(benchmark::State& state) {
 }
 BENCHMARK(BM_PlumeTransmittance640x480)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// Twenty plumes of which five are in a 60° view north from the origin: two fires with a flame
+// at one of them, a ship funnel and a steam vent 1.5–3 km ahead; the other fifteen (fires and
+// funnels) 2–4 km behind the camera. Wind 5 m/s toward the east.
+PlumeSystem FiveOfTwentyInView() {
+    PlumesSettings settings;
+    const auto add = [&](PlumeKind kind, glm::dvec3 position_m) {
+        PlumeSourceSettings s = DefaultPlumeSource(kind);
+        s.position_m = position_m;
+        s.seed = uint64_t(settings.sources.size() + 1);
+        settings.sources.push_back(s);
+    };
+    add(PlumeKind::Smoke, {-500.0, 2000.0, 0.0});
+    add(PlumeKind::Flame, {-500.0, 2000.0, 0.0});
+    add(PlumeKind::Smoke, {300.0, 3000.0, 0.0});
+    add(PlumeKind::Exhaust, {-100.0, 1500.0, 30.0});
+    add(PlumeKind::Steam, {600.0, 2500.0, 20.0});
+    for (int i = 0; i < 15; ++i)
+        add(i % 3 == 2 ? PlumeKind::Exhaust : PlumeKind::Smoke,
+            {-1400.0 + 200.0 * i, -2000.0 - 150.0 * (i % 4), i % 3 == 2 ? 30.0 : 0.0});
+    PlumeAmbient ambient;
+    ambient.windSpeed_mps = 5.0;
+    ambient.windDirection_rad = std::numbers::pi / 2;
+    ambient.sunElevation_rad = 0.6;
+    return PlumeSystem(settings, ambient);
+}
+
 // CompositePlumes on a 640x480 OTW frame (2x2 supersampling, sea below the horizon at the
-// range of a level plane 40 m below the eye) of the twenty plumes, at state.range(0) threads;
-// the commit is not included (BM_PlumeCommit20).
-void BM_PlumeComposite(benchmark::State& state) {
-    const PlumeSystem system = TwentyPlumes();
-    PlumeField field = system.MakeField();
-    system.Commit(300.0, field);
+// range of a level plane 40 m below the eye) of field seen from eye, tilted up 4°, at
+// `threads` threads; the commit is not included (BM_PlumeCommit20).
+void CompositeFrames(benchmark::State& state, const PlumeField& field, const glm::dvec3& eye,
+                     int threads) {
     channels::ChannelCamera cam;
     Attitude attitude;
     attitude.pitch_rad = 4.0 * std::numbers::pi / 180.0;
-    cam.worldFromCamera = Pose{glm::dvec3(0.0, -2500.0, 40.0), WorldFromBodyRotation(attitude)};
+    cam.worldFromCamera = Pose{eye, WorldFromBodyRotation(attitude)};
     cam.hfov_rad = kHfov_rad;
     cam.width = kWidth;
     cam.height = kHeight;
@@ -114,7 +146,7 @@ void BM_PlumeComposite(benchmark::State& state) {
             const glm::dvec3 d = cam.SampleDirection(x, y);
             if (d.z >= -1e-3) continue;
             vis.primitive[vis.Index(x, y)] = 0;
-            vis.depth[vis.Index(x, y)] = float(cam.near_m / (40.0 / -d.z * glm::dot(d, forward)));
+            vis.depth[vis.Index(x, y)] = float(cam.near_m / (eye.z / -d.z * glm::dot(d, forward)));
         }
     }
     const channels::BlackbodyGlowTable glow;
@@ -125,7 +157,7 @@ void BM_PlumeComposite(benchmark::State& state) {
     light.glow = &glow;
     Image background(cam.SampleWidth(), cam.SampleHeight(), 3), image;
     std::fill(background.pixels.begin(), background.pixels.end(), 1000.0f);
-    tbb::task_arena arena(int(state.range(0)));
+    tbb::task_arena arena(threads);
     channels::PlumeCompositeStats stats;
     for (auto _ : state) {
         state.PauseTiming();
@@ -137,8 +169,82 @@ void BM_PlumeComposite(benchmark::State& state) {
     state.counters["puffs"] = double(field.PuffCount());
     state.counters["covered_pixels"] = double(stats.pixelsCovered);
     state.counters["traces"] = double(stats.traces);
+    state.counters["puff_tests"] = double(stats.puffTests);
+}
+
+// All twenty plumes of TwentyPlumes in view from (0, −2500, 40).
+void BM_PlumeComposite(benchmark::State& state) {
+    const PlumeSystem system = TwentyPlumes();
+    PlumeField field = system.MakeField();
+    system.Commit(300.0, field);
+    CompositeFrames(state, field, glm::dvec3(0.0, -2500.0, 40.0), int(state.range(0)));
 }
 BENCHMARK(BM_PlumeComposite)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// Issue 4's case: a 640x480 view with five plumes in it (of twenty), from (0, 0, 40).
+void BM_PlumeComposite5InView(benchmark::State& state) {
+    const PlumeSystem system = FiveOfTwentyInView();
+    PlumeField field = system.MakeField();
+    system.Commit(300.0, field);
+    CompositeFrames(state, field, glm::dvec3(0.0, 0.0, 40.0), int(state.range(0)));
+}
+BENCHMARK(BM_PlumeComposite5InView)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The per-frame scene update of issue 4's "sky, clock and 20 plumes" target, on one thread:
+// the clock and the sun and moon ephemeris with their illuminance (World::State of
+// configs/plumes.yaml with the sun from the ephemeris, one frame after another at 30 Hz),
+// the natural illuminance of the observer (Circular 171), the channel's sky (AnalyticSky,
+// rebuilt when the sun or moon rounded to 0.01° moved, as OtwChannel does; state.range(0) = 1
+// rebuilds it every frame, the worst frame), the plumes' ambient light from it, and committing
+// the twenty plumes of TwentyPlumes.
+void BM_SkyClockPlumesUpdate(benchmark::State& state) {
+    Scenario sc = LoadScenario(std::filesystem::path(SEASENSE_SOURCE_DIR) / "configs/plumes.yaml");
+    sc.environment.sun.fromEphemeris = true;
+    const World world(sc);
+    const PlumeSystem system = TwentyPlumes();
+    PlumeField field = system.MakeField();
+    const bool everyFrame = state.range(0) != 0;
+    constexpr double kStep_rad = 0.01 * std::numbers::pi / 180.0;  // OtwChannel's kSkySunStep
+    Observer observer;
+    observer.latitude_deg = sc.world.latitude_deg;
+    observer.longitude_deg = sc.world.longitude_deg;
+    observer.height_m = sc.eyepoint.position_m.z;
+    std::unique_ptr<radiometry::AnalyticSky> sky;
+    glm::dvec3 skySun(0.0), skyMoon(0.0);
+    int64_t frame = 0, rebuilds = 0;
+    double lux = 0.0;
+    for (auto _ : state) {
+        const SceneState s = world.State(frame++);
+        lux += NaturalIlluminance(s.utc, observer).total_lux;
+        const glm::dvec3 sun = radiometry::QuantizeSunDirection(s.sun.direction, kStep_rad);
+        const glm::dvec3 moon = radiometry::QuantizeSunDirection(s.moon.direction, kStep_rad);
+        if (everyFrame || !sky || sun != skySun || moon != skyMoon) {
+            radiometry::SkyConditions c;
+            c.sunDirection = sun;
+            c.sunIlluminance_lux = s.sun.illuminance_lux;
+            c.turbidity = sc.environment.sky.turbidity;
+            c.extinctionV_magPerAirmass = ZenithExtinctionV_mag(observer.height_m);
+            c.moon = true;
+            c.moonDirection = moon;
+            c.moonPhaseAngle_rad = s.moon.phaseAngle_rad;
+            c.moonDistance_m = s.moon.distance_m;
+            sky = std::make_unique<radiometry::AnalyticSky>(c);
+            skySun = sun, skyMoon = moon;
+            ++rebuilds;
+        }
+        benchmark::DoNotOptimize(channels::VisibleAmbientRadiance(*sky));
+        system.Commit(300.0 + s.time_s, field);
+        benchmark::DoNotOptimize(field.PuffCount());
+    }
+    benchmark::DoNotOptimize(lux);
+    state.counters["sky_rebuilds_per_frame"] = double(rebuilds) / double(state.iterations());
+    state.counters["puffs"] = double(field.PuffCount());
+}
+BENCHMARK(BM_SkyClockPlumesUpdate)
+    ->ArgName("sky_every_frame")
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace seasense::scene

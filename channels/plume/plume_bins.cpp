@@ -1,0 +1,356 @@
+// Screen-space puff bins: per-puff tolerance footprints, tile lists and the per-ray trace.
+#include "channels/plume/plume_bins.h"
+
+#include <algorithm>
+#include <cmath>
+#include <iterator>
+#include <limits>
+#include <numbers>
+
+#include "scene/core/check.h"
+#include "scene/core/simd4.h"
+
+namespace seasense::channels {
+
+PlumeScreenBins::PlumeScreenBins(const scene::PlumeField& field, const ChannelCamera& camera,
+                                 scene::ObscurantBand band, float tolerance) {
+    CHECK(tolerance > 0.0f);
+    width_ = camera.width + kMargin;
+    height_ = camera.height + kMargin;
+    tilesX_ = (width_ + kTile - 1) / kTile;
+    tilesY_ = (height_ + kTile - 1) / kTile;
+    const scene::PlumeField::PuffArrays puffs = field.Puffs();
+    const size_t n = puffs.x.size();
+    puffTolerance_ = tolerance / float(std::max<size_t>(n, 1));
+    const double eps = puffTolerance_;
+
+    const glm::dmat3 cameraFromWorld = glm::transpose(camera.worldFromCamera.worldFromBody);
+    const glm::dvec3 eye = camera.worldFromCamera.position_m;
+    const double tanH = camera.TanHalfH(), tanV = camera.TanHalfV();
+    const double W = camera.width, H = camera.height;
+    const double pixelAngle = 2.0 * tanH / W;
+    const size_t b = size_t(band);
+    const double sqrt2Pi = std::sqrt(2.0 * std::numbers::pi);
+    const double halfSqrtPi = 0.5 * std::sqrt(std::numbers::pi);
+    for (size_t i = 0; i < n; ++i) {
+        const scene::ObscurantOptics& optics = field.Optics(puffs.plume[i]);
+        const double alpha = optics.massExtinction_m2pkg[b];
+        const double sh = 1.0 / std::sqrt(double(puffs.invVarH[i]));
+        const double sz = 1.0 / std::sqrt(double(puffs.invVarZ[i]));
+        // Line integral through the centre: peak √(2π/A), largest for A = 1/max(σ)².
+        const double tauMax = alpha * double(puffs.peak_kgpm3[i]) * sqrt2Pi * std::max(sh, sz);
+        if (!(tauMax > eps)) continue;
+        const double r2 = 2.0 * std::log(tauMax / eps);
+        const double r = std::sqrt(r2);
+        const glm::dvec3 c{puffs.x[i], puffs.y[i], puffs.z[i]};
+        const glm::dvec3 lo = c - glm::dvec3(r * sh, r * sh, r * sz);
+        const glm::dvec3 hi = c + glm::dvec3(r * sh, r * sh, r * sz);
+        // Screen rectangle of the box, as pixel indices.
+        double xMin = 1e300, xMax = -1e300, yMin = 1e300, yMax = -1e300, far = 0.0;
+        int behind = 0;
+        for (int k = 0; k < 8; ++k) {
+            const glm::dvec3 p{k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z};
+            far = std::max(far, glm::length(p - eye));
+            const glm::dvec3 q = cameraFromWorld * (p - eye);  // x right, y forward, z up
+            if (q.y < camera.near_m) {
+                ++behind;
+                continue;
+            }
+            const double x = (q.x / (q.y * tanH) + 1.0) * 0.5 * W;
+            const double y = (1.0 - q.z / (q.y * tanV)) * 0.5 * H;
+            xMin = std::min(xMin, x), xMax = std::max(xMax, x);
+            yMin = std::min(yMin, y), yMax = std::max(yMax, y);
+        }
+        if (behind == 8) continue;
+        Rect rect{0, 0, width_, height_};
+        if (behind == 0) {
+            const auto clampX = [&](double v) { return int(std::clamp(v, 0.0, double(width_))); };
+            const auto clampY = [&](double v) { return int(std::clamp(v, 0.0, double(height_))); };
+            rect = {clampX(std::floor(xMin) - 1.0), clampY(std::floor(yMin) - 1.0),
+                    clampX(std::ceil(xMax) + 1.0), clampY(std::ceil(yMax) + 1.0)};
+        }
+        if (rect.x0 >= rect.x1 || rect.y0 >= rect.y1) continue;
+        const double nearest = glm::length(glm::clamp(eye, lo, hi) - eye);
+        const glm::dvec3 qc = cameraFromWorld * (c - eye);
+        const double sigmaPixels = qc.y > camera.near_m ? std::min(sh, sz) / (qc.y * pixelAngle)
+                                                        : std::numeric_limits<double>::infinity();
+
+        const double omega = optics.albedo[b];
+        const double T = puffs.temperature_K[i];
+        const double hot = T >= double(scene::kHotPuff_K) ? 1.0 - omega : 0.0;
+        kept_.push_back(uint32_t(i));
+        rect_.push_back(rect);
+        const float values[kFields] = {
+            float(eye.x - c.x), float(eye.y - c.y), float(eye.z - c.z), puffs.invVarH[i],
+            puffs.invVarZ[i], float(r2), float(alpha * double(puffs.peak_kgpm3[i]) * halfSqrtPi),
+            // Float margins: a little nearer and farther than the box.
+            float(nearest * 0.999), float(omega), float((1.0 - omega) * T), float(hot),
+            float(hot * T), float(omega * optics.asymmetry)};
+        for (int f = 0; f < kFields; ++f) data_[f].push_back(values[f]);
+        far_.push_back(float(far * 1.001 + 1.0));
+        sigmaPixels_.push_back(float(sigmaPixels));
+        tauMax_.push_back(float(tauMax));
+    }
+
+    // The inert puff: a unit sphere at the eye with a negative cutoff, beyond every range.
+    inert_ = uint32_t(kept_.size());
+    const float inert[kFields] = {0, 0, 0, 1, 1, -1, 0, std::numeric_limits<float>::infinity(),
+                                  0, 0, 0, 0, 0};
+    for (int f = 0; f < kFields; ++f) data_[f].push_back(inert[f]);
+
+    // Counting sort of (tile, kept position) pairs: per tile in increasing kept position.
+    tileStart_.assign(size_t(tilesX_) * size_t(tilesY_) + 1, 0);
+    for (const Rect& r : rect_)
+        for (int ty = r.y0 / kTile; ty <= (r.y1 - 1) / kTile; ++ty)
+            for (int tx = r.x0 / kTile; tx <= (r.x1 - 1) / kTile; ++tx)
+                ++tileStart_[size_t(ty) * size_t(tilesX_) + size_t(tx) + 1];
+    for (size_t t = 1; t < tileStart_.size(); ++t) tileStart_[t] += tileStart_[t - 1];
+    tileEntries_.resize(tileStart_.back());
+    std::vector<uint32_t> fill(tileStart_.begin(), tileStart_.end() - 1);
+    for (size_t k = 0; k < rect_.size(); ++k) {
+        const Rect& r = rect_[k];
+        for (int ty = r.y0 / kTile; ty <= (r.y1 - 1) / kTile; ++ty)
+            for (int tx = r.x0 / kTile; tx <= (r.x1 - 1) / kTile; ++tx)
+                tileEntries_[fill[size_t(ty) * size_t(tilesX_) + size_t(tx)]++] = uint32_t(k);
+    }
+}
+
+int PlumeScreenBins::TileOf(int px, int py) const {
+    CHECK(px >= 0 && px < width_ && py >= 0 && py < height_);
+    return (py / kTile) * tilesX_ + px / kTile;
+}
+
+void PlumeScreenBins::Gather(int x0, int y0, int x1, int y1, float smallPixels, bool copy,
+                             List& out) const {
+    out.count = 0;
+    out.index.clear();
+    out.near_m = std::numeric_limits<float>::infinity();
+    out.far_m = 0.0f;
+    out.smallOpticalDepth = 0.0f;
+    x1 = std::min(x1, width_), y1 = std::min(y1, height_);
+    if (x0 < x1 && y0 < y1) {
+        // The rectangle's tiles; their lists are merged in kept order, each puff once.
+        const int tx0 = x0 / kTile, tx1 = (x1 - 1) / kTile;
+        const int ty0 = y0 / kTile, ty1 = (y1 - 1) / kTile;
+        constexpr int kMaxTiles = 4;
+        CHECK_MSG((tx1 - tx0 + 1) * (ty1 - ty0 + 1) <= kMaxTiles, "gather over > 4 tiles");
+        const uint32_t* cur[kMaxTiles];
+        const uint32_t* end[kMaxTiles];
+        int lists = 0;
+        for (int ty = ty0; ty <= ty1; ++ty)
+            for (int tx = tx0; tx <= tx1; ++tx) {
+                const size_t t = size_t(ty) * size_t(tilesX_) + size_t(tx);
+                cur[lists] = tileEntries_.data() + tileStart_[t];
+                end[lists] = tileEntries_.data() + tileStart_[t + 1];
+                if (cur[lists] != end[lists]) ++lists;
+            }
+        const auto take = [&](uint32_t k) {
+            const Rect& r = rect_[k];
+            if (r.x1 <= x0 || r.x0 >= x1 || r.y1 <= y0 || r.y0 >= y1) return;
+            out.index.push_back(k);
+            out.near_m = std::min(out.near_m, data_[kNear][k]);
+            out.far_m = std::max(out.far_m, far_[k]);
+            if (sigmaPixels_[k] < smallPixels) out.smallOpticalDepth += tauMax_[k];
+        };
+        if (lists == 1) {
+            for (const uint32_t* p = cur[0]; p != end[0]; ++p) take(*p);
+        } else {
+            for (;;) {
+                uint32_t k = std::numeric_limits<uint32_t>::max();
+                for (int l = 0; l < lists; ++l)
+                    if (cur[l] != end[l]) k = std::min(k, *cur[l]);
+                if (k == std::numeric_limits<uint32_t>::max()) break;
+                for (int l = 0; l < lists; ++l)
+                    if (cur[l] != end[l] && *cur[l] == k) ++cur[l];
+                take(k);
+            }
+        }
+    }
+    out.count = out.index.size();
+    const size_t padded = (out.count + 3) & ~size_t(3);
+    out.index.resize(padded, inert_);
+    out.copied = false;
+    if (copy) Copy(out);
+}
+
+void PlumeScreenBins::Copy(List& list) const {
+    static_assert(std::size(decltype(List::data){}) == kFields);
+    if (list.copied) return;
+    for (int f = 0; f < kFields; ++f) {
+        std::vector<float>& v = list.data[f];
+        v.resize(list.index.size());
+        const float* src = data_[f].data();
+        for (size_t j = 0; j < list.index.size(); ++j) v[j] = src[list.index[j]];
+    }
+    list.copied = true;
+}
+
+namespace {
+
+using simd4::F4;
+
+// e^x for x ≤ 0, four lanes: x = n ln 2 + r with |r| ≤ ln 2 / 2 (ln 2 split in two so that
+// n ln 2 is exact, Cody & Waite, "Software Manual for the Elementary Functions" (1980) ch. 6),
+// e^r by its degree-6 Taylor polynomial (remainder ≤ (ln 2 / 2)^7 / 7! · √2 < 1.7e-7
+// relative), 2^n by the exponent bits. Arguments below −87 give e^−87 (< 1.7e-38, nothing here).
+inline F4 Exp4(F4 x) {
+    x = _mm_max_ps(x, _mm_set1_ps(-87.0f));
+    const __m128i n = _mm_cvtps_epi32(_mm_mul_ps(x, _mm_set1_ps(1.44269504f)));  // round
+    const F4 fn = _mm_cvtepi32_ps(n);
+    F4 r = _mm_sub_ps(x, _mm_mul_ps(fn, _mm_set1_ps(0.693359375f)));
+    r = _mm_sub_ps(r, _mm_mul_ps(fn, _mm_set1_ps(-2.12194440e-4f)));
+    F4 p = _mm_set1_ps(1.0f / 720.0f);
+    p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(1.0f / 120.0f));
+    p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(1.0f / 24.0f));
+    p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(1.0f / 6.0f));
+    p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(0.5f));
+    p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(1.0f));
+    p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(1.0f));
+    const F4 scale = _mm_castsi128_ps(_mm_slli_epi32(_mm_add_epi32(n, _mm_set1_epi32(127)), 23));
+    return _mm_mul_ps(p, scale);
+}
+
+// FastErf on four lanes (A&S 7.1.26 with Exp4; |error| ≤ 1.5e-7 + 2e-7).
+inline F4 Erf4(F4 x) {
+    const F4 sign = _mm_and_ps(x, _mm_set1_ps(-0.0f));
+    const F4 ax = simd4::Abs4(x);
+    const F4 t = _mm_div_ps(_mm_set1_ps(1.0f),
+                            _mm_add_ps(_mm_set1_ps(1.0f), _mm_mul_ps(_mm_set1_ps(0.3275911f), ax)));
+    F4 poly = _mm_set1_ps(1.061405429f);
+    poly = _mm_add_ps(_mm_mul_ps(poly, t), _mm_set1_ps(-1.453152027f));
+    poly = _mm_add_ps(_mm_mul_ps(poly, t), _mm_set1_ps(1.421413741f));
+    poly = _mm_add_ps(_mm_mul_ps(poly, t), _mm_set1_ps(-0.284496736f));
+    poly = _mm_add_ps(_mm_mul_ps(poly, t), _mm_set1_ps(0.254829592f));
+    poly = _mm_mul_ps(poly, t);
+    F4 e = _mm_sub_ps(_mm_set1_ps(1.0f),
+                      _mm_mul_ps(poly, Exp4(_mm_sub_ps(_mm_setzero_ps(), _mm_mul_ps(ax, ax)))));
+    e = simd4::Select4(_mm_cmpge_ps(ax, _mm_set1_ps(3.9f)), _mm_set1_ps(1.0f), e);
+    return _mm_or_ps(e, sign);
+}
+
+// Erf4, skipped when every lane is at or beyond ±3.9 where Erf4 is ±1: rays that start well
+// before a puff and end well beyond it, the common case.
+inline F4 ErfOrSign4(F4 x) {
+    const F4 saturated = _mm_cmpge_ps(simd4::Abs4(x), _mm_set1_ps(3.9f));
+    if (_mm_movemask_ps(saturated) == 0xF)
+        return _mm_or_ps(_mm_set1_ps(1.0f), _mm_and_ps(x, _mm_set1_ps(-0.0f)));
+    return Erf4(x);
+}
+
+inline float Sum4(F4 v) {
+    alignas(16) float f[4];
+    _mm_store_ps(f, v);
+    return (f[0] + f[1]) + (f[2] + f[3]);
+}
+
+struct BandAccumulator {
+    F4 extinction = _mm_setzero_ps(), scattering = _mm_setzero_ps(), absorption = _mm_setzero_ps(),
+       absorptionT = _mm_setzero_ps(), hotAbsorption = _mm_setzero_ps(),
+       hotAbsorptionT = _mm_setzero_ps(), scatteringG = _mm_setzero_ps();
+
+    // Weights w[0..4]: scattering, absorption × T, hot absorption, hot absorption × T,
+    // scattering × g per unit optical depth.
+    void Add(const F4 (&w)[5], F4 tau) {
+        extinction = _mm_add_ps(extinction, tau);
+        const F4 scattered = _mm_mul_ps(tau, w[0]);
+        scattering = _mm_add_ps(scattering, scattered);
+        absorption = _mm_add_ps(absorption, _mm_sub_ps(tau, scattered));
+        absorptionT = _mm_add_ps(absorptionT, _mm_mul_ps(tau, w[1]));
+        hotAbsorption = _mm_add_ps(hotAbsorption, _mm_mul_ps(tau, w[2]));
+        hotAbsorptionT = _mm_add_ps(hotAbsorptionT, _mm_mul_ps(tau, w[3]));
+        scatteringG = _mm_add_ps(scatteringG, _mm_mul_ps(tau, w[4]));
+    }
+
+    BandTrace Result() const {
+        const float ext = Sum4(extinction), scat = Sum4(scattering), abs = Sum4(absorption);
+        const float hot = Sum4(hotAbsorption);
+        BandTrace t;
+        t.opticalDepth = ext;
+        t.albedo = ext > 0.0f ? scat / ext : 0.0f;
+        t.temperature_K = abs > 0.0f ? Sum4(absorptionT) / abs : 0.0f;
+        t.hotFraction = abs > 0.0f ? std::min(hot / abs, 1.0f) : 0.0f;
+        t.hotTemperature_K = hot > 0.0f ? Sum4(hotAbsorptionT) / hot : 0.0f;
+        t.asymmetry = scat > 0.0f ? Sum4(scatteringG) / scat : 0.0f;
+        return t;
+    }
+};
+
+}  // namespace
+
+// Four puffs at a time. Per puff, along the ray the exponent of the Gaussian is
+// −(A s² + 2 B s + C) / 2, so ∫ over [0, S] = e^(−m²/2) (√π / 2) / √(A/2) · (erf u1 − erf u0),
+// m² the squared Mahalanobis distance of the closest approach s* = −B / A, u0 = −s* √(A/2),
+// u1 = u0 + S √(A/2).
+void PlumeScreenBins::Trace2(const List& list, const glm::vec3& dir, float range_m, float range2_m,
+                             BandTrace& first, BandTrace& second) const {
+    if (list.copied)
+        Trace2Impl<true>(list, dir, range_m, range2_m, first, second);
+    else
+        Trace2Impl<false>(list, dir, range_m, range2_m, first, second);
+}
+
+template <bool Copied>
+void PlumeScreenBins::Trace2Impl(const List& l, const glm::vec3& dir, float range_m, float range2_m,
+                                 BandTrace& first, BandTrace& second) const {
+    // Four puffs' values of field f from k on: contiguous in a copied list, else gathered.
+    const auto load = [&](int f, size_t k) {
+        if constexpr (Copied) {
+            return _mm_loadu_ps(l.data[f].data() + k);
+        } else {
+            const float* v = data_[f].data();
+            const uint32_t* i = l.index.data() + k;
+            return _mm_setr_ps(v[i[0]], v[i[1]], v[i[2]], v[i[3]]);
+        }
+    };
+    BandAccumulator a1, a2;
+    const bool two = range2_m != range_m;
+    const F4 dx = _mm_set1_ps(dir.x), dy = _mm_set1_ps(dir.y), dz = _mm_set1_ps(dir.z);
+    const F4 dh2 = _mm_set1_ps(dir.x * dir.x + dir.y * dir.y), dz2 = _mm_set1_ps(dir.z * dir.z);
+    const F4 end = _mm_set1_ps(std::max(range_m, range2_m));
+    const F4 r1 = _mm_set1_ps(range_m), r2 = _mm_set1_ps(range2_m);
+    const F4 zero = _mm_setzero_ps(), half = _mm_set1_ps(0.5f);
+    for (size_t k = 0; k < l.index.size(); k += 4) {
+        const F4 qx = load(kQx, k), qy = load(kQy, k), qz = load(kQz, k);
+        const F4 ivh = load(kIvh, k), ivz = load(kIvz, k);
+        const F4 A = _mm_add_ps(_mm_mul_ps(dh2, ivh), _mm_mul_ps(dz2, ivz));
+        const F4 B = _mm_add_ps(_mm_mul_ps(_mm_add_ps(_mm_mul_ps(dx, qx), _mm_mul_ps(dy, qy)), ivh),
+                                _mm_mul_ps(_mm_mul_ps(dz, qz), ivz));
+        // The offset at the closest approach rather than C − B²/A, which cancels
+        // catastrophically in float for far rays.
+        const F4 sStar = _mm_sub_ps(zero, _mm_div_ps(B, A));
+        const F4 rx = _mm_add_ps(qx, _mm_mul_ps(sStar, dx));
+        const F4 ry = _mm_add_ps(qy, _mm_mul_ps(sStar, dy));
+        const F4 rz = _mm_add_ps(qz, _mm_mul_ps(sStar, dz));
+        const F4 m2 =
+            _mm_add_ps(_mm_mul_ps(_mm_add_ps(_mm_mul_ps(rx, rx), _mm_mul_ps(ry, ry)), ivh),
+                       _mm_mul_ps(_mm_mul_ps(rz, rz), ivz));
+        const F4 use =
+            _mm_and_ps(_mm_cmple_ps(m2, load(kCutoff2, k)), _mm_cmplt_ps(load(kNear, k), end));
+        if (_mm_movemask_ps(use) == 0) continue;
+        const F4 scale = _mm_sqrt_ps(_mm_mul_ps(half, A));
+        const F4 u0 = _mm_sub_ps(zero, _mm_mul_ps(sStar, scale));
+        const F4 amplitude = _mm_div_ps(
+            _mm_mul_ps(load(kKappa, k), Exp4(_mm_mul_ps(_mm_set1_ps(-0.5f), m2))), scale);
+        const F4 u1 = _mm_add_ps(u0, _mm_mul_ps(r1, scale));
+        const F4 e0 = ErfOrSign4(u0), e1 = ErfOrSign4(u1);
+        const F4 w[5] = {load(kWs, k), load(kWAbsT, k), load(kWHot, k), load(kWHotT, k),
+                         load(kWg, k)};
+        const F4 tau1 = _mm_mul_ps(amplitude, _mm_sub_ps(e1, e0));
+        a1.Add(w, _mm_and_ps(_mm_and_ps(use, _mm_cmpgt_ps(tau1, zero)), tau1));
+        if (two) {
+            const F4 e2 = ErfOrSign4(_mm_add_ps(u0, _mm_mul_ps(r2, scale)));
+            const F4 tau2 = _mm_mul_ps(amplitude, _mm_sub_ps(e2, e0));
+            a2.Add(w, _mm_and_ps(_mm_and_ps(use, _mm_cmpgt_ps(tau2, zero)), tau2));
+        }
+    }
+    first = a1.Result();
+    second = two ? a2.Result() : first;
+}
+
+BandTrace PlumeScreenBins::Trace(const List& list, const glm::vec3& dir, float range_m) const {
+    BandTrace t, unused;
+    Trace2(list, dir, range_m, range_m, t, unused);
+    return t;
+}
+
+}  // namespace seasense::channels

@@ -1,0 +1,127 @@
+// Screen-space bins of a plume field's puffs for one camera and one band: each puff's footprint
+// on the screen (where its optical depth can exceed a stated tolerance), binned into tiles,
+// and the per-ray trace over a short list of puffs.
+#pragma once
+
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <span>
+#include <vector>
+
+#include "channels/camera/channel_camera.h"
+#include "scene/plumes/plume_field.h"
+
+namespace seasense::channels {
+
+// What a ray meets in the plumes in one band (the compositor's view of scene::PlumeTrace):
+// optical depth τ, τ-weighted single-scattering albedo, absorption-weighted temperature of all
+// puffs and of the hot (≥ scene::kHotPuff_K) ones with the hot share of the absorption, and the
+// Henyey–Greenstein asymmetry weighted by scattering depth (meaningful in the visible).
+struct BandTrace {
+    float opticalDepth = 0.0f;
+    float albedo = 0.0f;
+    float temperature_K = 0.0f;
+    float hotFraction = 0.0f;
+    float hotTemperature_K = 0.0f;
+    float asymmetry = 0.0f;
+};
+
+// Default bound on |T − T_exact| of a traced pixel, T = e^(−τ) (absolute).
+inline constexpr float kPlumeTransmittanceTolerance = 1.0e-3f;
+
+// The puffs of a field projected through a camera (output pixels, ENU world). A puff whose
+// optical depth along any line stays at or below the per-puff tolerance ε = tolerance / (number
+// of puffs in the field) is dropped; any other puff i contributes at most ε to a ray that passes
+// outside its ellipsoid of Mahalanobis radius r_i, τ_max,i e^(−r_i²/2) = ε (τ_max,i its optical
+// depth through the centre along its longest axis; the part of any ray outside the ellipsoid
+// carries at most ε of it, because erfc x ≤ e^(−x²)). Each kept puff's ellipsoid bounds a box
+// whose screen rectangle (widened by a pixel; the whole screen if the box reaches behind the
+// near plane) is binned into kTile × kTile tiles. A ray through pixel (px, py) then loops only
+// over the puffs whose rectangles contain the pixel, and a puff whose box lies entirely beyond
+// the ray's end is skipped; everything skipped adds at most ε each, so the trace's optical depth
+// is within tolerance of the exact sum over all puffs and T within tolerance of e^(−τ_exact)
+// (|e^(−a) − e^(−b)| ≤ |a − b|), plus float rounding and the 1.5e-7 error of the erf
+// approximation. Pixel coordinates run over [0, width + kMargin) × [0, height + kMargin): the
+// extra columns and rows serve interpolation nodes beyond the far edges.
+class PlumeScreenBins {
+  public:
+    static constexpr int kTile = 32;   // pixels
+    static constexpr int kMargin = 8;  // pixels beyond the image's right and bottom edges
+
+    PlumeScreenBins(const scene::PlumeField& field, const ChannelCamera& camera,
+                    scene::ObscurantBand band, float tolerance = kPlumeTransmittanceTolerance);
+
+    // Per-puff optical-depth tolerance ε.
+    float PuffTolerance() const { return puffTolerance_; }
+    size_t KeptPuffs() const { return kept_.size(); }
+    size_t BinEntries() const { return tileEntries_.size(); }
+
+    // The puffs whose rectangles overlap the pixel rectangle [x0, x1) × [y0, y1) (at most 2 × 2
+    // tiles), in field order, padded with an inert puff to a multiple of 4; with the nearest
+    // and farthest range (m) where they can matter and the sum of the largest optical depths
+    // (through the centre along the longest axis) of those with σ under smallPixels pixels at
+    // their distance. With copy, their data is also gathered into contiguous arrays
+    // (worth it when the list serves many rays).
+    struct List {
+        size_t count = 0;  // puffs (index and the arrays hold count rounded up to 4)
+        float near_m = 0.0f, far_m = 0.0f;
+        float smallOpticalDepth = 0.0f;
+        bool copied = false;
+        std::vector<uint32_t> index;  // kept positions
+        std::vector<float> data[13];  // per field of Arrays, when copied
+        size_t size() const { return count; }
+    };
+    void Gather(int x0, int y0, int x1, int y1, float smallPixels, bool copy, List& out) const;
+    // Copies a gathered list's data (no-op when copied already).
+    void Copy(List& list) const;
+    // Tile of pixel (px, py).
+    int TileOf(int px, int py) const;
+
+    // The trace along eye + s·dir, s in [0, range_m], over list (gathered for a pixel rectangle
+    // containing the pixel that dir points through); dir must be a unit vector. With a second
+    // range range2_m ≥ range_m the trace to it goes to second in the same pass. Bit-identical
+    // whether or not the list was copied.
+    BandTrace Trace(const List& list, const glm::vec3& dir, float range_m) const;
+    void Trace2(const List& list, const glm::vec3& dir, float range_m, float range2_m,
+                BandTrace& first, BandTrace& second) const;
+
+  private:
+    struct Rect {
+        int x0, y0, x1, y1;
+    };
+    int width_ = 0, height_ = 0;  // bin area: camera width and height + kMargin
+    int tilesX_ = 0, tilesY_ = 0;
+    float puffTolerance_ = 0.0f;
+    // Per kept puff (field index order, then one inert puff that no ray uses, for padding):
+    // eye − centre (m), 1/σh², 1/σz², the cutoff r², α peak √π / 2 (optical-depth scale), the
+    // nearest range, and the weights of the band's scattering, absorption × T, hot absorption,
+    // hot absorption × T and scattering × g per unit optical depth.
+    enum Field {
+        kQx,
+        kQy,
+        kQz,
+        kIvh,
+        kIvz,
+        kCutoff2,
+        kKappa,
+        kNear,
+        kWs,
+        kWAbsT,
+        kWHot,
+        kWHotT,
+        kWg,
+        kFields
+    };
+    std::vector<float> data_[kFields];
+    std::vector<uint32_t> kept_;
+    std::vector<Rect> rect_;
+    std::vector<float> far_, sigmaPixels_, tauMax_;
+    uint32_t inert_ = 0;
+    template <bool Copied>
+    void Trace2Impl(const List& list, const glm::vec3& dir, float range_m, float range2_m,
+                    BandTrace& first, BandTrace& second) const;
+    // Per tile, the kept positions of its puffs in increasing order.
+    std::vector<uint32_t> tileStart_, tileEntries_;
+};
+
+}  // namespace seasense::channels

@@ -1,0 +1,167 @@
+// Tests of the screen-space puff bins: traces within the stated transmittance tolerance of the
+// exact sum over every puff (no cutoff, double-precision erf) for committed plumes and for a
+// thick flame puff, and the dropping of puffs too thin to matter.
+#include "channels/plume/plume_bins.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <numbers>
+
+#include "channels/plume/plume_composite.h"
+#include "scene/plumes/plume_system.h"
+
+namespace seasense::channels {
+namespace {
+
+using scene::ObscurantBand;
+
+// A camera at eye looking north, tilted up pitch_deg.
+ChannelCamera NorthCamera(const glm::dvec3& eye, int width, int height, double hfov_deg,
+                          double pitch_deg) {
+    ChannelCamera cam;
+    scene::Attitude attitude;
+    attitude.pitch_rad = pitch_deg * std::numbers::pi / 180.0;
+    cam.worldFromCamera = scene::Pose{eye, scene::WorldFromBodyRotation(attitude)};
+    cam.hfov_rad = hfov_deg * std::numbers::pi / 180.0;
+    cam.width = width;
+    cam.height = height;
+    cam.supersampling = 1;
+    return cam;
+}
+
+// Σ α ∫C dl over every puff of field along eye + s·dir, s in [0, range_m]: the exact sum.
+double ExactOpticalDepth(const scene::PlumeField& field, ObscurantBand band, const glm::dvec3& eye,
+                         const glm::dvec3& dir, double range_m) {
+    double tau = 0.0;
+    for (size_t i = 0; i < field.PuffCount(); ++i) {
+        const scene::Puff p = field.PuffAt(i);
+        tau += field.Optics(p.plume).massExtinction_m2pkg[size_t(band)] *
+               scene::GaussianPuffLineIntegral_kgpm2(p.centre_m, p.sigmaH_m, p.sigmaZ_m, p.mass_kg,
+                                                     eye, dir, range_m);
+    }
+    return tau;
+}
+
+struct Worst {
+    double error = 0.0;
+    int dark = 0;  // pixels with T < 0.8
+};
+
+// Largest |T − T_exact| over every pixel of the bin area (the image plus the far column and
+// row) for rays to range_m.
+Worst CompareWithExact(const scene::PlumeField& field, const ChannelCamera& cam, ObscurantBand band,
+                       double range_m) {
+    const PlumeScreenBins bins(field, cam, band);
+    const glm::dvec3 eye = cam.worldFromCamera.position_m;
+    PlumeScreenBins::List list;
+    Worst worst;
+    for (int py = 0; py <= cam.height; ++py) {
+        for (int px = 0; px <= cam.width; ++px) {
+            bins.Gather(px, py, px + 1, py + 1, 0.0f, false, list);
+            const glm::dvec3 dir = cam.SampleDirection(px, py);
+            const BandTrace gathered = bins.Trace(list, glm::vec3(dir), float(range_m));
+            // The same from the copied list, bit for bit.
+            bins.Copy(list);
+            const BandTrace copied = bins.Trace(list, glm::vec3(dir), float(range_m));
+            EXPECT_EQ(std::memcmp(&gathered, &copied, sizeof(BandTrace)), 0);
+            const double T = std::exp(-double(copied.opticalDepth));
+            const double exact = std::exp(-ExactOpticalDepth(field, band, eye, dir, range_m));
+            worst.error = std::max(worst.error, std::abs(T - exact));
+            worst.dark += exact < 0.8;
+        }
+    }
+    return worst;
+}
+
+// Four plumes 1.5–2.5 km ahead (fire with its flame, ship funnel, steam), committed at 300 s.
+scene::PlumeField CommittedPlumes() {
+    scene::PlumesSettings settings;
+    const auto add = [&](scene::PlumeKind kind, glm::dvec3 position_m) {
+        scene::PlumeSourceSettings s = scene::DefaultPlumeSource(kind);
+        s.position_m = position_m;
+        s.seed = uint64_t(settings.sources.size() + 1);
+        settings.sources.push_back(s);
+    };
+    add(scene::PlumeKind::Smoke, {-300.0, 2000.0, 0.0});
+    add(scene::PlumeKind::Flame, {-300.0, 2000.0, 0.0});
+    add(scene::PlumeKind::Exhaust, {100.0, 1500.0, 30.0});
+    add(scene::PlumeKind::Steam, {400.0, 2500.0, 20.0});
+    scene::PlumeAmbient ambient;
+    ambient.windSpeed_mps = 5.0;
+    ambient.windDirection_rad = std::numbers::pi / 2;
+    ambient.sunElevation_rad = 0.6;
+    const scene::PlumeSystem system(settings, ambient);
+    scene::PlumeField field = system.MakeField();
+    system.Commit(300.0, field);
+    return field;
+}
+
+TEST(PlumeScreenBins, CommittedPlumesWithinToleranceOfTheExactSum) {
+    const scene::PlumeField field = CommittedPlumes();
+    ASSERT_GT(field.PuffCount(), 100u);
+    const ChannelCamera cam = NorthCamera({0.0, 0.0, 20.0}, 96, 72, 40.0, 3.0);
+    for (ObscurantBand band : {ObscurantBand::Visible, ObscurantBand::Lwir}) {
+        // To the sky, and to a surface inside the plumes (rays end within them).
+        for (double range_m : {double(kPlumeSkyRange_m), 2000.0}) {
+            const Worst w = CompareWithExact(field, cam, band, range_m);
+            EXPECT_LE(w.error, double(kPlumeTransmittanceTolerance))
+                << "band " << int(band) << " range " << range_m;
+            if (band == ObscurantBand::Visible && range_m > 1e5) {
+                EXPECT_GT(w.dark, 200) << w.dark;
+            }
+        }
+    }
+}
+
+// A flame puff of optical depth ~300 through its centre: at 3.5 σ (where a fixed cutoff
+// stops) its rays still have τ ≈ 0.7; the tolerance footprint reaches far enough.
+TEST(PlumeScreenBins, ThickPuffHasNoHardEdge) {
+    scene::PlumeField field(1, 1);
+    field.SetOptics(0, scene::KindOptics(scene::PlumeKind::Flame, 0.2));
+    field.Clear(0.0);
+    scene::Puff flame;
+    flame.centre_m = {0.0, 200.0, 10.0};
+    flame.sigmaH_m = flame.sigmaZ_m = 3.0;
+    flame.mass_kg = 50.0;
+    flame.temperature_K = 1200.0;
+    field.Add(flame);
+    field.Build();
+    const ChannelCamera cam = NorthCamera({0.0, 0.0, 10.0}, 121, 91, 20.0, 0.0);
+    const glm::dvec3 centre = cam.worldFromCamera.position_m;
+    ASSERT_GT(ExactOpticalDepth(field, ObscurantBand::Visible, centre, {0.0, 1.0, 0.0}, 1e6),
+              100.0);
+    const Worst w = CompareWithExact(field, cam, ObscurantBand::Visible, kPlumeSkyRange_m);
+    EXPECT_LE(w.error, double(kPlumeTransmittanceTolerance));
+}
+
+// Puffs whose optical depth along every line is below the per-puff tolerance are not binned;
+// the others are.
+TEST(PlumeScreenBins, DropsOnlyPuffsBelowTolerance) {
+    scene::PlumeField field(2, 1);
+    const scene::ObscurantOptics optics = scene::KindOptics(scene::PlumeKind::Smoke, 0.3);
+    field.SetOptics(0, optics);
+    field.Clear(0.0);
+    const ChannelCamera cam = NorthCamera({0.0, 0.0, 10.0}, 64, 48, 30.0, 0.0);
+    const double alpha = optics.massExtinction_m2pkg[0];
+    // τ through the centre of a sphere: α M / (2π σ²). Per-puff tolerance: 1e-3 / 2.
+    const double sigma = 5.0;
+    const auto massFor = [&](double tau) {
+        return tau * 2.0 * std::numbers::pi * sigma * sigma / alpha;
+    };
+    for (double tau : {1e-4, 1e-2}) {
+        scene::Puff p;
+        p.centre_m = {0.0, 300.0, 10.0};
+        p.sigmaH_m = p.sigmaZ_m = sigma;
+        p.mass_kg = massFor(tau);
+        field.Add(p);
+    }
+    field.Build();
+    const PlumeScreenBins bins(field, cam, ObscurantBand::Visible);
+    EXPECT_FLOAT_EQ(bins.PuffTolerance(), 5e-4f);
+    EXPECT_EQ(bins.KeptPuffs(), 1u);
+}
+
+}  // namespace
+}  // namespace seasense::channels
