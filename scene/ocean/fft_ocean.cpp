@@ -197,13 +197,29 @@ void FftOcean::Build(const Density& density, const FftOceanSettings& s) {
                 }
             });
         maxRow_.push_back(0);
+        std::vector<std::pair<double, double>> slope;  // (k, k² F Δk²), for the median
         for (int my = -half; my < half; ++my)
             for (int mx = -half; mx < half; ++mx) {
                 const size_t i = Index(mx, my);
                 modeVariance_m2_ += variance[i];
+                bands_[c].variance_m2 += variance[i];
+                if (variance[i] > 0.0) {
+                    const double k2 = double(m.kx[i]) * m.kx[i] + double(m.ky[i]) * m.ky[i];
+                    slope.emplace_back(std::sqrt(k2), k2 * variance[i]);
+                }
                 if (variance[i] > 0.0) maxRow_.back() = std::max(maxRow_.back(), std::abs(my));
                 if (mx != -half && my != -half) m.h0MinusConj[i] = std::conj(m.h0[Index(-mx, -my)]);
             }
+        std::sort(slope.begin(), slope.end());
+        double slopeTotal = 0.0, slopeSum = 0.0;
+        for (const auto& [k, v] : slope) slopeTotal += v;
+        for (const auto& [k, v] : slope) {
+            slopeSum += v;
+            if (slopeSum >= 0.5 * slopeTotal) {
+                bands_[c].slopeMedian_radpm = k;
+                break;
+            }
+        }
     }
 }
 
@@ -328,11 +344,15 @@ const cv::Mat& FftOceanFrame::FieldPlane(size_t cascade, int plane) const {
     return cascades_[cascade].field[size_t(plane)];
 }
 
-SurfaceTerms FftOceanFrame::Terms(double x0, double y0) const {
+SurfaceTerms FftOceanFrame::Terms(double x0, double y0, const double* cascadeWeights) const {
     CHECK_MSG(!cascades_.empty(), "FftOceanFrame used before FftOcean::Synthesize filled it");
     const int planes = hasRates_ ? kPlanes : kPlanes - kRatePlanes;
     std::array<double, 2 * kPlanes> sum{};
-    for (const Cascade& c : cascades_) {
+    for (size_t ci = 0; ci < cascades_.size(); ++ci) {
+        const Cascade& c = cascades_[ci];
+        // × 1 is exact: unweighted cascades add the same bits as without weights.
+        const double cw = cascadeWeights ? cascadeWeights[ci] : 1.0;
+        if (cw == 0.0) continue;
         // Grid node j lies at j L / N; bilinear weights within the periodic cell.
         const double u = x0 / c.patch_m * n_, v = y0 / c.patch_m * n_;
         const double fu = std::floor(u), fv = std::floor(v);
@@ -348,8 +368,8 @@ SurfaceTerms FftOceanFrame::Terms(double x0, double y0) const {
             const cv::Vec2f* r0 = m.ptr<cv::Vec2f>(ix0);
             const cv::Vec2f* r1 = m.ptr<cv::Vec2f>(ix1);
             for (int q = 0; q < 2; ++q)
-                sum[2 * p + q] +=
-                    w00 * r0[iy0][q] + w10 * r1[iy0][q] + w01 * r0[iy1][q] + w11 * r1[iy1][q];
+                sum[2 * p + q] += cw * (w00 * r0[iy0][q] + w10 * r1[iy0][q] + w01 * r0[iy1][q] +
+                                        w11 * r1[iy1][q]);
         }
     }
     const auto f = [&](OceanField field) { return sum[size_t(field)]; };

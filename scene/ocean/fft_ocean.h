@@ -71,7 +71,8 @@ class FftOceanFrame {
 
     // Displacement and derivatives at rest position (x0, y0) (world metres), choppiness applied,
     // cascades sampled bilinearly. The velocity is NaN when the rates were not synthesized.
-    SurfaceTerms Terms(double x0, double y0) const;
+    // With cascadeWeights (one per cascade) each cascade's fields are scaled by its weight.
+    SurfaceTerms Terms(double x0, double y0, const double* cascadeWeights = nullptr) const;
     // Surface at rest position (x0, y0) (world metres).
     OceanSample Evaluate(double x0, double y0) const {
         return MakeOceanSample(x0, y0, Terms(x0, y0));
@@ -106,6 +107,10 @@ struct CascadeBand {
     double patch_m = 0.0;
     double kMin_radpm = 0.0;
     double kMax_radpm = 0.0;
+    double variance_m2 = 0.0;  // Σ F Δk² over the cascade's modes
+    // Median wavenumber of the cascade's slope variance (Σ k² F Δk²): the waves that carry the
+    // slopes, and so the shading, this cascade draws (rad/m; 0 for an empty cascade).
+    double slopeMedian_radpm = 0.0;
 };
 
 class FftOcean {

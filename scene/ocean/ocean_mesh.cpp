@@ -139,9 +139,26 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
             const double rx = radius * sinAz[size_t(i)], ry = radius * cosAz[size_t(i)];
             const size_t v = size_t(j) * size_t(columns) + size_t(i);
             GeometrySums s{};
-            frame.AccumulateFft(req.eye_m.x + rx, req.eye_m.y + ry, filter, s);
-            if (gerstner) local.Accumulate(float(rx), float(ry), fp, s.data());
-            if (surf) frame.AccumulateSurf(req.eye_m.x + rx, req.eye_m.y + ry, s);
+            const double x0 = req.eye_m.x + rx, y0 = req.eye_m.y + ry;
+            if (!surf) {
+                frame.AccumulateFft(x0, y0, filter, s);
+                if (gerstner) local.Accumulate(float(rx), float(ry), fp, s.data());
+            } else {
+                // Each part of the deep sea with its depth weight, then the surf components.
+                SurfPointInfo info;
+                const SurfaceTerms st = frame.Surf()->Terms(x0, y0, frame.Time_s(), &info);
+                frame.AccumulateFft(x0, y0, filter, s, info.weights.cascade.data());
+                const double wg = info.weights.gerstner;
+                if (gerstner && wg == 1.0) {
+                    local.Accumulate(float(rx), float(ry), fp, s.data());
+                } else if (gerstner && wg > 0.0) {
+                    GeometrySums g{};
+                    local.Accumulate(float(rx), float(ry), fp, g.data());
+                    for (int k = 0; k < kGeometryTerms; ++k)
+                        s[size_t(k)] += float(wg) * g[size_t(k)];
+                }
+                frame.AddSurf(x0, y0, st, s);
+            }
             out.positions[v] = glm::vec3(float(req.eye_m.x + rx + double(s[kTermDispX])),
                                          float(req.eye_m.y + ry + double(s[kTermDispY])),
                                          float(double(s[kTermHeight]) - drop));

@@ -129,17 +129,20 @@ glm::dvec3 SeabedWithSlope(const Bathymetry& b, double x, double y) {
 }  // namespace
 
 SurfaceTerms OceanSurfaceFrame::Terms(double x0, double y0) const {
-    SurfaceTerms t = gerstner_.Terms(x0, y0, t_s_);
-    if (hasFft_) t += fft_.Terms(x0, y0);
-    if (!surf_) return t;
+    if (!surf_) {
+        SurfaceTerms t = gerstner_.Terms(x0, y0, t_s_);
+        if (hasFft_) t += fft_.Terms(x0, y0);
+        return t;
+    }
     SurfPointInfo info;
     const SurfaceTerms s = surf_->Terms(x0, y0, t_s_, &info);
-    if (info.deepWeight != 1.0) {
-        const double w = info.deepWeight;
+    SurfaceTerms t = gerstner_.Terms(x0, y0, t_s_);
+    if (const double w = info.weights.gerstner; w != 1.0) {
         t.displacement *= w;
         t.dxx *= w, t.dyy *= w, t.dxy *= w, t.sx *= w, t.sy *= w;
         t.velocity_mps *= w;
     }
+    if (hasFft_) t += fft_.Terms(x0, y0, info.weights.cascade.data());
     t += s;
     t.displacement.z += surf_->Bathy().Tide_m();
     // The water never lies below the seabed (seed 003): where it would, it lies on it, still.
@@ -154,12 +157,9 @@ SurfaceTerms OceanSurfaceFrame::Terms(double x0, double y0) const {
     return t;
 }
 
-void OceanSurfaceFrame::AccumulateSurf(double x0, double y0, GeometrySums& sums) const {
-    if (!surf_) return;
-    SurfPointInfo info;
-    const SurfaceTerms s = surf_->Terms(x0, y0, t_s_, &info);
-    if (info.deepWeight != 1.0)
-        for (float& v : sums) v *= float(info.deepWeight);
+void OceanSurfaceFrame::AddSurf(double x0, double y0, const SurfaceTerms& s,
+                                GeometrySums& sums) const {
+    CHECK(surf_);
     sums[kTermHeight] += float(s.displacement.z + surf_->Bathy().Tide_m());
     sums[kTermDispX] += float(s.displacement.x);
     sums[kTermDispY] += float(s.displacement.y);
@@ -199,24 +199,40 @@ FftFilter OceanSurfaceFrame::Filter(float footprint_m) const {
 }
 
 void OceanSurfaceFrame::AccumulateFft(double x0, double y0, const FftFilter& filter,
-                                      GeometrySums& sums) const {
+                                      GeometrySums& sums, const double* cascadeWeights) const {
     for (size_t c = 0; c < textures_.size(); ++c) {
+        // × 1 is exact: unweighted cascades add the same bits as without weights.
+        const float w = cascadeWeights ? float(cascadeWeights[c]) : 1.0f;
+        if (w == 0.0f) continue;
         const float f = filter.frac[c];
-        AddBilinear(textures_[c], filter.level[c], x0, y0, 1.0f - f, sums);
-        if (f > 0.0f) AddBilinear(textures_[c], filter.level[c] + 1, x0, y0, f, sums);
+        AddBilinear(textures_[c], filter.level[c], x0, y0, (1.0f - f) * w, sums);
+        if (f > 0.0f) AddBilinear(textures_[c], filter.level[c] + 1, x0, y0, f * w, sums);
     }
 }
 
 glm::vec3 OceanSurfaceFrame::DetailNormal(double x0, double y0, float footprint_m) const {
     GeometrySums sums{};
-    AccumulateFft(x0, y0, footprint_m, sums);
-    if (gerstner_.WaveCount() > 0) {
+    // In a surf zone the parts carry their depth weights, as in the mesh, plus the surf
+    // components' own slopes (long waves: unfiltered).
+    SurfPointInfo info;
+    SurfaceTerms surfTerms;
+    if (surf_) surfTerms = surf_->Terms(x0, y0, t_s_, &info);
+    AccumulateFft(x0, y0, Filter(footprint_m), sums, surf_ ? info.weights.cascade.data() : nullptr);
+    const double wg = info.weights.gerstner;
+    if (gerstner_.WaveCount() > 0 && wg > 0.0) {
         const SurfaceTerms g = gerstner_.Terms(x0, y0, t_s_, footprint_m);
-        sums[kTermSlopeX] += float(g.sx);
-        sums[kTermSlopeY] += float(g.sy);
-        sums[kTermDispXX] += float(g.dxx);
-        sums[kTermDispYY] += float(g.dyy);
-        sums[kTermDispXY] += float(g.dxy);
+        sums[kTermSlopeX] += float(wg * g.sx);
+        sums[kTermSlopeY] += float(wg * g.sy);
+        sums[kTermDispXX] += float(wg * g.dxx);
+        sums[kTermDispYY] += float(wg * g.dyy);
+        sums[kTermDispXY] += float(wg * g.dxy);
+    }
+    if (surf_ && !info.weights.AllDeep()) {
+        sums[kTermSlopeX] += float(surfTerms.sx);
+        sums[kTermSlopeY] += float(surfTerms.sy);
+        sums[kTermDispXX] += float(surfTerms.dxx);
+        sums[kTermDispYY] += float(surfTerms.dyy);
+        sums[kTermDispXY] += float(surfTerms.dxy);
     }
     return GeometryNormal(sums);
 }
@@ -271,6 +287,7 @@ std::shared_ptr<const SurfWaves> OceanSurface::MakeSurfWaves() const {
                 summary_.dominantDirection_rad +
                 kSpread_rad * (2.0 * Uniform01(seed, kSurfDirectionStream, uint64_t(j)) - 1.0);
             c.phase_rad = kTwoPi * Uniform01(seed, kSurfPhaseStream, uint64_t(j));
+            c.spectral = true;
             components.push_back(c);
         }
     }
@@ -283,7 +300,22 @@ std::shared_ptr<const SurfWaves> OceanSurface::MakeSurfWaves() const {
         components.push_back(c);
     }
     if (!(peakWavelength > 0.0)) peakWavelength = 100.0;  // flat sea: any fade depth will do
-    return std::make_shared<const SurfWaves>(bathy, std::move(components), peakWavelength);
+    // Each cascade fades with its own wavelength (see surf_waves.h): the peak wavelength for a
+    // cascade holding the peak or longer waves, else the median wavelength of its slopes.
+    std::vector<SurfCascade> cascades;
+    if (fft_) {
+        const double kPeak = kTwoPi / peakWavelength;
+        for (const CascadeBand& b : fft_->Cascades()) {
+            SurfCascade c;
+            c.variance_m2 = b.variance_m2;
+            c.wavelength_m = b.kMin_radpm <= kPeak || !(b.slopeMedian_radpm > 0.0)
+                                 ? peakWavelength
+                                 : kTwoPi / b.slopeMedian_radpm;
+            cascades.push_back(c);
+        }
+    }
+    return std::make_shared<const SurfWaves>(bathy, std::move(components), peakWavelength,
+                                             std::move(cascades));
 }
 
 OceanSurface::~OceanSurface() = default;

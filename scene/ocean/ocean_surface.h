@@ -87,17 +87,21 @@ class OceanSurfaceFrame {
     }
     // The same with the levels of a footprint resolved once (e.g. per mesh ring).
     FftFilter Filter(float footprint_m) const;
-    void AccumulateFft(double x0, double y0, const FftFilter& filter, GeometrySums& sums) const;
+    // With cascadeWeights (one per cascade, e.g. SurfWeights::cascade) each cascade is scaled.
+    void AccumulateFft(double x0, double y0, const FftFilter& filter, GeometrySums& sums,
+                       const double* cascadeWeights = nullptr) const;
 
     // Unit upward normal of the surface at rest position (x0, y0) (world m) band-limited to a
     // footprint (m), FFT cascades and Gerstner waves together: for shading finer than the mesh
     // (per sample, with the sample's footprint on the sea), seed 001's normal-map idea.
     glm::vec3 DetailNormal(double x0, double y0, float footprint_m) const;
 
-    // With a surf zone: scales the deep sea's sums (FFT and Gerstner, already in sums) by the
-    // deep weight at rest position (x0, y0), adds the surf components and the tide, and clamps
-    // the height to the seabed under the displaced point. The mesh path; Terms does the same.
-    void AccumulateSurf(double x0, double y0, GeometrySums& sums) const;
+    // With a surf zone, the mesh path (Terms does the same): sums hold the deep sea at rest
+    // position (x0, y0) already scaled by info.weights (AccumulateFft with the cascade weights,
+    // the Gerstner waves times weights.gerstner); adds the surf components' terms (surfTerms
+    // and info from Surf()->Terms at the frame time) and the tide, and clamps the height to the
+    // seabed under the displaced point.
+    void AddSurf(double x0, double y0, const SurfaceTerms& surfTerms, GeometrySums& sums) const;
 
     // The surf components (nullptr without environment.ocean.surf).
     const SurfWaves* Surf() const { return surf_.get(); }

@@ -22,6 +22,15 @@ constexpr double kMinDepth_m = 0.01;
 // Largest cross-shore table (samples): 0.5 m steps over 20 km.
 constexpr int kMaxSamples = 40000;
 
+// Cosine of the fade angle at depth h for a wave fading from deep (depth ≥ deep) to nothing
+// (depth ≤ deep / 2); its sine is the weight of what replaces it, so cos² + sin² = 1.
+double Fade(double h, double deep) {
+    const double shallow = 0.5 * deep;
+    if (h >= deep) return 1.0;
+    if (h <= shallow) return 0.0;
+    return std::cos(0.5 * std::numbers::pi * (deep - h) / (deep - shallow));
+}
+
 double Interp(const std::vector<double>& t, double x) {
     if (x <= 0.0) return t.front();
     const double last = double(t.size() - 1);
@@ -34,14 +43,29 @@ double Interp(const std::vector<double>& t, double x) {
 }  // namespace
 
 SurfWaves::SurfWaves(const Bathymetry& bathymetry, std::vector<SurfComponent> components,
-                     double peakWavelength_m, const SurfWaveSettings& settings)
-    : bathy_(bathymetry), components_(std::move(components)), settings_(settings) {
+                     double peakWavelength_m, std::vector<SurfCascade> cascades,
+                     const SurfWaveSettings& settings)
+    : bathy_(bathymetry),
+      components_(std::move(components)),
+      cascades_(std::move(cascades)),
+      settings_(settings) {
     CHECK(peakWavelength_m > 0.0);
     CHECK(components_.size() <= kMaxSurfComponents);
+    CHECK(cascades_.size() <= kMaxSurfCascades);
     const double tide = bathy_.Tide_m();
     const double offshoreDepth = tide + bathy_.OceanDepth_m();
-    fadeDeep_m_ = std::min(0.5 * peakWavelength_m, offshoreDepth);
-    fadeShallow_m_ = 0.5 * fadeDeep_m_;
+    peakFadeDeep_m_ = std::min(0.5 * peakWavelength_m, offshoreDepth);
+    peakFadeShallow_m_ = 0.5 * peakFadeDeep_m_;
+    fadeDeep_m_ = peakFadeDeep_m_;
+    for (SurfCascade& c : cascades_) {
+        CHECK(c.variance_m2 >= 0.0 && c.wavelength_m > 0.0);
+        c.wavelength_m = std::min(c.wavelength_m, 2.0 * offshoreDepth);
+        cascadeVariance_m2_ += c.variance_m2;
+        fadeDeep_m_ = std::max(fadeDeep_m_, 0.5 * c.wavelength_m);
+    }
+    for (const SurfComponent& c : components_)
+        (c.spectral ? spectralVariance_m2_ : gerstnerVariance_m2_) +=
+            0.5 * c.amplitude_m * c.amplitude_m;
 
     // Cross-shore table: from the fade's deep end (plane beach) landward past the waterline.
     auto profileDepth = [&](double s) { return tide - bathy_.ProfileZ_m(s); };
@@ -137,17 +161,22 @@ double SurfWaves::DepthTable(const std::vector<double>& t, double h) const {
     return Interp(t, h / dh_m_);
 }
 
-void SurfWaves::Weights(double depth_m, double& deep, double& surf) const {
-    if (depth_m >= fadeDeep_m_) {
-        deep = 1.0, surf = 0.0;
-    } else if (depth_m <= fadeShallow_m_) {
-        deep = 0.0, surf = 1.0;
-    } else {
-        // Angle from 0 (deep end) to π/2 (shallow end): deep² + surf² = 1 conserves variance.
-        const double a =
-            0.5 * std::numbers::pi * (fadeDeep_m_ - depth_m) / (fadeDeep_m_ - fadeShallow_m_);
-        deep = std::cos(a), surf = std::sin(a);
+SurfWeights SurfWaves::Weights(double depth_m) const {
+    SurfWeights w;
+    w.gerstner = Fade(depth_m, peakFadeDeep_m_);
+    w.gerstnerSurf = std::sqrt(std::max(0.0, 1.0 - w.gerstner * w.gerstner));
+    if (cascades_.empty() || !(cascadeVariance_m2_ > 0.0)) {
+        w.spectralSurf = w.gerstnerSurf;  // no cascades given: the spectral sea fades as a whole
+        return w;
     }
+    double lost = 0.0;
+    for (size_t c = 0; c < cascades_.size(); ++c) {
+        const double f = Fade(depth_m, 0.5 * cascades_[c].wavelength_m);
+        w.cascade[c] = f;
+        lost += cascades_[c].variance_m2 * (1.0 - f * f);
+    }
+    w.spectralSurf = std::sqrt(std::clamp(lost / cascadeVariance_m2_, 0.0, 1.0));
+    return w;
 }
 
 SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* info) const {
@@ -155,19 +184,26 @@ SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* inf
     const ShorePoint p = bathy_.Frame().ShoreFromWorld(x0, y0);
     const double zBed = bathy_.SeabedZAtShore_m(p.s_m, p.u_m);
     const double h = bathy_.Tide_m() - zBed;
-    double deep = 1.0, surf = 0.0;
-    Weights(h, deep, surf);
+    const SurfWeights weights = Weights(h);
     SurfPointInfo local;
     local.depth_m = h;
     local.seabedZ_m = zBed;
-    local.deepWeight = deep;
-    local.surfWeight = surf;
+    local.weights = weights;
+    const double variance = spectralVariance_m2_ + gerstnerVariance_m2_;
+    if (variance > 0.0) {
+        const double surfShare =
+            (weights.spectralSurf * weights.spectralSurf * spectralVariance_m2_ +
+             weights.gerstnerSurf * weights.gerstnerSurf * gerstnerVariance_m2_) /
+            variance;
+        local.surfWeight = std::sqrt(std::clamp(surfShare, 0.0, 1.0));
+        local.deepWeight = std::sqrt(std::clamp(1.0 - surfShare, 0.0, 1.0));
+    }
     const double tableIndex = (sRef_m_ - p.s_m) / ds_m_;
     if (!breakTime_s_.empty() && std::isfinite(sBreak_m_)) {
         local.breaking.broken = p.s_m <= sBreak_m_;
         local.breaking.timeSinceBreaking_s = Interp(breakTime_s_, tableIndex);
     }
-    if (surf <= 0.0 || h <= 0.0 || components_.empty()) {
+    if (weights.AllDeep() || h <= 0.0 || components_.empty()) {
         if (info) *info = local;
         return out;
     }
@@ -186,7 +222,9 @@ SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* inf
         const double k = DepthTable(tr.k, hh), cg = DepthTable(tr.cg, hh);
         const double kx = -std::sqrt(std::max(k * k - tr.ku * tr.ku, 0.0));
         const double cosT = std::max(-kx / k, 1e-3);
-        const double a = c.amplitude_m * std::sqrt(tr.cg0 / cg) * std::sqrt(tr.cos0 / cosT);
+        // Shoaled and refracted, times the weight of the component's part in the fade.
+        const double a = c.amplitude_m * std::sqrt(tr.cg0 / cg) * std::sqrt(tr.cos0 / cosT) *
+                         (c.spectral ? weights.spectralSurf : weights.gerstnerSurf);
         const double crossPhase =
             p.s_m >= sRef_m_ ? tr.ks0 * p.s_m : tr.ks0 * sRef_m_ + Interp(tr.phase, tableIndex);
         const double psi = tr.phaseOrigin + tr.ku * p.u_m + crossPhase - c.omega_radps * t;
@@ -200,7 +238,7 @@ SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* inf
     // approaches the breaker height.
     const double q = settings_.deepSteepness + (1.0 - settings_.deepSteepness) *
                                                    std::min(1.0, 2.0 * A / std::max(gammaH, 1e-9));
-    const double w = surf * cap;
+    const double w = cap;
     double best = -1.0;
     for (size_t i = 0; i < count; ++i) {
         const Local& v = waves[i];

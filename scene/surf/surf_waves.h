@@ -9,8 +9,13 @@
 // sum of discrete components that carry the sea's whole variance (the FFT's mode variance and
 // each Gerstner wave's A²/2) with local-depth physics; in between the two are cross-faded with
 // weights cos and sin of the same angle, so the variance of the sum (the two are independent) is
-// conserved through the fade: Hs does not dip. The short waves of the FFT fade out in shallow
-// water as they do in nature (they break and dissipate first). 12 spectral components spaced in
+// conserved through the fade: Hs does not dip. The fade is per FFT cascade: a cascade fades over
+// ½ to ¼ of its own wavelength — the peak wavelength for a cascade holding the peak or longer
+// waves, else the median wavelength of its slope variance (the chop that the shading shows) — so
+// the short chop, deep water for its own wavelength even a metre or two deep, keeps its weight
+// while the long cascade hands its variance to the surf components; the spectral surf components
+// take exactly the variance the cascades give up (Σ var_c (1 − w_c²)), the Gerstner waves fade
+// with the peak wavelength into their own components. 12 spectral components spaced in
 // frequency around the peak (0.8–1.6 ω_p) beat against each other: wave groups and surf beat
 // come for free.
 //
@@ -24,6 +29,7 @@
 // waves near breaking) steepens the fronts.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <vector>
@@ -42,6 +48,26 @@ struct SurfComponent {
     double omega_radps = 0.0;    // angular frequency
     double direction_rad = 0.0;  // deep-water direction of travel, azimuth from north clockwise
     double phase_rad = 0.0;  // phase at the world origin at t = 0: η = A cos(k·x − ωt + φ)
+    // Carries the FFT cascades' variance (faded in as they fade out) rather than a Gerstner
+    // wave of its own (faded in as the Gerstner waves fade out).
+    bool spectral = false;
+};
+
+// An FFT cascade the surf fades out: its variance and the wavelength that sets its fade depths
+// (½ and ¼ of it).
+struct SurfCascade {
+    double variance_m2 = 0.0;
+    double wavelength_m = 0.0;
+};
+inline constexpr size_t kMaxSurfCascades = 8;
+
+// Weights of the parts of the sea at a depth: deep² + surf² = 1 per part, so Hs is conserved.
+struct SurfWeights {
+    std::array<double, kMaxSurfCascades> cascade{1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0};
+    double gerstner = 1.0;      // the scenario's Gerstner waves
+    double spectralSurf = 0.0;  // the spectral surf components: √(Σ var_c (1 − w_c²) / Σ var_c)
+    double gerstnerSurf = 0.0;  // the Gerstner waves' surf components: √(1 − gerstner²)
+    bool AllDeep() const { return spectralSurf == 0.0 && gerstnerSurf == 0.0; }
 };
 
 // The breaking state at a point and instant.
@@ -58,10 +84,13 @@ struct SurfBreaking {
 
 // What the surf adds at a rest position, beside the terms.
 struct SurfPointInfo {
-    double depth_m = 0.0;     // still-water depth (tide − seabed), negative on land
-    double seabedZ_m = 0.0;   // ENU z of the seabed
-    double deepWeight = 1.0;  // weight of the FFT + Gerstner sea (cos of the fade angle)
-    double surfWeight = 0.0;  // weight of the surf components (sin of it)
+    double depth_m = 0.0;    // still-water depth (tide − seabed), negative on land
+    double seabedZ_m = 0.0;  // ENU z of the seabed
+    // Share of the sea's variance drawn by the deep sea (FFT + Gerstner) and by the surf
+    // components, as amplitude weights (deep² + surf² = 1); the parts' weights in weights.
+    double deepWeight = 1.0;
+    double surfWeight = 0.0;
+    SurfWeights weights;
     double envelope_m = 0.0;  // local wave-group envelope amplitude |Σ A e^{iψ}| (saturated)
     double unbrokenHeight_m = 0.0;  // 2 × envelope before the breaker cap
     SurfBreaking breaking;
@@ -81,18 +110,25 @@ struct SurfWaveSettings {
 // Immutable after construction; pure and thread-safe.
 class SurfWaves {
   public:
-    // peakWavelength_m sets the fade depths (¼ and ½ of it).
+    // peakWavelength_m sets the fade depths (¼ and ½ of it) of the Gerstner waves, and of the
+    // spectral components when no cascades are given; cascades (at most kMaxSurfCascades) fade
+    // with their own wavelengths.
     SurfWaves(const Bathymetry& bathymetry, std::vector<SurfComponent> components,
-              double peakWavelength_m, const SurfWaveSettings& settings = {});
+              double peakWavelength_m, std::vector<SurfCascade> cascades = {},
+              const SurfWaveSettings& settings = {});
 
     const Bathymetry& Bathy() const { return bathy_; }
     const std::vector<SurfComponent>& Components() const { return components_; }
+    const std::vector<SurfCascade>& Cascades() const { return cascades_; }
+    // Depth below which any part of the sea fades (the deepest fade), and the Gerstner waves'
+    // (peak wavelength) fade depths.
     double FadeDeep_m() const { return fadeDeep_m_; }
-    double FadeShallow_m() const { return fadeShallow_m_; }
+    double PeakFadeDeep_m() const { return peakFadeDeep_m_; }
+    double PeakFadeShallow_m() const { return peakFadeShallow_m_; }
     double BreakerIndex() const { return settings_.breakerIndex; }
 
-    // Deep/surf weights at a still-water depth h (m).
-    void Weights(double depth_m, double& deep, double& surf) const;
+    // Weights of the sea's parts at a still-water depth h (m).
+    SurfWeights Weights(double depth_m) const;
 
     // The surf components' terms at rest position (x0, y0), time t (already weighted by the surf
     // weight), and the point's information. Velocity is included.
@@ -116,8 +152,11 @@ class SurfWaves {
 
     Bathymetry bathy_;
     std::vector<SurfComponent> components_;
+    std::vector<SurfCascade> cascades_;
     SurfWaveSettings settings_;
-    double fadeDeep_m_ = 0.0, fadeShallow_m_ = 0.0;
+    double fadeDeep_m_ = 0.0, peakFadeDeep_m_ = 0.0, peakFadeShallow_m_ = 0.0;
+    double cascadeVariance_m2_ = 0.0;
+    double spectralVariance_m2_ = 0.0, gerstnerVariance_m2_ = 0.0;  // of the components
     double sRef_m_ = 0.0, sShore_m_ = 0.0, ds_m_ = 0.5;
     double dh_m_ = 0.02;
     int depthSamples_ = 0;

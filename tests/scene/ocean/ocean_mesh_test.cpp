@@ -12,6 +12,7 @@
 #include <map>
 #include <numbers>
 #include <utility>
+#include <vector>
 
 namespace seasense::scene {
 namespace {
@@ -34,6 +35,25 @@ OceanSettings Beaufort5(uint64_t seed = 11) {
     w.amplitude_m = 0.4;
     w.steepness = 0.4;
     o.waves.push_back(w);
+    return o;
+}
+
+// The same sea running onto a plane beach 3 % steep (shoreline along x = 0, sea to the east)
+// with a sandbar: the surf zone's fade, surf components, tide and seabed clamp in the mesh.
+OceanSettings WithSurf(OceanSettings o) {
+    SurfSettings s;
+    s.lowTide_m = -1.0;
+    s.highTide_m = 1.0;
+    s.tide_m = 0.2;
+    s.intertidal = {0.03, 0.0};
+    s.supralittoral = {0.03, 50.0};
+    s.sublittoral = {0.03, 400.0};
+    s.offshoreSlope = 0.03;
+    SurfRegionSettings r;
+    r.width_m = 300.0;
+    r.sandbar = SandbarSettings{20.0, 150.0, 1.0, 80.0, 15.0};
+    s.regions = {r};
+    o.surf = s;
     return o;
 }
 
@@ -158,6 +178,67 @@ TEST(OceanMesh, VertexHeightsMatchTheQueryAtThatPoint) {
     }
     EXPECT_GT(tested, 1000);
     EXPECT_LT(worst, 1e-4);
+}
+
+TEST(OceanMesh, SurfVertexHeightsMatchTheQueryAtThatPoint) {
+    // With the surf zone on, looking at the beach from 5 m of water: the faded cascades, surf
+    // components, tide and seabed clamp of the mesh are what the query answers, to 1e-4 m.
+    const OceanSurface sea(WithSurf(Beaufort5()));
+    const auto frame = sea.At(23.0);
+    const glm::dvec3 eye(170.0, 30.0, 2.0);
+    OceanMesh m;
+    BuildOceanMesh(*frame, View(eye, 1.5 * kPi, 0.9), m);
+    const double finest = sea.Fft()->Cascades().back().patch_m / sea.Fft()->GridSize();
+    const Bathymetry& b = sea.Surf()->Bathy();
+    const size_t columns = Columns(m);
+    int tested = 0, shallow = 0;
+    double worst = 0.0;
+    for (int j = 0; j < m.rings; ++j) {
+        if (m.footprint_m[size_t(j)] > finest) continue;  // filtered
+        for (size_t i = 0; i < columns; ++i) {
+            const glm::dvec3 p(m.positions[size_t(j) * columns + i]);
+            if (b.Depth_m(p.x, p.y) < 0.05) continue;  // on the beach the clamp is the seabed's
+            const OceanSample s = frame->SampleAt(p.x, p.y);
+            if (s.minEigenvalue < 0.2) continue;  // near folds the drawn surface is multivalued
+            const double drop = CurvatureDrop_m(m.radii_m[size_t(j)]);
+            worst = std::max(worst, std::abs(s.position.z - (p.z + drop)));
+            ++tested;
+            if (b.Depth_m(p.x, p.y) < sea.Surf()->PeakFadeShallow_m()) ++shallow;
+        }
+    }
+    EXPECT_GT(tested, 1000);
+    EXPECT_GT(shallow, 100);  // the surf components alone, not only the fade
+    EXPECT_LT(worst, 1e-4);
+}
+
+TEST(OceanMesh, SurfMeshAndFrameBitIdenticalForAnyThreadCount) {
+    const auto build = [](int threads) {
+        tbb::task_arena arena(threads);
+        return arena.execute([] {
+            const OceanSurface sea(WithSurf(Beaufort5(4)));
+            const auto frame = sea.At(6.5);
+            OceanMesh m;
+            BuildOceanMesh(*frame, View({150.0, 4.0, 2.5}, 1.5 * kPi, 0.9), m);
+            std::vector<double> z;
+            for (double x = -10.0; x < 600.0; x += 3.7)
+                z.push_back(frame->Terms(x, 7.0).displacement.z);
+            return std::make_pair(m, z);
+        });
+    };
+    const auto [a, za] = build(1);
+    const auto [b, zb] = build(2);
+    ASSERT_EQ(za.size(), zb.size());
+    for (size_t i = 0; i < za.size(); ++i)
+        ASSERT_EQ(std::bit_cast<uint64_t>(za[i]), std::bit_cast<uint64_t>(zb[i]));
+    ASSERT_EQ(a.positions.size(), b.positions.size());
+    ASSERT_EQ(a.indices, b.indices);
+    for (size_t v = 0; v < a.positions.size(); ++v)
+        for (int k = 0; k < 3; ++k) {
+            ASSERT_EQ(std::bit_cast<uint32_t>(a.positions[v][k]),
+                      std::bit_cast<uint32_t>(b.positions[v][k]));
+            ASSERT_EQ(std::bit_cast<uint32_t>(a.normals[v][k]),
+                      std::bit_cast<uint32_t>(b.normals[v][k]));
+        }
 }
 
 TEST(OceanMesh, BitIdenticalForAnyThreadCount) {

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -178,6 +179,95 @@ TEST(SurfWaves, SurfaceNeverBelowTheSeabedAndTapersToZeroDepth) {
         }
     }
     EXPECT_GE(worst, -1e-9);
+}
+
+TEST(SurfWaves, ChopKeepsItsWeightWhereItIsDeepWaterForItsWavelength) {
+    const OceanSurface sea(SpectralBeach(true));
+    const SurfWaves& w = *sea.Surf();
+    const std::vector<SurfCascade>& cascades = w.Cascades();
+    ASSERT_EQ(cascades.size(), 2u);
+    const double lp = sea.Summary().peakWavelength_m;
+    // The long cascade holds the peak: it fades over ½–¼ L_p. The chop cascade's waves are far
+    // shorter than the peak's.
+    EXPECT_DOUBLE_EQ(cascades[0].wavelength_m, lp);
+    const double lc = cascades[1].wavelength_m;
+    ASSERT_LT(lc, 0.5 * lp);
+    for (double h = 0.0; h < 1.2 * w.FadeDeep_m(); h += 0.05) {
+        const SurfWeights sw = w.Weights(h);
+        // Deep water for the chop's wavelength (tanh kh ≥ tanh π = 0.996): full weight.
+        if (std::tanh(2.0 * kPi / lc * h) >= std::tanh(kPi)) {
+            EXPECT_EQ(sw.cascade[1], 1.0) << h;
+        }
+        if (h <= 0.25 * lp) {
+            EXPECT_EQ(sw.cascade[0], 0.0) << h;
+        }
+        if (h >= 0.5 * lp) {
+            EXPECT_TRUE(sw.AllDeep()) << h;
+        }
+    }
+    // Where the long waves are gone and the chop is not, the surf components carry exactly the
+    // long cascade's variance.
+    const double h = std::max(0.55 * lc, 0.2 * lp);
+    const SurfWeights sw = w.Weights(h);
+    EXPECT_EQ(sw.cascade[1], 1.0);
+    const double total = cascades[0].variance_m2 + cascades[1].variance_m2;
+    EXPECT_NEAR(sw.spectralSurf * sw.spectralSurf * total, cascades[0].variance_m2, 1e-12 * total);
+}
+
+TEST(SurfWaves, HsIsConservedThroughThePerCascadeFade) {
+    const OceanSurface sea(SpectralBeach(true));
+    const SurfWaves& w = *sea.Surf();
+    const std::vector<SurfCascade>& cascades = w.Cascades();
+    double total = 0.0;
+    for (const SurfCascade& c : cascades) total += c.variance_m2;
+    // Variance bookkeeping at every depth: what the cascades lose the components gain.
+    for (double h = 0.0; h < 1.1 * w.FadeDeep_m(); h += 0.01) {
+        const SurfWeights sw = w.Weights(h);
+        double kept = 0.0;
+        for (size_t c = 0; c < cascades.size(); ++c)
+            kept += sw.cascade[c] * sw.cascade[c] * cascades[c].variance_m2;
+        EXPECT_NEAR(kept + sw.spectralSurf * sw.spectralSurf * total, total, 1e-12 * total) << h;
+        EXPECT_NEAR(sw.gerstner * sw.gerstner + sw.gerstnerSurf * sw.gerstnerSurf, 1.0, 1e-12);
+    }
+    // The drawn surface: the height variance over time at a point in the fade equals the kept
+    // share of each cascade's variance (as realized at that point: a random-phase sea of finite
+    // modes differs from its expected variance by several %) plus the surf components' shoaled
+    // and refracted variance (energy flux and Snell's law computed here).
+    const double slope = 0.03;
+    const double lp = sea.Summary().peakWavelength_m;
+    const double h = 0.4 * lp;  // inside the long cascade's fade, below any breaking
+    const SurfWeights sw = w.Weights(h);
+    ASSERT_GT(sw.cascade[0], 0.05);
+    ASSERT_LT(sw.cascade[0], 0.95);
+    double expected = 0.0;
+    const double depth0 = 80.0;
+    for (const SurfComponent& c : w.Components()) {
+        const double k0 = K(c.omega_radps, depth0), k = K(c.omega_radps, h);
+        // Angle to the shore normal (travel toward 270°); Snell: k sin θ is conserved.
+        const double th0 = c.direction_rad - 1.5 * kPi;
+        const double th = std::asin(k0 * std::sin(th0) / k);
+        const double a = c.amplitude_m * sw.spectralSurf *
+                         std::sqrt(Cg(c.omega_radps, depth0) / Cg(c.omega_radps, h)) *
+                         std::sqrt(std::cos(th0) / std::cos(th));
+        expected += 0.5 * a * a;
+    }
+    const std::array<std::array<double, 2>, 2> only{{{1.0, 0.0}, {0.0, 1.0}}};
+    std::array<double, 3> sum{}, sum2{};
+    int n = 0;
+    for (int f = 0; f < 1500; ++f) {
+        const auto frame = sea.At(f * 1.0 + 0.37);
+        for (const double y : {0.0, 57.0, 131.0, 213.0}) {
+            const double x = h / slope;
+            const std::array<double, 3> z{frame->Terms(x, y).displacement.z,
+                                          frame->Fft()->Terms(x, y, only[0].data()).displacement.z,
+                                          frame->Fft()->Terms(x, y, only[1].data()).displacement.z};
+            for (size_t i = 0; i < 3; ++i) sum[i] += z[i], sum2[i] += z[i] * z[i];
+            ++n;
+        }
+    }
+    const auto var = [&](size_t i) { return sum2[i] / n - (sum[i] / n) * (sum[i] / n); };
+    for (size_t c = 0; c < 2; ++c) expected += sw.cascade[c] * sw.cascade[c] * var(c + 1);
+    EXPECT_NEAR(var(0), expected, 0.05 * expected);
 }
 
 TEST(SurfWaves, DeepWaterIsTheSeaWithoutSurf) {
