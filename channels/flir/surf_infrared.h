@@ -10,11 +10,11 @@ namespace seasense::channels {
 // Frame constants of the surf zone in the channel's band (W·m⁻²·sr⁻¹ for radiances).
 struct SurfInfrared {
     // Foam emissivity (hemispherical; taken as independent of the view angle): sea foam is
-    // nearly black in the windows, LWIR ~0.99 (Salisbury, D'Aria & Wald, "Thermal-infrared
-    // remote sensing and Kirchhoff's law 2. Field measurements", J. Geophys. Res. 99(B6),
-    // 11909-11917 (1994); Niclòs et al., "Foam effect on the sea surface emissivity in the
-    // 8-14 um region", J. Geophys. Res. 112, C12020 (2007): foam raises the emissivity of the
-    // sea toward 0.99 and flattens its fall with view angle).
+    // nearly black in the windows, LWIR ~0.99, MWIR ~0.98 (J. W. Salisbury and D. M. D'Aria,
+    // Remote Sens. Environ. 42, 83-106 (1992), the source of configs/materials.yaml's foam;
+    // R. Niclòs et al., "Foam effect on the sea surface emissivity in the 8-14 um region",
+    // J. Geophys. Res. 112, C12020 (2007): foam raises the sea's emissivity toward 0.99 and
+    // flattens its fall with view angle). The default stands for a table without `foam`.
     float foamEmissivity = 0.99f;
     float foamB = 0.0f;  // B(T_foam): foam is sea water at the sea temperature
     // Surface-leaving radiance of level dry and wet sand: ε B(T) + (1 − ε) L_sky,hemi (sand is a
