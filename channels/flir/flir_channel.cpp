@@ -47,14 +47,6 @@ glm::vec3 ShadowRayOrigin(const glm::vec3& p, const glm::vec3& n) {
     return p + n * (4e-6f * std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)}) + 1e-3f);
 }
 
-// A surface's at-aperture radiance τ·[ε·B + (1 − ε)·L_sky] + (1 − τ)·B_air, four lanes, in the
-// order of the scalar expression.
-F4 Aperture4(F4 tau, F4 eps, F4 B, F4 sky, F4 airB) {
-    const F4 one = Set4(1.0f);
-    const F4 L = _mm_add_ps(_mm_mul_ps(eps, B), _mm_mul_ps(_mm_sub_ps(one, eps), sky));
-    return _mm_add_ps(_mm_mul_ps(tau, L), _mm_mul_ps(_mm_sub_ps(one, tau), airB));
-}
-
 }  // namespace
 
 radiometry::Band InfraredBandOf(scene::InfraredBand band) {
@@ -193,6 +185,13 @@ FlirChannel::FlirChannel(const scene::World& world, const scene::ChannelSettings
     std::vector<float> nodes(kSkyNodes);
     for (int i = 0; i < kSkyNodes; ++i)
         nodes[size_t(i)] = float(atmosphere_.SkyRadiance(double(i) / (kSkyNodes - 1)));
+    // 2∫₀¹ L(μ) μ dμ by the trapezoid rule over the table's nodes.
+    double hemi = 0.0;
+    for (int i = 0; i + 1 < kSkyNodes; ++i) {
+        const double mu0 = double(i) / (kSkyNodes - 1), mu1 = double(i + 1) / (kSkyNodes - 1);
+        hemi += (mu1 - mu0) * (nodes[size_t(i)] * mu0 + nodes[size_t(i) + 1] * mu1);
+    }
+    skyHemi_ = float(hemi);
     skyTable_ = UniformTable(std::move(nodes), 1.0f);
     seaEmissivity_ = UniformTable(seaCurve_.Nodes(), 1.0f);
     nodes.assign(kPathNodes, 0.0f);
@@ -214,24 +213,53 @@ FlirChannel::FlirChannel(const scene::World& world, const scene::ChannelSettings
     env.skyLongwave_W_m2 = atmosphere_.SkyLongwaveIrradiance_W_m2();
     // Entities of one heat-balance material share its temperatures (same drivers).
     std::map<std::string, int> heatBalanceOf;
-    for (const scene::EntitySettings& e : sc.entities) {
-        const radiometry::Material& m = materials.Get(e.material);
-        EntityThermal t;
-        t.emissivity =
-            settings.band == scene::InfraredBand::Mwir ? m.emissivityMwir : m.emissivityLwir;
-        if (m.thermal.kind == radiometry::ThermalModelKind::HeatBalance) {
-            auto [it, added] = heatBalanceOf.emplace(e.material, int(heatBalance_.size()));
-            if (added) {
-                radiometry::HeatBalanceParameters p = m.thermal.heatBalance;
-                p.emissivity = m.emissivityLwir;
-                heatBalance_.push_back(std::make_unique<OrientationTemperatures>(p, env, sc));
-            }
-            t.heatBalance = it->second;
-        } else {
-            t.staticT_K = m.StaticTemperature_K(thermalEnv);
-        }
-        entities_.push_back(t);
+    for (const scene::EntitySettings& e : sc.entities)
+        entities_.push_back(
+            ThermalOf(materials.Get(e.material), settings.band, env, thermalEnv, heatBalanceOf));
+
+    // Surf zone. Foam is drawn wherever the sea mesh carries foam (deep-water whitecaps too):
+    // the table's `foam` material, or without one the published emissivity of SurfInfrared at
+    // the sea temperature. The beach needs the sand materials' thermal models.
+    foam_.emissivity = surf_.foamEmissivity;
+    foam_.staticT_K = sea_.temperature_K;
+    if (const radiometry::Material* m = materials.Find("foam"))
+        foam_ = ThermalOf(*m, settings.band, env, thermalEnv, heatBalanceOf);
+    hasSurf_ = sc.environment.ocean.surf.has_value();
+    if (hasSurf_) {
+        for (const char* name : {"sand_dry", "sand_wet"})
+            if (!materials.Find(name))
+                throw InputError("scenario " + sc.file.string() +
+                                 ": environment.ocean.surf: the flir channel draws the beach "
+                                 "with the material table's sand_dry and sand_wet, but the table "
+                                 "has no " +
+                                 std::string(name));
+        sandDry_ =
+            ThermalOf(*materials.Find("sand_dry"), settings.band, env, thermalEnv, heatBalanceOf);
+        sandWet_ =
+            ThermalOf(*materials.Find("sand_wet"), settings.band, env, thermalEnv, heatBalanceOf);
     }
+}
+
+FlirChannel::EntityThermal FlirChannel::ThermalOf(const radiometry::Material& m,
+                                                  scene::InfraredBand band,
+                                                  const OrientationTemperatures::Environment& env,
+                                                  const radiometry::ThermalEnvironment& thermalEnv,
+                                                  std::map<std::string, int>& heatBalanceOf) {
+    EntityThermal t;
+    t.emissivity = band == scene::InfraredBand::Mwir ? m.emissivityMwir : m.emissivityLwir;
+    if (m.thermal.kind == radiometry::ThermalModelKind::HeatBalance) {
+        auto [it, added] = heatBalanceOf.emplace(m.name, int(heatBalance_.size()));
+        if (added) {
+            radiometry::HeatBalanceParameters p = m.thermal.heatBalance;
+            p.emissivity = m.emissivityLwir;
+            heatBalance_.push_back(
+                std::make_unique<OrientationTemperatures>(p, env, world_.GetScenario()));
+        }
+        t.heatBalance = it->second;
+    } else {
+        t.staticT_K = m.StaticTemperature_K(thermalEnv);
+    }
+    return t;
 }
 
 FlirChannel::~FlirChannel() = default;
@@ -239,7 +267,11 @@ FlirChannel::~FlirChannel() = default;
 std::array<double, OrientationTemperatures::kClasses> FlirChannel::EntityTemperatures_K(
     size_t entity, double time_s) {
     CHECK(entity < entities_.size());
-    const EntityThermal& t = entities_[entity];
+    return ClassTemperatures_K(entities_[entity], time_s);
+}
+
+std::array<double, OrientationTemperatures::kClasses> FlirChannel::ClassTemperatures_K(
+    const EntityThermal& t, double time_s) {
     if (t.heatBalance >= 0) return heatBalance_[size_t(t.heatBalance)]->At(time_s);
     std::array<double, OrientationTemperatures::kClasses> out;
     out.fill(t.staticT_K);
@@ -253,6 +285,24 @@ void FlirChannel::UpdateEntityRadiance(double time_s) {
         const std::array<double, kC> T = EntityTemperatures_K(i, time_s);
         for (size_t c = 0; c < size_t(kC); ++c) entityB_[i][c] = float(table_.Radiance(T[c]));
     }
+    // Foam and sand lie level: the upward class, sunlit (equal to shaded without sun).
+    constexpr size_t kUpSunlit = size_t(OrientationTemperatures::kOrientations);
+    surf_.foamEmissivity = float(foam_.emissivity);
+    surf_.foamB = float(table_.Radiance(ClassTemperatures_K(foam_, time_s)[kUpSunlit]));
+    if (!hasSurf_) return;
+    const std::array<double, 2> T = SandTemperatures_K(time_s);
+    const auto Leaving = [&](const EntityThermal& t, double T_K) {
+        return float(t.emissivity * table_.Radiance(T_K) + (1.0 - t.emissivity) * skyHemi_);
+    };
+    surf_.sandDry = Leaving(sandDry_, T[0]);
+    surf_.sandWet = Leaving(sandWet_, T[1]);
+}
+
+std::array<double, 2> FlirChannel::SandTemperatures_K(double time_s) {
+    if (!hasSurf_) return {0.0, 0.0};
+    constexpr size_t kUpSunlit = size_t(OrientationTemperatures::kOrientations);
+    return {ClassTemperatures_K(sandDry_, time_s)[kUpSunlit],
+            ClassTemperatures_K(sandWet_, time_s)[kUpSunlit]};
 }
 
 // The constants of one frame's shading.
@@ -266,6 +316,7 @@ struct FlirChannel::FrameShading {
     glm::vec3 eye{0.0f}, sunDir{0.0f};
     bool shadows = false;
     float seaB = 0.0f, airB = 0.0f;
+    SurfInfrared surf;
     // View rays: direction ∝ forward + up·ndcY − right + (x + ½)·colStep (the camera axes
     // scaled by the pinhole geometry), so sky samples need no trigonometry.
     glm::vec3 colStep{0.0f};
@@ -280,6 +331,7 @@ struct FlirChannel::ShadeScratch {
         std::vector<uint32_t> skyK, seaK;  // sample index within the block
         std::vector<float> skyZ, skyLength;
         std::vector<float> px, py, pz, nx, ny, nz;
+        std::vector<float> depth, wet, foam;  // sea-mesh attributes (ViewGeometry)
         std::vector<uint32_t> modelK;
         std::vector<glm::vec3> modelP, modelN;
         std::vector<int> modelMesh;
@@ -290,7 +342,8 @@ struct FlirChannel::ShadeScratch {
 
         void Reserve(size_t n) {
             if (skyK.size() >= n) return;
-            for (std::vector<float>* v : {&skyZ, &skyLength, &px, &py, &pz, &nx, &ny, &nz})
+            for (std::vector<float>* v :
+                 {&skyZ, &skyLength, &px, &py, &pz, &nx, &ny, &nz, &depth, &wet, &foam})
                 v->resize(n);
             skyK.resize(n), seaK.resize(n);
         }
@@ -335,6 +388,9 @@ uint64_t FlirChannel::ShadeRows(const FrameShading& f, int y0, int y1, float* ou
                 sc.seaK[seaCount] = k;
                 sc.px[seaCount] = p[0], sc.py[seaCount] = p[1], sc.pz[seaCount] = p[2];
                 sc.nx[seaCount] = n[0], sc.ny[seaCount] = n[1], sc.nz[seaCount] = n[2];
+                alignas(16) float a[4];
+                tri.Attributes(b1[x], b2[x], a);
+                sc.depth[seaCount] = a[0], sc.wet[seaCount] = a[1], sc.foam[seaCount] = a[2];
                 ++seaCount;
                 continue;
             }
@@ -370,7 +426,8 @@ uint64_t FlirChannel::ShadeRows(const FrameShading& f, int y0, int y1, float* ou
 
     // Pass 3: sea. Emissivity at the local view angle (Masuda's wind average for the unresolved
     // slopes), sky reflected about the resolved normal (a ray reflected into the sea meets the
-    // next wave's sky), through the path.
+    // next wave's sky); sand where the sea lies on the beach and foam over both
+    // (SurfInfraredRadiance4); through the path.
     const F4 eyeX = Set4(f.eye.x), eyeY = Set4(f.eye.y), eyeZ = Set4(f.eye.z);
     for (size_t c = 0; c < seaCount; c += kChunk) {
         const size_t count = std::min(kChunk, seaCount - c);
@@ -398,9 +455,18 @@ uint64_t FlirChannel::ShadeRows(const FrameShading& f, int y0, int y1, float* ou
         skyTable_(count, sc.b, sc.e);
         pathTau_(count, sc.c, sc.a);
         const F4 seaB = Set4(f.seaB), airB = Set4(f.airB);
-        for (size_t i = 0; i < count; i += 4)
-            _mm_store_ps(sc.b + i, Aperture4(_mm_load_ps(sc.a + i), _mm_load_ps(sc.d + i), seaB,
-                                             _mm_load_ps(sc.e + i), airB));
+        const F4 one = Set4(1.0f);
+        for (size_t i = 0; i < count; i += 4) {
+            const size_t lanes = std::min<size_t>(4, count - i);
+            const size_t j = c + i;
+            const F4 L = SurfInfraredRadiance4(
+                f.surf, _mm_load_ps(sc.d + i), seaB, _mm_load_ps(sc.e + i),
+                LoadLanes(&sc.depth[j], lanes, kDeepColumn_m), LoadLanes(&sc.wet[j], lanes, 0.0f),
+                LoadLanes(&sc.foam[j], lanes, 0.0f));
+            const F4 tau = _mm_load_ps(sc.a + i);
+            _mm_store_ps(sc.b + i,
+                         _mm_add_ps(_mm_mul_ps(tau, L), _mm_mul_ps(_mm_sub_ps(one, tau), airB)));
+        }
         for (size_t i = 0; i < count; ++i) out[sc.seaK[c + i]] = sc.b[i];
     }
 
@@ -463,7 +529,9 @@ void FlirChannel::Render(const scene::SceneState& state, Image& radiance) {
     const double tanH = cam.TanHalfH(), tanV = cam.TanHalfV();
     FrameShading frame(vis, occlusion);
     const scene::OceanMesh& ocean = geometry_.Ocean();
-    frame.meshes.push_back({ocean.positions.data(), ocean.normals.data(), ocean.indices.data()});
+    CHECK(geometry_.OceanAttributes().size() == ocean.positions.size());
+    frame.meshes.push_back({ocean.positions.data(), ocean.normals.data(), ocean.indices.data(),
+                            geometry_.OceanAttributes().data()});
     for (const scene::TriangleMesh& m : geometry_.EntityMeshes())
         frame.meshes.push_back({m.positions.data(), m.normals.data(), m.indices.data()});
     frame.sampleWidth = sw;
@@ -473,6 +541,7 @@ void FlirChannel::Render(const scene::SceneState& state, Image& radiance) {
     frame.shadows = setup_.channel.shadows && !occlusion.Empty() && frame.sunDir.z > 0.0f;
     frame.seaB = float(table_.Radiance(sea_.temperature_K));
     frame.airB = float(atmosphere_.AirRadiance());
+    frame.surf = surf_;
     frame.colStep = glm::vec3(R * glm::dvec3(2.0 * tanH / sw, 0.0, 0.0));
     frame.forward = R * glm::dvec3(0.0, 1.0, 0.0);
     frame.right = R * glm::dvec3(tanH, 0.0, 0.0);

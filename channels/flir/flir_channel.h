@@ -5,10 +5,13 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "channels/flir/flir_imager.h"
+#include "channels/flir/surf_infrared.h"
 #include "channels/view/view_geometry.h"
 #include "radiometry/atmosphere/atmosphere.h"
 #include "radiometry/materials/material_table.h"
@@ -136,6 +139,15 @@ class FlirChannel {
     // for materials without a heat balance.
     std::array<double, OrientationTemperatures::kClasses> EntityTemperatures_K(size_t entity,
                                                                                double time_s);
+    // Temperatures (K) of level dry and wet sand on the beach at time_s (the sand_dry and
+    // sand_wet materials' models, upward-facing and sunlit); both 0 without a surf zone.
+    std::array<double, 2> SandTemperatures_K(double time_s);
+    // The surf zone's constants of the last rendered frame (foam emissivity and radiance, sand
+    // surface-leaving radiances).
+    const SurfInfrared& SurfConstants() const { return surf_; }
+    // Cosine-weighted hemispherical mean of the sky radiance, 2∫₀¹ L_sky(μ) μ dμ: the sky a level
+    // Lambertian surface reflects.
+    float HemisphericalSkyRadiance() const { return skyHemi_; }
 
   private:
     struct EntityThermal {
@@ -147,7 +159,16 @@ class FlirChannel {
     struct ShadeScratch;
     struct FrameShading;
 
-    // Band blackbody radiance of every entity's orientation classes at time_s.
+    // The thermal model of material m in the channel's band (heat-balance materials share one
+    // OrientationTemperatures per name through heatBalanceOf).
+    EntityThermal ThermalOf(const radiometry::Material& m, scene::InfraredBand band,
+                            const OrientationTemperatures::Environment& environment,
+                            const radiometry::ThermalEnvironment& thermalEnvironment,
+                            std::map<std::string, int>& heatBalanceOf);
+    std::array<double, OrientationTemperatures::kClasses> ClassTemperatures_K(
+        const EntityThermal& t, double time_s);
+    // Band blackbody radiance of every entity's orientation classes at time_s, and the surf
+    // zone's constants.
     void UpdateEntityRadiance(double time_s);
     // Shades the sample rows [y0, y1) into out (the rows' first sample); returns the number
     // of shadow rays traced.
@@ -167,6 +188,11 @@ class FlirChannel {
     std::vector<EntityThermal> entities_;
     std::vector<std::unique_ptr<OrientationTemperatures>> heatBalance_;
     std::vector<std::array<float, OrientationTemperatures::kClasses>> entityB_;
+    // Surf zone: foam (always: deep-water whitecaps too), dry and wet sand (with a surf zone).
+    bool hasSurf_ = false;
+    float skyHemi_ = 0.0f;
+    EntityThermal foam_, sandDry_, sandWet_;
+    SurfInfrared surf_;
     std::unique_ptr<ShadeScratch> scratch_;
     std::unique_ptr<ChannelPlumes> plumes_;  // scenario plumes (channels/plume)
     std::unique_ptr<CloudSky> clouds_;       // cloud pass scratch (environment.clouds)

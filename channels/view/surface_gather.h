@@ -12,11 +12,18 @@
 
 namespace seasense::channels {
 
-// Vertex arrays of one rasterized mesh (mesh 0 the sea, mesh i ≥ 1 entity i − 1).
+// Vertex attributes above this (the +∞ water column of a sea without a surf zone) are taken as
+// this value, so that they interpolate finitely.
+inline constexpr float kMaxVertexAttribute = 1.0e4f;
+
+// Vertex arrays of one rasterized mesh (mesh 0 the sea, mesh i ≥ 1 entity i − 1). attributes:
+// optional per-vertex values interpolated like the normals (the sea's
+// ViewGeometry::OceanAttributes).
 struct MeshArrays {
     const glm::vec3* positions;
     const glm::vec3* normals;
     const uint32_t* indices;
+    const glm::vec4* attributes = nullptr;
 };
 
 // Mesh m's primitives are [primitiveBase[m], primitiveBase[m + 1]): the mesh of prim by binary
@@ -48,11 +55,27 @@ class TriangleCache {
             p_[2] = Load3(m.positions[i2]);
             n_[0] = Load3(m.normals[i0]), n_[1] = Load3(m.normals[i1]);
             n_[2] = Load3(m.normals[i2]);
+            if (m.attributes) {
+                const F4 top = Set4(kMaxVertexAttribute);
+                a_[0] = _mm_min_ps(_mm_loadu_ps(&m.attributes[i0].x), top);
+                a_[1] = _mm_min_ps(_mm_loadu_ps(&m.attributes[i1].x), top);
+                a_[2] = _mm_min_ps(_mm_loadu_ps(&m.attributes[i2].x), top);
+            } else {
+                a_[0] = a_[1] = a_[2] = _mm_setzero_ps();
+            }
         }
         const F4 w0 = Set4(1.0f - b1 - b2), w1 = Set4(b1), w2 = Set4(b2);
         _mm_storeu_ps(position, Interpolate(w0, w1, w2, p_));
         _mm_storeu_ps(normal, Interpolate(w0, w1, w2, n_));
         mesh = mesh_;
+    }
+
+    // The vertex attributes of the triangle of the last Surface call (0 for a mesh without them)
+    // at barycentrics (1 − b1 − b2, b1, b2), written to attributes[4]; the same sums as Surface.
+    void Attributes(float b1, float b2, float* attributes) const {
+        using namespace simd4;
+        const F4 w0 = Set4(1.0f - b1 - b2), w1 = Set4(b1), w2 = Set4(b2);
+        _mm_storeu_ps(attributes, Interpolate(w0, w1, w2, a_));
     }
 
   private:
@@ -64,7 +87,7 @@ class TriangleCache {
 
     uint32_t prim_ = kNoPrimitive;
     int mesh_ = 0;
-    simd4::F4 p_[3] = {}, n_[3] = {};
+    simd4::F4 p_[3] = {}, n_[3] = {}, a_[3] = {};
 };
 
 }  // namespace seasense::channels

@@ -1,0 +1,54 @@
+// Thermal-infrared shading of the surf zone, four lanes at a time: sea water, the beach (dry and
+// wet sand) where the sea lies on it, and a foam layer over both.
+#pragma once
+
+#include "channels/otw/shore_shading.h"
+#include "scene/core/simd4.h"
+
+namespace seasense::channels {
+
+// Frame constants of the surf zone in the channel's band (W·m⁻²·sr⁻¹ for radiances).
+struct SurfInfrared {
+    // Foam emissivity (hemispherical; taken as independent of the view angle): sea foam is
+    // nearly black in the windows, LWIR ~0.99, MWIR ~0.98 (J. W. Salisbury and D. M. D'Aria,
+    // Remote Sens. Environ. 42, 83-106 (1992), the source of configs/materials.yaml's foam;
+    // R. Niclòs et al., "Foam effect on the sea surface emissivity in the 8-14 um region",
+    // J. Geophys. Res. 112, C12020 (2007): foam raises the sea's emissivity toward 0.99 and
+    // flattens its fall with view angle). The default stands for a table without `foam`.
+    float foamEmissivity = 0.99f;
+    float foamB = 0.0f;  // B(T_foam): foam is sea water at the sea temperature
+    // Surface-leaving radiance of level dry and wet sand: ε B(T) + (1 − ε) L_sky,hemi (sand is a
+    // rough, diffuse reflector, so it reflects the cosine-weighted hemispherical sky).
+    float sandDry = 0.0f, sandWet = 0.0f;
+};
+
+// Surface-leaving band radiance of a sea-mesh sample:
+//   water   = ε_w B(T_sea) + (1 − ε_w) L_sky,r      (ε_w at the view angle, L_sky,r the sky about
+//                                                   the resolved normal)
+//   foam    = ε_f B(T_foam) + (1 − ε_f) L_sky,r
+//   sand    = L_dry + (L_wet − L_dry)·wet
+//   surface = water + (sand − water)·(1 − min(d / kSwashFilm_m, 1))
+//   result  = surface + (foam − surface)·c
+// Water is opaque in the thermal infrared (absorption length ~10 µm at 10 µm, ~1 µm at 3 µm:
+// Hale & Querry, Appl. Opt. 12, 555 (1973)), so the seabed never shows through shallow water:
+// sand appears only where the column d is thinner than the swash film that OTW uses for the
+// waterline, and the two channels put the waterline in the same place. Written so that without
+// sand (film 1) and foam (c = 0) the result is the water term bit for bit.
+inline simd4::F4 SurfInfraredRadiance4(const SurfInfrared& s, simd4::F4 epsWater, simd4::F4 seaB,
+                                       simd4::F4 skyR, simd4::F4 depth, simd4::F4 wet,
+                                       simd4::F4 foam) {
+    using namespace simd4;
+    const F4 one = Set4(1.0f);
+    const F4 water =
+        _mm_add_ps(_mm_mul_ps(epsWater, seaB), _mm_mul_ps(_mm_sub_ps(one, epsWater), skyR));
+    const F4 epsF = Set4(s.foamEmissivity);
+    const F4 white =
+        _mm_add_ps(_mm_mul_ps(epsF, Set4(s.foamB)), _mm_mul_ps(_mm_sub_ps(one, epsF), skyR));
+    const F4 sand = _mm_add_ps(Set4(s.sandDry), _mm_mul_ps(Set4(s.sandWet - s.sandDry), wet));
+    const F4 film = _mm_min_ps(_mm_mul_ps(depth, Set4(1.0f / kSwashFilm_m)), one);
+    const F4 surface =
+        _mm_add_ps(water, _mm_mul_ps(_mm_sub_ps(sand, water), _mm_sub_ps(one, film)));
+    return _mm_add_ps(surface, _mm_mul_ps(_mm_sub_ps(white, surface), foam));
+}
+
+}  // namespace seasense::channels
