@@ -405,12 +405,8 @@ struct FrameGeometry {
         tri.p0 = Load3(m.P[i0]), tri.p1 = Load3(m.P[i1]), tri.p2 = Load3(m.P[i2]);
         tri.n0 = Load3(m.N[i0]), tri.n1 = Load3(m.N[i1]), tri.n2 = Load3(m.N[i2]);
         if (m.A) {
-            // The +∞ column of a sea without a surf zone taken as kDeepColumn_m: ∞ times a zero
-            // barycentric weight (samples on a triangle's edge) would be NaN.
-            const F4 top = Set4(kDeepColumn_m);
-            tri.a0 = _mm_min_ps(_mm_loadu_ps(&m.A[i0].x), top);
-            tri.a1 = _mm_min_ps(_mm_loadu_ps(&m.A[i1].x), top);
-            tri.a2 = _mm_min_ps(_mm_loadu_ps(&m.A[i2].x), top);
+            tri.a0 = _mm_loadu_ps(&m.A[i0].x), tri.a1 = _mm_loadu_ps(&m.A[i1].x);
+            tri.a2 = _mm_loadu_ps(&m.A[i2].x);
         }
     }
 };

@@ -160,13 +160,15 @@ void ViewGeometry::UpdateOceanAttributes(double time_s) {
                 // The seabed under the drawn (displaced) point, dropped by the same curvature.
                 const double bed = bathy.SeabedZ_m(p.x, p.y);
                 a.x = float(std::max(0.0, double(p.z) + drop - bed));
+                if (a.x <= 0.0f) a.z = 0.0f;  // no whitecaps on the sand
                 // Sand at or below high water has been wet by the last tide; above it dries over
                 // the swash's run-up (taken as 0.3 m of elevation).
                 a.y = float(std::clamp(1.0 - (bed - bathy.Settings().highTide_m) / 0.3, 0.0, 1.0));
-                // Surf foam only where the surf components are drawn (depth below the fade).
+                // Surf foam only where the surf components are drawn (depth below the fade) and
+                // there is water above the seabed (none on the dry beach).
                 const double az = dphi * double(ocean_.firstColumn + i);
                 const double x0 = eye.x + radius * std::sin(az), y0 = eye.y + radius * std::cos(az);
-                if (bathy.Depth_m(x0, y0) < surf->FadeDeep_m()) {
+                if (a.x > 0.0f && bathy.Depth_m(x0, y0) < surf->FadeDeep_m()) {
                     scene::SurfPointInfo info;
                     surf->Terms(x0, y0, time_s, &info);
                     a.z = std::max(a.z, float(scene::SurfFoamCoverage(info, x0, y0, time_s,
