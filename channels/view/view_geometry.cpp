@@ -132,7 +132,7 @@ void ViewGeometry::UpdateCasterBounds() {
     casterMax_ = hi + margin_m;
 }
 
-void ViewGeometry::UpdateOceanAttributes(double time_s) {
+void ViewGeometry::UpdateOceanAttributes() {
     const scene::OceanSurfaceFrame& sea = *oceanFrame_;
     const scene::SurfWaves* surf = sea.Surf();
     const double threshold = world_.GetScenario().environment.ocean.foamThreshold;
@@ -141,8 +141,6 @@ void ViewGeometry::UpdateOceanAttributes(double time_s) {
     const int columns = ocean_.fullCircle ? ocean_.segments : ocean_.segments + 1;
     if (rings == 0) return;
     CHECK(size_t(rings) * size_t(columns) == ocean_.positions.size());
-    const double dphi = 2.0 * M_PI / double(ocean_.circleSegments);
-    const glm::dvec3 eye = camera_.worldFromCamera.position_m;
     tbb::parallel_for(0, rings, [&](int j) {
         const double radius = ocean_.radii_m[size_t(j)];
         const double drop = scene::CurvatureDrop_m(radius);
@@ -164,16 +162,9 @@ void ViewGeometry::UpdateOceanAttributes(double time_s) {
                 // Sand at or below high water has been wet by the last tide; above it dries over
                 // the swash's run-up (taken as 0.3 m of elevation).
                 a.y = float(std::clamp(1.0 - (bed - bathy.Settings().highTide_m) / 0.3, 0.0, 1.0));
-                // Surf foam only where the surf components are drawn (depth below the fade) and
-                // there is water above the seabed (none on the dry beach).
-                const double az = dphi * double(ocean_.firstColumn + i);
-                const double x0 = eye.x + radius * std::sin(az), y0 = eye.y + radius * std::cos(az);
-                if (a.x > 0.0f && bathy.Depth_m(x0, y0) < surf->FadeDeep_m()) {
-                    scene::SurfPointInfo info;
-                    surf->Terms(x0, y0, time_s, &info);
-                    a.z = std::max(a.z, float(scene::SurfFoamCoverage(info, x0, y0, time_s,
-                                                                      bathy.Settings().foam)));
-                }
+                // Surf foam (computed with the vertex, OceanMesh::surfFoam) only where there is
+                // water above the seabed (none on the dry beach).
+                if (a.x > 0.0f) a.z = std::max(a.z, ocean_.surfFoam[v]);
             }
             oceanAttributes_[v] = a;
         }
@@ -201,7 +192,7 @@ void ViewGeometry::Update(const scene::SceneState& state) {
     FrustumAzimuthSector(cam, 20.0 * M_PI / 180.0, req.azimuthMin_rad, req.azimuthMax_rad);
     req.minRange_m = NearestVisibleSeaRange_m(cam, sea.MaxHeight_m(), sea.MaxHorizontal_m());
     scene::BuildOceanMesh(sea, req, ocean_);
-    UpdateOceanAttributes(state.time_s);
+    UpdateOceanAttributes();
 
     std::vector<RasterMesh> meshes;
     // The sea is seen from both sides only when a camera dips below it; cull back faces.

@@ -69,7 +69,7 @@ class ViewGeometry {
     std::vector<scene::Pose> entityPoses_;          // the poses worldMeshes_ were built at
     std::vector<uint32_t> occlusionIds_;            // Embree geometry of each entity
     glm::vec3 casterMin_{0.0f}, casterMax_{0.0f};
-    void UpdateOceanAttributes(double time_s);
+    void UpdateOceanAttributes();
 
     scene::OceanMesh ocean_;
     std::vector<glm::vec4> oceanAttributes_;

@@ -31,6 +31,7 @@
 #include <cmath>
 
 #include "scene/core/check.h"
+#include "scene/surf/foam.h"
 
 namespace seasense::scene {
 
@@ -130,6 +131,10 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
         frame.Gerstner().Local(req.eye_m.x, req.eye_m.y, frame.Time_s());
     const bool gerstner = frame.Gerstner().WaveCount() > 0;
     const bool surf = frame.Surf() != nullptr;
+    if (surf)
+        out.surfFoam.resize(out.positions.size());
+    else
+        out.surfFoam.clear();
     tbb::parallel_for(0, rings, [&](int j) {
         const double radius = radii[size_t(j)];
         const double drop = CurvatureDrop_m(radius);
@@ -158,6 +163,11 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
                         s[size_t(k)] += float(wg) * g[size_t(k)];
                 }
                 frame.AddSurf(x0, y0, st, s);
+                const SurfWaves& waves = *frame.Surf();
+                out.surfFoam[v] = info.depth_m < waves.FadeDeep_m()
+                                      ? float(SurfFoamCoverage(info, x0, y0, frame.Time_s(),
+                                                               waves.Bathy().Settings().foam))
+                                      : 0.0f;
             }
             out.positions[v] = glm::vec3(float(req.eye_m.x + rx + double(s[kTermDispX])),
                                          float(req.eye_m.y + ry + double(s[kTermDispY])),

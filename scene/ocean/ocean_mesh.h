@@ -35,7 +35,11 @@ struct OceanMesh {
     std::vector<glm::vec3> positions;  // world ENU, curvature drop applied relative to the eye
     std::vector<glm::vec3> normals;    // unit, world
     std::vector<float> jacobian;       // surface folding measure (< 0 folded)
-    std::vector<uint32_t> indices;     // counter-clockwise seen from above
+    // With a surf zone, per vertex: the surf's foam coverage (scene/surf/foam.h) at the vertex's
+    // rest position where the still water is shallower than the fade depth, else 0; from the
+    // same SurfWaves::Terms evaluation as the vertex. Empty without a surf zone.
+    std::vector<float> surfFoam;
+    std::vector<uint32_t> indices;  // counter-clockwise seen from above
     // Ring j, column i is vertex j · (segments + !fullCircle) + i. Column i lies at azimuth
     // (firstColumn + i) · 2π / circleSegments: azimuths are fixed in the world.
     int rings = 0;
