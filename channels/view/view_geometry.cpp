@@ -88,6 +88,18 @@ double NearestVisibleSeaRange_m(const ChannelCamera& cam, double crestHeight_m,
     return std::max(0.0, 0.8 * h / slope - horizontalReach_m);
 }
 
+double NearestVisibleSeaRange_m(const ChannelCamera& cam, const scene::OceanSurfaceFrame& sea,
+                                const glm::dvec3& eye_m) {
+    // The bound of the sea right under the eye gives the largest candidate range; the bound over
+    // that whole disc (never lower, since the disc holds the eye's point) then gives a range no
+    // larger, inside the disc the bound was taken over, so it holds there.
+    const scene::SurfaceBounds under = sea.BoundsNear(eye_m.x, eye_m.y, 0.0);
+    const double r0 = NearestVisibleSeaRange_m(cam, under.height_m, under.horizontal_m);
+    if (!(r0 > 0.0) || !std::isfinite(r0)) return r0;
+    const scene::SurfaceBounds disc = sea.BoundsNear(eye_m.x, eye_m.y, r0);
+    return NearestVisibleSeaRange_m(cam, disc.height_m, disc.horizontal_m);
+}
+
 ViewGeometry::ViewGeometry(const scene::World& world, const scene::ChannelSettings& settings)
     : world_(world), settings_(settings) {
     const scene::SceneState s0 = world.State(0);
@@ -190,7 +202,7 @@ void ViewGeometry::Update(const scene::SceneState& state) {
     req.eye_m = cam.worldFromCamera.position_m;
     req.angularStep_rad = kOceanVertexSpacing_px * cam.hfov_rad / double(cam.width);
     FrustumAzimuthSector(cam, 20.0 * M_PI / 180.0, req.azimuthMin_rad, req.azimuthMax_rad);
-    req.minRange_m = NearestVisibleSeaRange_m(cam, sea.MaxHeight_m(), sea.MaxHorizontal_m());
+    req.minRange_m = NearestVisibleSeaRange_m(cam, sea, req.eye_m);
     scene::BuildOceanMesh(sea, req, ocean_);
     UpdateOceanAttributes();
 

@@ -89,5 +89,9 @@ void FrustumAzimuthSector(const ChannelCamera& camera, double margin_rad, double
 // view ray points down.
 double NearestVisibleSeaRange_m(const ChannelCamera& camera, double crestHeight_m,
                                 double horizontalReach_m);
+// The same for the sea of a frame seen from eye_m: the crest and reach bounds taken over the
+// disc of sea near the eye (OceanSurfaceFrame::BoundsNear) rather than the whole surface.
+double NearestVisibleSeaRange_m(const ChannelCamera& camera, const scene::OceanSurfaceFrame& sea,
+                                const glm::dvec3& eye_m);
 
 }  // namespace seasense::channels

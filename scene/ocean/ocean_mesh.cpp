@@ -53,10 +53,15 @@ std::vector<double> OceanMeshRadii(double eyeHeight_m, double significantHeight_
     // Foreshortening uses the eye's height above a typical trough (half the significant height).
     const double hEff = std::max(eyeHeight_m, 0.05) + 0.5 * significantHeight_m;
     std::vector<double> radii{0.0};  // a centre vertex under the eye
-    double r = std::max(0.05, 0.25 * hEff);
+    // A ring at range r is seen at the depression angle atan(h / r), which changes by
+    // h dr / (r² + h²): steps of dphi (r² + h²) / h subtend the angular step from the nadir to the
+    // horizon (π/2 / dphi rings out to the grazing range), capped at 8× the tangential spacing
+    // r dphi where grazing foreshortening would stretch the cells further.
+    double r = hEff * dphi;
     while (r < maxRange_m) {
         radii.push_back(r);
-        const double step = std::min(r * dphi * std::max(1.0, r / hEff), 8.0 * r * dphi);
+        const double step =
+            std::min(dphi * (r * r + hEff * hEff) / hEff, std::max(8.0 * r, hEff) * dphi);
         r += std::max(step, 1e-3);
     }
     radii.push_back(maxRange_m);

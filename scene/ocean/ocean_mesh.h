@@ -53,9 +53,9 @@ struct OceanMesh {
 
 // Rest-position radii of the rings for an eye height above the mean sea (m), the waves'
 // significant height (m) and an angular step (rad), out to maxRange_m (the last ring): a centre
-// vertex, then rings spaced so that each step subtends about the angular step seen from the eye
-// — geometric near the eye, growing as r²/h where grazing foreshortening compresses them,
-// capped at 8× the tangential spacing. A function of these arguments only.
+// vertex, then rings spaced so that each step subtends the angular step in depression angle seen
+// from the eye — h·dphi under the eye, growing as r²/h where grazing foreshortening compresses
+// them, capped at 8× the tangential spacing. A function of these arguments only.
 std::vector<double> OceanMeshRadii(double eyeHeight_m, double significantHeight_m,
                                    double angularStep_rad, double maxRange_m);
 

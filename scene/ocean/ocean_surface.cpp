@@ -21,6 +21,7 @@ namespace {
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
 // Frames kept by OceanSurface::At: the current frame time and the one before, so the host's
 // wave riding and a renderer's mesh of one frame share a synthesis.
 constexpr size_t kCachedFrames = 2;
@@ -65,6 +66,7 @@ void OceanSurfaceFrame::BuildTextures() {
     const float l = float(fft_.Choppiness());
     const int levelCount = std::countr_zero(unsigned(n)) + 1;
     textures_.resize(cascades);
+    cascadeBounds_.resize(cascades);
     maxHeight_m_ = maxHorizontal_m_ = 0.0;
     for (size_t c = 0; c < cascades; ++c) {
         CascadeTexture& tex = textures_[c];
@@ -97,8 +99,10 @@ void OceanSurfaceFrame::BuildTextures() {
             rowHorizontal[size_t(ix)] = std::sqrt(maxD2);
         });
         // The bilinear surface never exceeds its nodes; the cascades' maxima bound the sum.
-        maxHeight_m_ += *std::max_element(rowHeight.begin(), rowHeight.end());
-        maxHorizontal_m_ += *std::max_element(rowHorizontal.begin(), rowHorizontal.end());
+        cascadeBounds_[c] = {*std::max_element(rowHeight.begin(), rowHeight.end()),
+                             *std::max_element(rowHorizontal.begin(), rowHorizontal.end())};
+        maxHeight_m_ += cascadeBounds_[c].height_m;
+        maxHorizontal_m_ += cascadeBounds_[c].horizontal_m;
         for (int lv = 1; lv < levelCount; ++lv) {
             const int m = n >> lv;
             const std::vector<Texel>& fine = tex.levels[size_t(lv - 1)];
@@ -328,7 +332,10 @@ void OceanSurface::Fill(OceanSurfaceFrame& frame, double t, bool withVelocity) c
     frame.significantHeight_m_ = summary_.significantHeight_m;
     frame.hasFft_ = fft_ != nullptr;
     frame.maxHeight_m_ = frame.maxHorizontal_m_ = 0.0;
-    if (!fft_) frame.textures_.clear();  // else rebuilt in place, reusing the buffers
+    if (!fft_) {
+        frame.textures_.clear();  // else rebuilt in place, reusing the buffers
+        frame.cascadeBounds_.clear();
+    }
     if (fft_) {
         fft_->Synthesize(t, frame.fft_, withVelocity);
         frame.BuildTextures();
@@ -336,13 +343,29 @@ void OceanSurface::Fill(OceanSurfaceFrame& frame, double t, bool withVelocity) c
     frame.maxHeight_m_ += gerstner_.MaxAmplitude_m();
     frame.maxHorizontal_m_ += gerstner_.MaxHorizontal_m();
     frame.surf_ = surf_;
+    frame.surfReach_m_ = 0.0;
     if (surf_) {
-        // Surf crests are capped at γ h / 2 within the fade depth, on top of the tide; their
-        // horizontal orbits at A / tanh(kh) ≤ A / (kh) ~ the depth at most.
-        frame.maxHeight_m_ +=
-            0.5 * surf_->BreakerIndex() * surf_->FadeDeep_m() + std::abs(surf_->Bathy().Tide_m());
-        frame.maxHorizontal_m_ += surf_->FadeDeep_m();
+        // Over the whole surface: the surf bound at every depth, the whole seabed.
+        frame.surfReach_m_ =
+            surf_->BoundAtDepths(-kInf, frame.cascadeBounds_, frame.GerstnerBound()).horizontal_m;
+        const SurfaceBounds all = frame.BoundsNear(0.0, 0.0, kInf);
+        frame.maxHeight_m_ = all.height_m;
+        frame.maxHorizontal_m_ = all.horizontal_m;
     }
+}
+
+SurfWaves::Bound OceanSurfaceFrame::GerstnerBound() const {
+    return {gerstner_.MaxAmplitude_m(), gerstner_.MaxHorizontal_m()};
+}
+
+SurfaceBounds OceanSurfaceFrame::BoundsNear(double x, double y, double radius_m) const {
+    CHECK(radius_m >= 0.0);
+    if (!surf_) return {maxHeight_m_, maxHorizontal_m_};
+    // Rest positions within the radius; the seabed clamp looks under the displaced points.
+    const double tide = surf_->Bathy().Tide_m();
+    const double zBed = surf_->Bathy().MaxSeabedZWithin_m(x, y, radius_m + surfReach_m_);
+    const SurfWaves::Bound b = surf_->BoundAtDepths(tide - zBed, cascadeBounds_, GerstnerBound());
+    return {std::max({tide + b.height_m, zBed, 0.0}), b.horizontal_m};
 }
 
 std::shared_ptr<const OceanSurfaceFrame> OceanSurface::At(double t) const {

@@ -60,6 +60,13 @@ struct FftFilter {
 };
 
 // The surface at one instant: an immutable snapshot once made by OceanSurface.
+// Upper bounds of (part of) the sea surface at an instant: the highest point (ENU z, m) and the
+// largest horizontal displacement from rest (m).
+struct SurfaceBounds {
+    double height_m = 0.0;
+    double horizontal_m = 0.0;
+};
+
 class OceanSurfaceFrame {
   public:
     double Time_s() const { return t_s_; }
@@ -110,10 +117,15 @@ class OceanSurfaceFrame {
     const GerstnerOcean& Gerstner() const { return gerstner_; }
     const FftOceanFrame* Fft() const { return hasFft_ ? &fft_ : nullptr; }
 
-    // Bounds over the whole surface at this instant: largest |η| and largest horizontal
-    // displacement (m), for view culling and the horizon.
+    // Bounds over the whole surface at this instant: highest surface point (ENU z, m; with a
+    // surf zone the beach included) and largest horizontal displacement (m), for view culling
+    // and the horizon.
     double MaxHeight_m() const { return maxHeight_m_; }
     double MaxHorizontal_m() const { return maxHorizontal_m_; }
+    // The same bounds for the points whose rest positions lie within radius_m of world (x, y):
+    // with a surf zone, waves over shallow water are capped by their depth, so the sea near an
+    // eyepoint in deeper water is bounded far more tightly than the whole surface.
+    SurfaceBounds BoundsNear(double x, double y, double radius_m) const;
     // Significant wave height of the sea (time-independent; for mesh spacing choices), m.
     double SignificantHeight_m() const { return significantHeight_m_; }
 
@@ -131,6 +143,7 @@ class OceanSurfaceFrame {
         std::vector<std::vector<Texel>> levels;
     };
     void BuildTextures();
+    SurfWaves::Bound GerstnerBound() const;
 
     double t_s_ = 0.0;
     GerstnerOcean gerstner_;
@@ -140,6 +153,8 @@ class OceanSurfaceFrame {
     std::vector<CascadeTexture> textures_;
     double maxHeight_m_ = 0.0;
     double maxHorizontal_m_ = 0.0;
+    std::vector<SurfWaves::Bound> cascadeBounds_;  // per cascade: max |η|, max |D|
+    double surfReach_m_ = 0.0;  // largest horizontal displacement anywhere, with the surf
     double significantHeight_m_ = 0.0;
 };
 

@@ -76,9 +76,8 @@ int Bathymetry::RegionAt(double u_m, double* offset_m) const {
         if (offset_m) *offset_m = 0.0;
         return -1;
     }
-    double u = std::fmod(u_m, period_m_);
-    if (u < 0.0) u += period_m_;
-    if (u >= period_m_) u = 0.0;  // fmod of a value just below a multiple, then + period
+    double u = u_m - period_m_ * std::floor(u_m / period_m_);
+    if (u < 0.0 || u >= period_m_) u = 0.0;  // rounding just below a multiple of the period
     const auto next = std::upper_bound(regionStart_m_.begin(), regionStart_m_.end(), u);
     const int index = int(next - regionStart_m_.begin()) - 1;
     if (offset_m) *offset_m = u - regionStart_m_[size_t(index)];
@@ -99,7 +98,7 @@ double Bathymetry::BarLift(double s_m, double u_m, double profileZ_m) const {
     if (zCrest <= profileZ_m) return 0.0;
     const double ds = std::max(std::abs(s_m - bar.distance_m) - 0.5 * bar.width_m, 0.0);
     const double du = std::max(std::abs(offset_m - 0.5 * r.width_m) - 0.5 * bar.length_m, 0.0);
-    const double d = std::hypot(ds, du);
+    const double d = std::sqrt(ds * ds + du * du);
     if (d >= bar.sideSlope_m) return 0.0;
     const double t = 1.0 - d / bar.sideSlope_m;
     return (zCrest - profileZ_m) * t * t * (3.0 - 2.0 * t);
@@ -112,6 +111,44 @@ double Bathymetry::SeabedZAtShore_m(double s_m, double u_m) const {
     }
     const double z = ProfileZ_m(s_m);
     return z + BarLift(s_m, u_m, z);
+}
+
+double Bathymetry::MaxSeabedZWithin_m(double x, double y, double radius_m) const {
+    CHECK(radius_m >= 0.0);
+    if (settings_.depthGrid) {
+        const DepthGridSettings& g = *settings_.depthGrid;
+        const DepthGrid& grid = *g.grid;
+        // Bilinear samples lie between their four nodes; outside, the border extends.
+        const double c0 = (x - radius_m - g.origin_m.x) / g.cell_m;
+        const double c1 = (x + radius_m - g.origin_m.x) / g.cell_m;
+        const double r0 = (g.origin_m.y - y - radius_m) / g.cell_m;
+        const double r1 = (g.origin_m.y - y + radius_m) / g.cell_m;
+        const auto clampIndex = [](double v, int n) {
+            return int(std::clamp(v, 0.0, double(n - 1)));
+        };
+        const int ca = clampIndex(std::floor(c0), grid.Width());
+        const int cb = clampIndex(std::ceil(c1), grid.Width());
+        const int ra = clampIndex(std::floor(r0), grid.Height());
+        const int rb = clampIndex(std::ceil(r1), grid.Height());
+        double z = -std::numeric_limits<double>::infinity();
+        for (int r = ra; r <= rb; ++r)
+            for (int c = ca; c <= cb; ++c) {
+                const double v = grid.At(c, r);
+                z = std::max(z, g.values == DepthGridValues::Depth ? -v : v);
+            }
+        return std::max(z, -oceanDepth_m_);
+    }
+    const double s = frame_.ShoreFromWorld(x, y).s_m;
+    const double sNear = s - radius_m, sFar = s + radius_m;
+    double z = ProfileZ_m(sNear);  // the profile is highest at its landward end
+    for (const SurfRegionSettings& r : settings_.regions) {
+        if (!r.sandbar) continue;
+        const SandbarSettings& bar = *r.sandbar;
+        const double reach = 0.5 * bar.width_m + bar.sideSlope_m;
+        if (bar.distance_m + reach >= sNear && bar.distance_m - reach <= sFar)
+            z = std::max(z, settings_.tide_m - bar.crestDepth_m);
+    }
+    return z;
 }
 
 double Bathymetry::SeabedZ_m(double x, double y) const {

@@ -43,6 +43,11 @@ class Bathymetry {
         return settings_.tide_m - SeabedZAtShore_m(s_m, u_m);
     }
 
+    // An upper bound of the seabed elevation (ENU z, m) within radius_m of world point (x, y):
+    // the plane profile falls monotonically seaward, a sandbar lifts it at most to its crest, a
+    // grid never exceeds its largest node in the disc's bounding box. +∞ radius: the whole bed.
+    double MaxSeabedZWithin_m(double x, double y, double radius_m) const;
+
     // The plane beach alone: seabed elevation of the littoral slopes at cross-shore distance s
     // (no sandbars, no grid), floored at −oceanDepth_m.
     double ProfileZ_m(double s_m) const;

@@ -5,11 +5,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <complex>
 #include <limits>
 #include <numbers>
 
 #include "scene/core/check.h"
+#include "scene/core/sincos.h"
 #include "scene/ocean/gerstner.h"
 #include "scene/ocean/spectrum.h"
 
@@ -28,7 +28,9 @@ double Fade(double h, double deep) {
     const double shallow = 0.5 * deep;
     if (h >= deep) return 1.0;
     if (h <= shallow) return 0.0;
-    return std::cos(0.5 * std::numbers::pi * (deep - h) / (deep - shallow));
+    double sinA, cosA;
+    SinCos(0.5 * std::numbers::pi * (deep - h) / (deep - shallow), sinA, cosA);
+    return cosA;
 }
 
 double Interp(const std::vector<double>& t, double x) {
@@ -112,6 +114,27 @@ SurfWaves::SurfWaves(const Bathymetry& bathymetry, std::vector<SurfComponent> co
         }
     }
 
+    // The incoming components' derived depth samples and phases, interleaved for Terms.
+    for (size_t j = 0; j < components_.size(); ++j)
+        if (tracks_[j].incoming) incoming_.push_back(j);
+    const size_t n = incoming_.size();
+    depth_.resize(size_t(depthSamples_) * n);
+    phase_.resize(size_t(samples) * n);
+    for (size_t m = 0; m < n; ++m) {
+        const Track& tr = tracks_[incoming_[m]];
+        for (int i = 0; i < depthSamples_; ++i) {
+            const double h = std::max(i * dh_m_, kMinDepth_m);
+            const double k = tr.k[size_t(i)], cg = tr.cg[size_t(i)];
+            const double kx = -std::sqrt(std::max(k * k - tr.ku * tr.ku, 0.0));
+            const double cosT = std::max(-kx / k, 1e-3);
+            depth_[size_t(i) * n + m] = {k, kx,
+                                         components_[incoming_[m]].amplitude_m *
+                                             std::sqrt(tr.cg0 / cg) * std::sqrt(tr.cos0 / cosT),
+                                         1.0 / std::tanh(k * h), cg};
+        }
+        for (int i = 0; i < samples; ++i) phase_[size_t(i) * n + m] = tr.phase[size_t(i)];
+    }
+
     // Mean breaker line: where H_rms of the unbroken shoaled waves reaches γ h on the plane
     // beach, walking landward; group travel time from it with the dominant component.
     sBreak_m_ = -std::numeric_limits<double>::infinity();
@@ -179,6 +202,54 @@ SurfWeights SurfWaves::Weights(double depth_m) const {
     return w;
 }
 
+SurfWaves::Bound SurfWaves::BoundAtDepths(double minDepth_m, const std::vector<Bound>& cascades,
+                                          const Bound& gerstner) const {
+    CHECK(cascades.size() <= kMaxSurfCascades);
+    CHECK(cascades_.empty() || cascades.size() == cascades_.size());
+    // At or below the deepest fade the sea is the deep sea alone, every weight 1.
+    Bound deep = gerstner;
+    for (const Bound& c : cascades) {
+        deep.height_m += c.height_m;
+        deep.horizontal_m += c.horizontal_m;
+    }
+    Bound out = deep;
+    const size_t n = incoming_.size();
+    for (int i = 0; i + 1 < depthSamples_; ++i) {
+        const double h0 = i * dh_m_, h1 = (i + 1) * dh_m_;
+        if (h1 < minDepth_m) continue;
+        if (h0 >= fadeDeep_m_) break;
+        // The deep weights grow with depth, the surf weights fall.
+        const SurfWeights wDeep = Weights(h1), wSurf = Weights(std::max(h0, minDepth_m));
+        Bound b;
+        b.height_m = wDeep.gerstner * gerstner.height_m;
+        b.horizontal_m = wDeep.gerstner * gerstner.horizontal_m;
+        for (size_t c = 0; c < cascades.size(); ++c) {
+            const double w = cascades_.empty() ? 1.0 : wDeep.cascade[c];
+            b.height_m += w * cascades[c].height_m;
+            b.horizontal_m += w * cascades[c].horizontal_m;
+        }
+        double amplitude = 0.0, orbit = 0.0, longest = 0.0;
+        for (size_t m = 0; m < n; ++m) {
+            const DepthSample& s0 = depth_[size_t(i) * n + m];
+            const DepthSample& s1 = depth_[size_t(i + 1) * n + m];
+            const double w =
+                components_[incoming_[m]].spectral ? wSurf.spectralSurf : wSurf.gerstnerSurf;
+            const double a = std::max(s0.amplitude, s1.amplitude) * w;
+            const double invTanh = std::max(s0.invTanh, s1.invTanh);
+            amplitude += a;
+            orbit += a * invTanh;
+            longest = std::max(longest, invTanh);
+        }
+        // Height: cap · Re(Σ a e^{iψ}) ≤ min(|Σ a e^{iψ}|, γh/2) ≤ min(Σ a, γh/2) (see Terms).
+        const double halfGammaH = 0.5 * settings_.breakerIndex * h1;
+        b.height_m += std::min(amplitude, halfGammaH);
+        b.horizontal_m += std::min(orbit, halfGammaH * longest);
+        out.height_m = std::max(out.height_m, b.height_m);
+        out.horizontal_m = std::max(out.horizontal_m, b.horizontal_m);
+    }
+    return out;
+}
+
 SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* info) const {
     SurfaceTerms out;
     const ShorePoint p = bathy_.Frame().ShoreFromWorld(x0, y0);
@@ -203,68 +274,120 @@ SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* inf
         local.breaking.broken = p.s_m <= sBreak_m_;
         local.breaking.timeSinceBreaking_s = Interp(breakTime_s_, tableIndex);
     }
-    if (weights.AllDeep() || h <= 0.0 || components_.empty()) {
+    if (weights.AllDeep() || h <= 0.0 || incoming_.empty()) {
         if (info) *info = local;
         return out;
     }
 
+    // One interpolation position for every component: the depth samples and the cross-shore
+    // phases are interleaved by sample (see the constructor).
+    const size_t n = incoming_.size();
     const double hh = std::max(h, kMinDepth_m);
+    const double dx = std::min(hh / dh_m_, double(depthSamples_ - 1));
+    const size_t di = std::min(size_t(dx), size_t(depthSamples_ - 2));
+    const double df = dx - double(di);
+    const DepthSample* d0 = depth_.data() + di * n;
+    const DepthSample* d1 = d0 + n;
+    const size_t phaseSamples = phase_.size() / std::max<size_t>(n, 1);
+    const double px = std::clamp(tableIndex, 0.0, double(phaseSamples - 1));
+    const size_t pi = std::min(size_t(px), phaseSamples - 2);
+    const double pf = px - double(pi);
+    const double* p0 = phase_.data() + pi * n;
+    const double* p1 = p0 + n;
     struct Local {
-        double a, psi, k, kx, ku, tanhKh, omega, cg;
+        double a, k, kx, ku, invTanh, omega, cg, cs, sn, psi;
     };
     std::array<Local, kMaxSurfComponents> waves;
-    size_t count = 0;
-    std::complex<double> envelope(0.0, 0.0);
-    for (size_t j = 0; j < components_.size(); ++j) {
-        const Track& tr = tracks_[j];
-        if (!tr.incoming) continue;  // waves going out to sea are left to the deep sea (faded)
-        const SurfComponent& c = components_[j];
-        const double k = DepthTable(tr.k, hh), cg = DepthTable(tr.cg, hh);
-        const double kx = -std::sqrt(std::max(k * k - tr.ku * tr.ku, 0.0));
-        const double cosT = std::max(-kx / k, 1e-3);
-        // Shoaled and refracted, times the weight of the component's part in the fade.
-        const double a = c.amplitude_m * std::sqrt(tr.cg0 / cg) * std::sqrt(tr.cos0 / cosT) *
-                         (c.spectral ? weights.spectralSurf : weights.gerstnerSurf);
+    std::array<double, kMaxSurfComponents> psis, sines, cosines;
+    for (size_t m = 0; m < n; ++m) {
+        const Track& tr = tracks_[incoming_[m]];
         const double crossPhase =
-            p.s_m >= sRef_m_ ? tr.ks0 * p.s_m : tr.ks0 * sRef_m_ + Interp(tr.phase, tableIndex);
-        const double psi = tr.phaseOrigin + tr.ku * p.u_m + crossPhase - c.omega_radps * t;
-        waves[count++] = {a, psi, k, kx, tr.ku, std::tanh(k * hh), c.omega_radps, cg};
-        envelope += a * std::complex<double>(std::cos(psi), std::sin(psi));
+            p.s_m >= sRef_m_ ? tr.ks0 * p.s_m : tr.ks0 * sRef_m_ + p0[m] + pf * (p1[m] - p0[m]);
+        psis[m] =
+            tr.phaseOrigin + tr.ku * p.u_m + crossPhase - components_[incoming_[m]].omega_radps * t;
     }
-    const double A = std::abs(envelope);
+    for (size_t m = 0; m < n; ++m) SinCos(psis[m], sines[m], cosines[m]);
+    double envelopeRe = 0.0, envelopeIm = 0.0;
+    for (size_t m = 0; m < n; ++m) {
+        const size_t j = incoming_[m];
+        const Track& tr = tracks_[j];
+        const SurfComponent& c = components_[j];
+        const DepthSample& s0 = d0[m];
+        const DepthSample& s1 = d1[m];
+        // Shoaled and refracted, times the weight of the component's part in the fade.
+        const double a = (s0.amplitude + df * (s1.amplitude - s0.amplitude)) *
+                         (c.spectral ? weights.spectralSurf : weights.gerstnerSurf);
+        const double cs = cosines[m], sn = sines[m];
+        waves[m] = {a,
+                    s0.k + df * (s1.k - s0.k),
+                    s0.kx + df * (s1.kx - s0.kx),
+                    tr.ku,
+                    s0.invTanh + df * (s1.invTanh - s0.invTanh),
+                    c.omega_radps,
+                    s0.cg + df * (s1.cg - s0.cg),
+                    cs,
+                    sn,
+                    psis[m]};
+        envelopeRe += a * cs;
+        envelopeIm += a * sn;
+    }
+    const double A = std::sqrt(envelopeRe * envelopeRe + envelopeIm * envelopeIm);
     const double gammaH = settings_.breakerIndex * h;
     const double cap = 2.0 * A > gammaH ? gammaH / (2.0 * A) : 1.0;
     // Steepening: Q rises from its deep value to 1 (the trochoid's cusp) as the group height
     // approaches the breaker height.
     const double q = settings_.deepSteepness + (1.0 - settings_.deepSteepness) *
                                                    std::min(1.0, 2.0 * A / std::max(gammaH, 1e-9));
-    const double w = cap;
-    double best = -1.0;
-    for (size_t i = 0; i < count; ++i) {
+    size_t best = 0;
+    double horizontalSum = 0.0, longest = 0.0;
+    glm::dvec3 horizontal{0.0};  // displacement x, y and the velocity's horizontal part below
+    glm::dvec2 horizontalVelocity{0.0};
+    double dxx = 0.0, dyy = 0.0, dxy = 0.0;
+    for (size_t i = 0; i < n; ++i) {
         const Local& v = waves[i];
-        const double a = v.a * w;
+        const double a = v.a * cap;
         // World unit direction of travel from the local shore wavevector.
         const glm::dvec2 kw = bathy_.Frame().WorldFromShoreDirection({v.kx, v.ku});
         const glm::dvec2 d = kw / v.k;
-        const double cs = std::cos(v.psi), sn = std::sin(v.psi);
-        const double hor = q * a / v.tanhKh;
-        out.displacement += glm::dvec3(-d.x * hor * sn, -d.y * hor * sn, a * cs);
-        out.sx += -a * sn * kw.x;
-        out.sy += -a * sn * kw.y;
-        out.dxx += -d.x * hor * cs * kw.x;
-        out.dyy += -d.y * hor * cs * kw.y;
-        out.dxy += -d.x * hor * cs * kw.y;
-        out.velocity_mps +=
-            glm::dvec3(d.x * hor * v.omega * cs, d.y * hor * v.omega * cs, a * v.omega * sn);
-        if (v.a > best) {
-            best = v.a;
-            local.direction_rad = std::atan2(d.x, d.y);
-            if (local.direction_rad < 0.0) local.direction_rad += kTwoPi;
-            local.phaseSpeed_mps = v.omega / v.k;
-            local.groupSpeed_mps = v.cg;
-            local.phase_rad = std::fmod(v.psi, kTwoPi);
-            if (local.phase_rad < 0.0) local.phase_rad += kTwoPi;
-        }
+        const double hor = q * a * v.invTanh;
+        horizontalSum += a * v.invTanh;
+        longest = std::max(longest, v.invTanh);
+        horizontal += glm::dvec3(-d.x * hor * v.sn, -d.y * hor * v.sn, 0.0);
+        out.displacement.z += a * v.cs;
+        out.sx += -a * v.sn * kw.x;
+        out.sy += -a * v.sn * kw.y;
+        dxx += -d.x * hor * v.cs * kw.x;
+        dyy += -d.y * hor * v.cs * kw.y;
+        dxy += -d.x * hor * v.cs * kw.y;
+        horizontalVelocity += glm::dvec2(d.x, d.y) * (hor * v.omega * v.cs);
+        out.velocity_mps.z += a * v.omega * v.sn;
+        if (v.a > waves[best].a) best = i;
+    }
+    // The horizontal excursion is held to that of one breaker-height wave (γh/2) of the longest
+    // component at this depth, (γh/2)/tanh(kh) — linear theory's orbit ξ = H / (2 tanh kh) at the
+    // breaking limit. Without it, components that cancel in height (small envelope, no cap) add
+    // their orbits, each ∝ a/(kh), which grow without bound as h → 0. Scaling the horizontal
+    // field by one factor keeps its direction; the factor's own gradient is left out of the
+    // Jacobian terms.
+    const double limit = std::min(horizontalSum, 0.5 * gammaH * longest);
+    const double len = std::sqrt(horizontal.x * horizontal.x + horizontal.y * horizontal.y);
+    const double f = len > limit && len > 0.0 ? limit / len : 1.0;
+    out.displacement.x = f * horizontal.x;
+    out.displacement.y = f * horizontal.y;
+    out.dxx = f * dxx;
+    out.dyy = f * dyy;
+    out.dxy = f * dxy;
+    out.velocity_mps.x = f * horizontalVelocity.x;
+    out.velocity_mps.y = f * horizontalVelocity.y;
+    if (n > 0) {
+        const Local& v = waves[best];
+        const glm::dvec2 kw = bathy_.Frame().WorldFromShoreDirection({v.kx, v.ku});
+        local.direction_rad = std::atan2(kw.x, kw.y);
+        if (local.direction_rad < 0.0) local.direction_rad += kTwoPi;
+        local.phaseSpeed_mps = v.omega / v.k;
+        local.groupSpeed_mps = v.cg;
+        local.phase_rad = std::fmod(v.psi, kTwoPi);
+        if (local.phase_rad < 0.0) local.phase_rad += kTwoPi;
     }
     local.envelope_m = A * cap;
     local.unbrokenHeight_m = 2.0 * A;

@@ -134,6 +134,19 @@ class SurfWaves {
     // weight), and the point's information. Velocity is included.
     SurfaceTerms Terms(double x0, double y0, double t_s, SurfPointInfo* info = nullptr) const;
 
+    // Upper bounds of the sea at still-water depths ≥ minDepth_m: its height above the tide and
+    // its horizontal displacement (m). The deep parts enter with their own bounds (each FFT
+    // cascade's, in the order of the cascades given at construction, and the Gerstner waves')
+    // times their fade weights; the surf components with their shoaled sum capped at γh/2 and
+    // their horizontal excursion as Terms limits it. Between depth samples each factor is taken
+    // at its larger end, so the bound holds at every depth, not only at the samples.
+    struct Bound {
+        double height_m = 0.0;
+        double horizontal_m = 0.0;
+    };
+    Bound BoundAtDepths(double minDepth_m, const std::vector<Bound>& cascades,
+                        const Bound& gerstner) const;
+
     // Mean breaker line (cross-shore s, m) of the plane beach: +∞ if no component, −∞ if the waves
     // never break before the shore.
     double BreakerLine_m() const { return sBreak_m_; }
@@ -148,6 +161,13 @@ class SurfWaves {
         std::vector<double> k;      // k at depth index (h = i dh)
         std::vector<double> cg;     // group speed at depth index
     };
+    // What Terms needs of an incoming component at one depth sample, derived once from k and cg
+    // so that a vertex costs one interpolation per quantity and no sqrt or tanh: the wavenumber,
+    // its cross-shore part k_s, the shoaled and refracted amplitude A0 √(cg0/cg) √(cos θ0/cos θ)
+    // (before the fade weight), 1/tanh(kh) and the group speed.
+    struct DepthSample {
+        double k, kx, amplitude, invTanh, cg;
+    };
     double DepthTable(const std::vector<double>& t, double h) const;
 
     Bathymetry bathy_;
@@ -161,6 +181,11 @@ class SurfWaves {
     double dh_m_ = 0.02;
     int depthSamples_ = 0;
     std::vector<Track> tracks_;
+    // Incoming components (indices into components_), and their depth samples and cross-shore
+    // phases interleaved by sample: depth_[i · n + j], phase_[i · n + j] for n incoming.
+    std::vector<size_t> incoming_;
+    std::vector<DepthSample> depth_;
+    std::vector<double> phase_;
     double sBreak_m_ = 0.0;
     std::vector<double> breakTime_s_;  // group travel time from the breaker line, per s sample
 };

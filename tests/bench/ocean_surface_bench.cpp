@@ -58,7 +58,7 @@ void BM_OceanLodMesh(benchmark::State& state) {
     req.eye_m = cam.worldFromCamera.position_m;
     req.angularStep_rad = 6.0 * cam.hfov_rad / double(cam.width);
     FrustumAzimuthSector(cam, 20.0 * M_PI / 180.0, req.azimuthMin_rad, req.azimuthMax_rad);
-    req.minRange_m = NearestVisibleSeaRange_m(cam, frame->MaxHeight_m(), frame->MaxHorizontal_m());
+    req.minRange_m = NearestVisibleSeaRange_m(cam, *frame, req.eye_m);
     scene::OceanMesh mesh;
     for (auto _ : state) arena.execute([&] { scene::BuildOceanMesh(*frame, req, mesh); });
     state.counters["vertices"] = double(mesh.positions.size());

@@ -141,7 +141,7 @@ void BM_OceanMesh(benchmark::State& state) {
     FrustumAzimuthSector(cam, 20.0 * M_PI / 180.0, req.azimuthMin_rad, req.azimuthMax_rad);
     double t = 0.0;
     const auto sea0 = world.Ocean().At(t);
-    req.minRange_m = NearestVisibleSeaRange_m(cam, sea0->MaxHeight_m(), sea0->MaxHorizontal_m());
+    req.minRange_m = NearestVisibleSeaRange_m(cam, *sea0, req.eye_m);
     scene::OceanMesh mesh;
     for (auto _ : state) {
         const auto sea = world.Ocean().At(t);

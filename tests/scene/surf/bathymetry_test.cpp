@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -144,6 +145,32 @@ TEST(Bathymetry, SandbarCrestLiesAtItsDepthBelowTheTideAndBlendsOverItsFlanks) {
     deep.regions[0].sandbar->crestDepth_m = 3.0;
     const Bathymetry d(deep, 20.0);
     EXPECT_NEAR(d.SeabedZ_m(10.0, 200.0), -0.5, 1e-12);
+}
+
+// The seabed bound over a disc (view culling) holds at every point of the disc, and off the bar
+// it is the plane beach at the disc's landward edge, where the monotone profile is highest.
+TEST(Bathymetry, SeabedBoundOverADiscHoldsEverywhereInIt) {
+    const Bathymetry b(BarredBeach(), 20.0);
+    for (const double cx : {-30.0, 10.0, 60.0, 100.0, 180.0, 400.0})
+        for (const double cy : {0.0, 200.0, 550.0})
+            for (const double r : {0.0, 5.0, 40.0, 150.0}) {
+                const double bound = b.MaxSeabedZWithin_m(cx, cy, r);
+                for (int i = 0; i <= 24; ++i)
+                    for (int j = 0; j < 48; ++j) {
+                        const double rho = r * i / 24.0, a = 2.0 * M_PI * j / 48.0;
+                        EXPECT_LE(b.SeabedZ_m(cx + rho * std::cos(a), cy + rho * std::sin(a)),
+                                  bound + 1e-12)
+                            << cx << " " << cy << " " << r;
+                    }
+            }
+    // Far from the bar (it spans s ∈ [65, 135] with its flanks): the profile at s − r.
+    EXPECT_NEAR(b.MaxSeabedZWithin_m(300.0, 0.0, 50.0), b.ProfileZ_m(250.0), 1e-12);
+    EXPECT_NEAR(b.MaxSeabedZWithin_m(30.0, 0.0, 10.0), b.ProfileZ_m(20.0), 1e-12);
+    // Reaching the bar: its crest level, 1 m below the tide.
+    EXPECT_NEAR(b.MaxSeabedZWithin_m(200.0, 0.0, 70.0), b.Tide_m() - 1.0, 1e-12);
+    // The whole bed: the level ground behind the beach.
+    EXPECT_NEAR(b.MaxSeabedZWithin_m(0.0, 0.0, std::numeric_limits<double>::infinity()),
+                b.ProfileZ_m(b.LandwardEdge_m() - 1.0), 1e-12);
 }
 
 TEST(Bathymetry, RegionsRepeatAlongTheShore) {

@@ -181,6 +181,40 @@ TEST(SurfWaves, SurfaceNeverBelowTheSeabedAndTapersToZeroDepth) {
     EXPECT_GE(worst, -1e-9);
 }
 
+// The height and reach bounds used to cull the sea near the eye hold at every point of the disc
+// they are taken over (deep water, over the bar, in the surf, on the beach), over many frames;
+// and near an eye in deep water they are far below the whole surface's bound (beach included).
+TEST(SurfWaves, BoundsNearAPointHoldOverTheWholeDisc) {
+    const OceanSurface sea(SpectralBeach(true));
+    ASSERT_NE(sea.Surf(), nullptr);
+    for (int f = 0; f < 60; ++f) {
+        const auto frame = sea.At(0.77 * f);
+        for (const double cx : {-10.0, 40.0, 100.0, 160.0, 300.0, 900.0})
+            for (const double r : {0.0, 10.0, 60.0}) {
+                const SurfaceBounds b = frame->BoundsNear(cx, 150.0, r);
+                EXPECT_LE(b.height_m, frame->MaxHeight_m() + 1e-12);
+                EXPECT_LE(b.horizontal_m, frame->MaxHorizontal_m() + 1e-12);
+                for (int i = 0; i <= 12; ++i)
+                    for (int j = 0; j < (i == 0 ? 1 : 36); ++j) {
+                        const double rho = r * i / 12.0, a = 2.0 * kPi * j / 36.0;
+                        const double x = cx + rho * std::cos(a), y = 150.0 + rho * std::sin(a);
+                        const SurfaceTerms t = frame->Terms(x, y);
+                        EXPECT_LE(t.displacement.z, b.height_m + 1e-9) << cx << " " << r;
+                        EXPECT_LE(std::hypot(t.displacement.x, t.displacement.y),
+                                  b.horizontal_m + 1e-9)
+                            << cx << " " << r;
+                    }
+            }
+    }
+    // 3 km out the seabed has reached the ocean floor, 80 m down, deeper than any fade: the bound
+    // there is exactly the bound of the same sea without a surf zone.
+    const OceanSurface open(SpectralBeach(false));
+    ASSERT_LT(sea.Surf()->FadeDeep_m(), sea.Surf()->Bathy().Depth_m(2000.0, 150.0));
+    const SurfaceBounds deep = sea.At(0.0)->BoundsNear(3000.0, 150.0, 10.0);
+    EXPECT_EQ(deep.height_m, open.At(0.0)->MaxHeight_m());
+    EXPECT_EQ(deep.horizontal_m, open.At(0.0)->MaxHorizontal_m());
+}
+
 TEST(SurfWaves, ChopKeepsItsWeightWhereItIsDeepWaterForItsWavelength) {
     const OceanSurface sea(SpectralBeach(true));
     const SurfWaves& w = *sea.Surf();
