@@ -113,23 +113,50 @@ void Intensifier::Process(const Image& samples, double time_s, int64_t frame) {
             *radiance_.At(x, y) = float(sum / (n * n));
         }
     });
-    // Mean photoelectrons over the field (fixed-order sum: deterministic).
+    // Mean photoelectrons over the field (fixed-order sums: deterministic) as the photocathode
+    // delivers them; BSP limits their mean.
     double total = 0.0;
     size_t count = 0;
     for (size_t i = 0; i < mask_.size(); ++i)
         if (mask_[i]) {
-            total += radiance_.pixels[i];
+            total += radiance_.pixels[i] * pePerRadiance_;
             ++count;
         }
-    meanPe_ = count ? total / double(count) * pePerRadiance_ : 0.0;
-    duty_ = meanPe_ > s_.bspThresholdPe ? s_.bspThresholdPe / meanPe_ : 1.0;
-    // ABC: the gain that puts the field's mean at abcLevel, capped at its value at the threshold.
-    const double target = s_.abcLevel / std::max(meanPe_ * duty_, s_.abcThresholdPe);
+    meanPe_ = count ? total / double(count) : 0.0;
+    const double bsp = s_.PixelFramePe(s_.bspThreshold_pe_s_mm2);
+    duty_ = meanPe_ > bsp ? bsp / meanPe_ : 1.0;
+    // The mean as the ABC senses it through the screen current at gain g: each pixel counts at
+    // most the photoelectrons that saturate it (1/g).
+    const auto sensed = [&](double g) {
+        const double cap = 1.0 / g;
+        double sum = 0.0;
+        for (size_t i = 0; i < mask_.size(); ++i)
+            if (mask_[i]) sum += std::min(radiance_.pixels[i] * pePerRadiance_ * duty_, cap);
+        return count ? sum / double(count) : 0.0;
+    };
+    // ABC: the gain that puts the sensed mean at abcLevel (capped at its value at the
+    // threshold), sensed at the previous frame's gain; the first frame starts settled, at the
+    // fixed point g = level / sensed(g) (sensed(g)·g rises with g: bisection on log g).
+    const double maxGain = s_.abcLevel / s_.PixelFramePe(s_.abcThreshold_pe_s_mm2);
+    const auto targetAt = [&](double g) {
+        return std::min(maxGain, s_.abcLevel / std::max(sensed(g), 1e-300));
+    };
     const double dt = time_s - lastTime_s_;
-    if (!started_ || !(dt > 0.0) || s_.abcTimeConstant_s <= 0.0)
-        gain_ = target;
-    else
+    if (!started_ || !(dt > 0.0) || s_.abcTimeConstant_s <= 0.0) {
+        double lo = maxGain * 1e-12, hi = maxGain;
+        if (targetAt(hi) >= hi) {
+            gain_ = hi;
+        } else {
+            for (int i = 0; i < 60; ++i) {
+                const double mid = std::sqrt(lo * hi);
+                (targetAt(mid) > mid ? lo : hi) = mid;
+            }
+            gain_ = std::sqrt(lo * hi);
+        }
+    } else {
+        const double target = targetAt(gain_);
         gain_ = target + (gain_ - target) * std::exp(-dt / s_.abcTimeConstant_s);
+    }
     started_ = true;
     lastTime_s_ = time_s;
 

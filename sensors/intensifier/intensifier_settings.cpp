@@ -26,6 +26,11 @@ double IntensifierSettings::PixelPitch_m() const {
     return FocalLength_m() * 2.0 * std::tan(0.5 * hfov_rad) / width_px;
 }
 
+double IntensifierSettings::PixelFramePe(double rate_pe_s_mm2) const {
+    const double pitch_mm = PixelPitch_m() * 1e3;
+    return rate_pe_s_mm2 * pitch_mm * pitch_mm * frameTime_s;
+}
+
 IntensifierSettings ReadIntensifierSettings(const scene::ConfigValue& value,
                                             const IntensifierSettings& defaults) {
     return scene::ReadMap(value, [&](ConfigMap& root) {
@@ -65,15 +70,15 @@ IntensifierSettings ReadIntensifierSettings(const scene::ConfigValue& value,
         }
         if (std::optional<ConfigMap> m = root.FindMap("abc")) {
             s.abcLevel = m->GetDouble("level", NumberRange::OpenClosed(0.0, 1.0), s.abcLevel);
-            s.abcThresholdPe =
-                m->GetDouble("threshold_pe", NumberRange::Positive("pe"), s.abcThresholdPe);
+            s.abcThreshold_pe_s_mm2 = m->GetDouble(
+                "threshold_pe_s_mm2", NumberRange::Positive("pe/(s mm2)"), s.abcThreshold_pe_s_mm2);
             s.abcTimeConstant_s = m->GetDouble(
                 "time_constant_s", NumberRange::Closed(0.0, 60.0, "s"), s.abcTimeConstant_s);
             m->Finish();
         }
         if (std::optional<ConfigMap> m = root.FindMap("bsp")) {
-            s.bspThresholdPe =
-                m->GetDouble("threshold_pe", NumberRange::Positive("pe"), s.bspThresholdPe);
+            s.bspThreshold_pe_s_mm2 = m->GetDouble(
+                "threshold_pe_s_mm2", NumberRange::Positive("pe/(s mm2)"), s.bspThreshold_pe_s_mm2);
             m->Finish();
         }
         return s;

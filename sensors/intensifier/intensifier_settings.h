@@ -41,28 +41,34 @@ struct IntensifierSettings {
     double halo_rad = 0.031415926535897934;  // 1.8°: halo diameter (constant angle)
     double haloFraction = 0.03;              // share of each pixel's signal spread into its halo
 
-    // Automatic brightness control: below thresholdPe photoelectrons per pixel per frame (mean
-    // over the field) the gain is at its maximum; above, it holds the mean screen brightness at
-    // `level` (fraction of the screen's saturation), following changes with a first-order lag.
+    // Automatic brightness control: while the field's mean photocathode current density is
+    // below abcThreshold (photoelectrons s⁻¹ mm⁻²; 1e6 ≈ 1.6e-7 A/m², a starlit scene) the gain
+    // is at its maximum; above, it holds the mean screen brightness at `level` (fraction of the
+    // screen's saturation), following changes with a first-order lag. The ABC senses the screen
+    // current, which a saturated MCP channel cannot raise: each pixel counts at most the
+    // photoelectrons that saturated it at the previous frame's gain.
     double abcLevel = 0.35;
-    double abcThresholdPe = 50.0;
+    double abcThreshold_pe_s_mm2 = 1.0e6;
     double abcTimeConstant_s = 0.25;
-    // Bright-source protection: above this mean photoelectron count per pixel per frame the
-    // photocathode's duty cycle falls as threshold / mean (the cathode current is held).
-    double bspThresholdPe = 2.0e4;
+    // Bright-source protection: above this mean photocathode current density (photoelectrons
+    // s⁻¹ mm⁻²; 4e8 ≈ 6.4e-5 A/m², about ten times a full-moon scene) the photocathode's duty
+    // cycle falls as threshold / mean, holding the cathode current.
+    double bspThreshold_pe_s_mm2 = 4.0e8;
 
     // Focal length (m) from the field stop and the photocathode diameter.
     double FocalLength_m() const;
     // Pixel pitch on the photocathode (m): the channel's hfov over width_px.
     double PixelPitch_m() const;
+    // Photoelectrons per pixel per frame of a photocathode current density (pe s⁻¹ mm⁻²).
+    double PixelFramePe(double rate_pe_s_mm2) const;
 };
 
 // Reads the `intensifier:` mapping (all keys optional; units in the key names):
 //   optics:       f_number, transmission, field_stop_deg, photocathode_diameter_mm
 //   photocathode: generation (gen2 | gen3), minus_blue (none | a | b), qe_peak
 //   tube:         resolution_lp_mm, noise_factor, halo_deg, halo_fraction
-//   abc:          level, threshold_pe, time_constant_s
-//   bsp:          threshold_pe
+//   abc:          level, threshold_pe_s_mm2, time_constant_s
+//   bsp:          threshold_pe_s_mm2
 // Starts from `defaults` (format, field of view, frame time and seed come from there). Unknown
 // keys and values out of range throw scene::ConfigError naming the key path (file:line:column).
 IntensifierSettings ReadIntensifierSettings(const scene::ConfigValue& value,

@@ -106,39 +106,58 @@ TEST(Intensifier, AbcHoldsOutputOverADecadeAboveThreshold) {
     s.haloFraction = 0.0;
     for (double k : {2.0, 5.0, 20.0}) {
         Intensifier t(s, 1);
-        const double pe = k * s.abcThresholdPe;
+        const double pe = k * s.PixelFramePe(s.abcThreshold_pe_s_mm2);
         t.Process(Uniform(s, 1, pe / t.PhotoelectronsPerRadiance()), 0.0, 0);
         EXPECT_NEAR(FieldMean(t, t.Brightness()) / s.abcLevel, 1.0, 0.02) << k;
     }
     // Below the threshold the gain is at its maximum: output proportional to the input.
     Intensifier t(s, 1);
-    const double pe = 0.2 * s.abcThresholdPe;
+    const double pe = 0.2 * s.PixelFramePe(s.abcThreshold_pe_s_mm2);
     t.Process(Uniform(s, 1, pe / t.PhotoelectronsPerRadiance()), 0.0, 0);
     EXPECT_NEAR(FieldMean(t, t.Brightness()) / (0.2 * s.abcLevel), 1.0, 0.05);
 }
 
-TEST(Intensifier, AbcStepResponseHasTheConfiguredTimeConstantAndWashesOut) {
+// A step of 25 % (the screen stays below saturation): the gain follows the first-order lag.
+TEST(Intensifier, AbcStepResponseHasTheConfiguredTimeConstant) {
     IntensifierSettings s = Small();
     s.abcTimeConstant_s = 0.2;
     s.haloFraction = 0.0;
     Intensifier t(s, 1);
     const double perPe = 1.0 / t.PhotoelectronsPerRadiance();
+    const double pe0 = 4.0 * s.PixelFramePe(s.abcThreshold_pe_s_mm2);
     const double dt = 1.0 / 30.0;
-    t.Process(Uniform(s, 1, 100.0 * perPe), 0.0, 0);
+    t.Process(Uniform(s, 1, pe0 * perPe), 0.0, 0);
     const double g0 = t.Gain();
-    // A flash: ten times the photoelectrons from frame 1 on.
-    const Image bright = Uniform(s, 1, 1000.0 * perPe);
-    const double gInf = s.abcLevel / 1000.0;
-    t.Process(bright, dt, 1);
-    // Washout: the gain of the dim scene on the bright one saturates the screen.
-    EXPECT_GT(FieldMean(t, t.Brightness()), 0.95);
-    for (int k = 2; k <= 60; ++k) {
-        t.Process(bright, k * dt, k);
-        // First-order lag: (g − g∞) = (g0 − g∞)·exp(−t/τ).
+    const Image brighter = Uniform(s, 1, 1.25 * pe0 * perPe);
+    const double gInf = s.abcLevel / (1.25 * pe0);
+    for (int k = 1; k <= 30; ++k) {
+        t.Process(brighter, k * dt, k);
+        // (g − g∞) = (g0 − g∞)·exp(−t/τ).
         const double expected = gInf + (g0 - gInf) * std::exp(-k * dt / s.abcTimeConstant_s);
         EXPECT_NEAR(t.Gain() / expected, 1.0, 1e-6) << k;
     }
-    // Recovered after 10 τ (the lag's excess is 9·e⁻¹⁰ ≈ 4e-4): output back at the level.
+}
+
+// A tenfold flash: the gain set for the dim scene saturates the screen (washout); the ABC,
+// sensing the saturated screen current, brings the image back to its level.
+TEST(Intensifier, AbcLagWashesOutAFlashThenRecovers) {
+    IntensifierSettings s = Small();
+    s.abcTimeConstant_s = 0.2;
+    s.haloFraction = 0.0;
+    Intensifier t(s, 1);
+    const double perPe = 1.0 / t.PhotoelectronsPerRadiance();
+    const double pe0 = 2.0 * s.PixelFramePe(s.abcThreshold_pe_s_mm2);
+    const double dt = 1.0 / 30.0;
+    t.Process(Uniform(s, 1, pe0 * perPe), 0.0, 0);
+    const Image bright = Uniform(s, 1, 10.0 * pe0 * perPe);
+    t.Process(bright, dt, 1);
+    EXPECT_GT(FieldMean(t, t.Brightness()), 0.95);
+    double previous = t.Gain();
+    for (int k = 2; k <= 120; ++k) {
+        t.Process(bright, k * dt, k);
+        EXPECT_LE(t.Gain(), previous);  // monotonic recovery, no overshoot
+        previous = t.Gain();
+    }
     EXPECT_NEAR(FieldMean(t, t.Brightness()) / s.abcLevel, 1.0, 0.03);
 }
 
@@ -228,8 +247,8 @@ TEST(IntensifierSettings, ReadsEveryKeyInSiUnits) {
         " photocathode_diameter_mm: 16}\n"
         "  photocathode: {generation: gen2, minus_blue: b, qe_peak: 0.12}\n"
         "  tube: {resolution_lp_mm: 72, noise_factor: 1.5, halo_deg: 2, halo_fraction: 0.1}\n"
-        "  abc: {level: 0.5, threshold_pe: 80, time_constant_s: 0.5}\n"
-        "  bsp: {threshold_pe: 1000}\n");
+        "  abc: {level: 0.5, threshold_pe_s_mm2: 2e6, time_constant_s: 0.5}\n"
+        "  bsp: {threshold_pe_s_mm2: 1e9}\n");
     EXPECT_DOUBLE_EQ(s.fNumber, 1.4);
     EXPECT_DOUBLE_EQ(s.opticsTransmission, 0.7);
     EXPECT_NEAR(s.fieldStop_rad, 30 * kDegToRad, 1e-15);
@@ -242,9 +261,9 @@ TEST(IntensifierSettings, ReadsEveryKeyInSiUnits) {
     EXPECT_NEAR(s.halo_rad, 2 * kDegToRad, 1e-15);
     EXPECT_DOUBLE_EQ(s.haloFraction, 0.1);
     EXPECT_DOUBLE_EQ(s.abcLevel, 0.5);
-    EXPECT_DOUBLE_EQ(s.abcThresholdPe, 80.0);
+    EXPECT_DOUBLE_EQ(s.abcThreshold_pe_s_mm2, 2e6);
     EXPECT_DOUBLE_EQ(s.abcTimeConstant_s, 0.5);
-    EXPECT_DOUBLE_EQ(s.bspThresholdPe, 1000.0);
+    EXPECT_DOUBLE_EQ(s.bspThreshold_pe_s_mm2, 1e9);
 }
 
 std::string ErrorOf(const std::string& text) {
