@@ -1025,14 +1025,17 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     if (basis_) {
         // Band basis: the grey overlays drawn alone, then added in their lights' vectors.
         const auto addOverlay = [&](const auto& draw, const glm::dvec3& perCdm2) {
+            // overlay_ is all zeros between uses: each use clears the samples it drew on.
             if (overlay_.width != sw || overlay_.height != sh) overlay_ = Image(sw, sh, 3);
-            std::fill(overlay_.pixels.begin(), overlay_.pixels.end(), 0.0f);
             draw(overlay_);
             const glm::vec3 v(perCdm2);
             for (size_t i = 0; i < overlay_.pixels.size(); i += 3) {
                 const float y = overlay_.pixels[i + 1];
                 if (y == 0.0f) continue;
-                for (int c = 0; c < 3; ++c) radiance.pixels[i + size_t(c)] += y * v[c];
+                for (int c = 0; c < 3; ++c) {
+                    radiance.pixels[i + size_t(c)] += y * v[c];
+                    overlay_.pixels[i + size_t(c)] = 0.0f;
+                }
             }
         };
         addOverlay(

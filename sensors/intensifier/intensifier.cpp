@@ -176,11 +176,13 @@ void Intensifier::Process(const Image& samples, double time_s, int64_t frame) {
     const int R = int(std::floor(haloRadius_px_));
     const double f = s_.haloFraction;
     if (f > 0.0 && R >= 1) {
-        std::vector<double> prefix(size_t(h) * size_t(w + 1), 0.0);
-        for (int y = 0; y < h; ++y) {
+        std::vector<double>& prefix = prefix_;  // every entry is written below
+        prefix.resize(size_t(h) * size_t(w + 1));
+        tbb::parallel_for(0, h, [&](int y) {
             double* p = &prefix[size_t(y) * size_t(w + 1)];
+            p[0] = 0.0;
             for (int x = 0; x < w; ++x) p[x + 1] = p[x] + electrons_.pixels[size_t(y) * w + x];
-        }
+        });
         std::vector<int> halfWidth(size_t(2 * R + 1));
         double discCount = 0.0;
         for (int dy = -R; dy <= R; ++dy) {

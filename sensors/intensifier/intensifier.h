@@ -58,6 +58,7 @@ class Intensifier {
     std::vector<uint8_t> mask_;
     Image radiance_, electrons_, halo_, brightness_;
     std::vector<uint8_t> display_;
+    std::vector<double> prefix_;        // halo: row prefix sums, kept between frames
     std::vector<uint8_t> phosphorLut_;  // kLutSize × 3: brightness → sRGB P43 colour
     bool started_ = false;
     double lastTime_s_ = 0.0;
