@@ -66,7 +66,8 @@ int main(int argc, char** argv) {
     capture->add_option(
         "--format", formats,
         "Comma-separated output formats: exr (scene-linear float; flir: radiometric "
-        "L and T), png, tiff (display 8-bit), raw_png, raw_tiff (flir: 16-bit "
+        "L and T; nvg: photon radiance L_p and screen brightness B), png, tiff (display "
+        "8-bit; nvg: P43 phosphor), raw_png, raw_tiff (flir: 16-bit "
         "ADC counts); default: the channel's output.formats");
     capture->add_option("--threads", cap.threads, "Worker threads (0 = all cores)")
         ->capture_default_str();

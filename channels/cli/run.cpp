@@ -114,18 +114,6 @@ void SleepUntilNs(int64_t t) {
     }
 }
 
-const char* KindName(scene::ChannelKind k) {
-    switch (k) {
-        case scene::ChannelKind::Otw:
-            return "otw";
-        case scene::ChannelKind::Flir:
-            return "flir";
-        case scene::ChannelKind::Nvg:
-            return "nvg";
-    }
-    return "?";
-}
-
 }  // namespace
 
 #ifndef SEASENSE_SOURCE_DIR
@@ -144,10 +132,6 @@ int RunHost(const RunOptions& opt) {
     if (opt.threadsPerChannel < 0)
         throw InputError("--threads: expected an integer >= 0 (0 = all cores)");
     const scene::Scenario scenario = scene::LoadScenario(opt.config);
-    for (const scene::ChannelSettings& ch : scenario.channels)
-        if (ch.kind == scene::ChannelKind::Nvg)
-            throw InputError(scenario.file.string() + ": channel '" + ch.name + "' has kind '" +
-                             KindName(ch.kind) + "', which this build cannot render yet");
     for (const std::string& name : opt.external)
         if (!scenario.FindChannel(name))
             throw InputError("--external: the scenario has no channel named '" + name + "'");

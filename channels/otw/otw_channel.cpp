@@ -812,6 +812,15 @@ OtwChannel::OtwChannel(const scene::World& world, const scene::ChannelSettings& 
     stars_ = scene::LoadStarCatalog(scene::DefaultStarCatalogPath());
 }
 
+OtwChannel::OtwChannel(const scene::World& world, const scene::ChannelSettings& settings,
+                       const OtwBandBasis& basis)
+    : OtwChannel(world, settings) {
+    CHECK(basis.reflectance.size() == reflectance_.size());
+    basis_ = std::make_unique<OtwBandBasis>(basis);
+    reflectance_ = basis.reflectance;
+    for (int c = 0; c < 3; ++c) shore_[c] = basis.shore[c];
+}
+
 struct OtwChannel::ShadeScratch {
     tbb::enumerable_thread_specific<BlockScratch> perThread;
 };
@@ -860,14 +869,20 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
         c.moonDirection = skyMoon;
         c.moonPhaseAngle_rad = state.moon.phaseAngle_rad;
         c.moonDistance_m = state.moon.distance_m;
+        if (basis_) c.basis = basis_->sky;
         sky_ = std::make_unique<radiometry::AnalyticSky>(c);
         skySun_ = skySun;
         skyMoon_ = skyMoon;
     }
     const radiometry::AnalyticSky& sky = *sky_;
     const glm::vec3 sunDir(state.sun.direction);
-    const glm::dvec3 sunIlluminance =
+    // Band basis: a grey (equal-component) Rec.709 light of E lx is E × the light's vector.
+    const auto inBasis = [&](const glm::dvec3& greyRgb, const glm::dvec3& perLux) {
+        return basis_ ? greyRgb.g * perLux : greyRgb;
+    };
+    const glm::dvec3 sunLux =
         radiometry::SunIlluminanceRgb(state.sun.direction, state.sun.illuminance_lux);
+    const glm::dvec3 sunIlluminance = inBasis(sunLux, basis_ ? basis_->sun : glm::dvec3(1.0));
     // Clouds (world.Clouds()): the world divided the direct sun and moon by their sky-condition
     // divisors (USNO Circular 171); the sky dome's light is divided by the divisor of the sky
     // overhead, and the sun's disc keeps its light above the clouds (the cloud pass attenuates
@@ -888,10 +903,12 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     // against the sun's 0.65, Allen's Astrophysical Quantities), so moonlit blue is about 20 %
     // too strong against green here.
     const DirectionalLight sunLight{sunDir, glm::vec3(sunIlluminance)};
+    const glm::dvec3 moonLux =
+        radiometry::SunIlluminanceRgb(state.moon.direction, state.moon.illuminance_lux);
     const DirectionalLight moonLight{
         glm::vec3(state.moon.direction),
-        glm::vec3(radiometry::SunIlluminanceRgb(state.moon.direction, state.moon.illuminance_lux))};
-    const bool moonKey = moonLight.E.g > sunLight.E.g;
+        glm::vec3(inBasis(moonLux, basis_ ? basis_->moon : glm::dvec3(1.0)))};
+    const bool moonKey = moonLux.g > sunLux.g;
     const DirectionalLight& key = moonKey ? moonLight : sunLight;
     std::vector<DirectionalLight> fill;
     if (const DirectionalLight& dim = moonKey ? sunLight : moonLight; dim.E.g > 0.0f)
@@ -907,7 +924,9 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
         const FlashLight flash =
             FlashLightAt(*lightning, flashes, glm::dvec3(eye), beta, world_.Clouds());
         if (flash.illuminance_lux > 0.0)
-            fill.push_back({glm::vec3(flash.direction), glm::vec3(float(flash.illuminance_lux))});
+            fill.push_back({glm::vec3(flash.direction),
+                            basis_ ? glm::vec3(flash.illuminance_lux * basis_->lightning)
+                                   : glm::vec3(float(flash.illuminance_lux))});
     }
     const glm::vec3 skyE(sky.HorizontalSkyIlluminance() / domeDivisor);
     // Downwelling irradiance on the sea surface (lx): direct light on a level surface plus sky.
@@ -1003,6 +1022,38 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     scene::MoonState moonAboveClouds = state.moon;
     moonAboveClouds.illuminance_lux *=
         world_.SkyConditionDivisor(state.eyepoint.position_m, state.moon.direction, state.time_s);
+    if (basis_) {
+        // Band basis: the grey overlays drawn alone, then added in their lights' vectors.
+        const auto addOverlay = [&](const auto& draw, const glm::dvec3& perCdm2) {
+            // overlay_ is all zeros between uses: each use clears the samples it drew on.
+            if (overlay_.width != sw || overlay_.height != sh) overlay_ = Image(sw, sh, 3);
+            draw(overlay_);
+            const glm::vec3 v(perCdm2);
+            for (size_t i = 0; i < overlay_.pixels.size(); i += 3) {
+                const float y = overlay_.pixels[i + 1];
+                if (y == 0.0f) continue;
+                for (int c = 0; c < 3; ++c) {
+                    radiance.pixels[i + size_t(c)] += y * v[c];
+                    overlay_.pixels[i + size_t(c)] = 0.0f;
+                }
+            }
+        };
+        addOverlay(
+            [&](Image& img) {
+                AddMoonAndStars(cam, vis, MakeMoonDisc(moonAboveClouds, state.sun), {}, img);
+            },
+            basis_->moon);
+        addOverlay(
+            [&](Image& img) {
+                AddMoonAndStars(cam, vis, MoonDisc{},
+                                scene::VisibleStars(stars_, state.utc, observer), img);
+            },
+            basis_->stars);
+        if (lightning)
+            addOverlay([&](Image& img) { DrawLightning(cam, vis, *lightning, flashes, beta, img); },
+                       basis_->lightning);
+        return;
+    }
     AddMoonAndStars(cam, vis, MakeMoonDisc(moonAboveClouds, state.sun),
                     scene::VisibleStars(stars_, state.utc, observer), radiance);
     // --- Cloud layers (channels/otw/cloud_layer) over the sky, sun, moon and stars. ---

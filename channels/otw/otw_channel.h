@@ -17,6 +17,18 @@ namespace seasense::channels {
 class ChannelPlumes;
 class CloudSky;
 
+// --- Band basis (channels/nvg) ---
+// Shading in another band's three-component basis instead of Rec.709 (NVG: three photocathode
+// sub-bands, radiometry/nvg). Every light's photometric quantity (lx, cd/m²) is multiplied by
+// its spectrum's components per lx; surfaces take per-component reflectances.
+struct OtwBandBasis {
+    radiometry::SkyConditions::BandBasis sky;
+    glm::dvec3 sun{1.0}, moon{1.0}, stars{1.0}, lightning{1.0};  // components per lx
+    std::vector<glm::dvec3> reflectance;                         // per entity, per component
+    ShoreChannel shore[3];                                       // surf-zone optics per component
+};
+// --- end of band basis ---
+
 struct OtwFrameStats {
     uint64_t oceanTriangles = 0;
     uint64_t modelTriangles = 0;
@@ -33,6 +45,10 @@ class OtwChannel {
   public:
     // Builds the occlusion scene from the world's models (committed once; static).
     OtwChannel(const scene::World& world, const scene::ChannelSettings& settings);
+    // In a band basis (channels/nvg): the components of Render's image are the basis's, in its
+    // units; clouds and plumes are not drawn (they shade in Rec.709 only).
+    OtwChannel(const scene::World& world, const scene::ChannelSettings& settings,
+               const OtwBandBasis& basis);
     ~OtwChannel();
 
     // Renders the supersampled at-aperture radiance of frame `state` into radiance:
@@ -65,6 +81,8 @@ class OtwChannel {
     std::unique_ptr<ChannelPlumes> plumes_;  // scenario plumes (channels/plume)
     std::unique_ptr<CloudSky> clouds_;       // cloud pass scratch (environment.clouds)
     OtwFrameStats stats_;
+    std::unique_ptr<OtwBandBasis> basis_;  // null: Rec.709
+    Image overlay_;                        // band basis: grey overlays before conversion
 };
 
 }  // namespace seasense::channels

@@ -84,6 +84,10 @@ sensors::ImageMetadata FrameMetadata(const scene::World& world, const scene::Cha
         md.Set("seasense:ocio_view", ch.ocioView);
         md.Set("oiio:ColorSpace", std::string("Linear Rec.709 (sRGB)"));
     }
+    if (ch.kind == scene::ChannelKind::Nvg)
+        md.Set("seasense:units",
+               std::string("L_p: photocathode-weighted photon radiance (relative QE, peak 1), "
+                           "photons s^-1 m^-2 sr^-1; B: screen brightness (1 = saturation)"));
     // Row-major, column-vector convention: p_camera = M · (p_world, 1).
     glm::dmat4 worldFromCamera(cam.worldFromCamera.worldFromBody);
     worldFromCamera[3] = glm::dvec4(cam.worldFromCamera.position_m, 1.0);
@@ -114,6 +118,12 @@ ChannelPipeline::ChannelPipeline(const scene::World& world, const scene::Channel
         msg += thermal ? ", raw_png or raw_tiff" : " (raw_png and raw_tiff are for flir channels)";
         throw InputError(msg);
     }
+    if (channel_.kind == scene::ChannelKind::Nvg) {
+        nvg_ = std::make_unique<NvgChannel>(world_, channel_);
+        intensifier_ = std::make_unique<sensors::Intensifier>(nvg_->IntensifierSettings(),
+                                                              channel_.supersampling);
+        return;
+    }
     if (thermal) {
         flir_ = std::make_unique<FlirChannel>(world_, channel_);
         channel_ = flir_->Settings();  // the field of view resolved with the imager
@@ -121,9 +131,6 @@ ChannelPipeline::ChannelPipeline(const scene::World& world, const scene::Channel
             flir_->ImagerSettings(), flir_->GetBand(), channel_.supersampling);
         return;
     }
-    if (channel_.kind != scene::ChannelKind::Otw)
-        throw InputError("channel '" + channel_.name + "': kind '" + KindName(channel_.kind) +
-                         "' is not available yet; this build renders kinds 'otw' and 'flir'");
     otw_ = std::make_unique<OtwChannel>(world_, channel_);
     display_ = std::make_unique<sensors::OcioDisplay>(ocioConfig, "sRGB", channel_.ocioView);
 }
@@ -138,12 +145,23 @@ const FlirChannel& ChannelPipeline::Flir() const {
     return *flir_;
 }
 
+const NvgChannel& ChannelPipeline::Nvg() const {
+    CHECK(nvg_);
+    return *nvg_;
+}
+
+const sensors::Intensifier& ChannelPipeline::GetIntensifier() const {
+    CHECK(intensifier_);
+    return *intensifier_;
+}
+
 const sensors::ThermalImager& ChannelPipeline::Imager() const {
     CHECK(imager_);
     return *imager_;
 }
 
 const ChannelCamera& ChannelPipeline::Camera() const {
+    if (nvg_) return nvg_->Camera();
     return flir_ ? flir_->Camera() : otw_->Camera();
 }
 
@@ -166,6 +184,15 @@ FrameRecord ChannelPipeline::Render(const scene::FrameState& frame) {
         rec.renderMs = MsSince(t0);
         t0 = std::chrono::steady_clock::now();
         imager_->Process(samples_, state_.time_s, state_.frame);
+        displayValid_ = false;
+        rec.sensorMs = MsSince(t0);
+        return rec;
+    }
+    if (nvg_) {
+        nvg_->Render(state_, samples_);
+        rec.renderMs = MsSince(t0);
+        t0 = std::chrono::steady_clock::now();
+        intensifier_->Process(samples_, state_.time_s, state_.frame);
         displayValid_ = false;
         rec.sensorMs = MsSince(t0);
         return rec;
@@ -194,7 +221,10 @@ FrameRecord ChannelPipeline::Render(const scene::FrameState& frame) {
 
 const std::vector<uint8_t>& ChannelPipeline::DisplayRgb8() {
     if (!displayValid_) {
-        if (imager_) {
+        if (intensifier_) {
+            const std::span<const uint8_t> d = intensifier_->Display();
+            display8_.assign(d.begin(), d.end());
+        } else if (imager_) {
             // The imager's display: gray (one byte per pixel) or already RGB.
             const std::span<const uint8_t> d = imager_->Display();
             if (imager_->DisplayChannels() == 3) {
@@ -214,7 +244,7 @@ const std::vector<uint8_t>& ChannelPipeline::DisplayRgb8() {
 
 std::vector<uint8_t> ChannelPipeline::PreviewRgb8(int width, int height) {
     CHECK(width > 0 && height > 0);
-    if (imager_) {
+    if (imager_ || intensifier_) {
         const std::vector<uint8_t>& rgb = DisplayRgb8();
         if (width == channel_.width && height == channel_.height) return rgb;
         std::vector<uint8_t> small(size_t(width) * size_t(height) * 3);
@@ -252,12 +282,46 @@ void ChannelPipeline::WriteThermal(const sensors::ImageMetadata& md, const std::
     }
 }
 
+void ChannelPipeline::WriteNvg(const sensors::ImageMetadata& frameMd, const std::string& base,
+                               FrameRecord& rec) {
+    const sensors::Intensifier& t = *intensifier_;
+    sensors::ImageMetadata md = frameMd;
+    md.Set("seasense:abc_gain_per_pe", float(t.Gain()));
+    md.Set("seasense:bsp_duty", float(t.Duty()));
+    md.Set("seasense:mean_photoelectrons_per_pixel", float(t.MeanPhotoelectrons()));
+    md.Set("seasense:pe_per_photon_radiance", float(t.PhotoelectronsPerRadiance()));
+    for (const std::string& fmt : formats_) {
+        const std::filesystem::path path = channelDir_ / (base + "." + fmt);
+        if (fmt == "exr") {
+            const Image& L = t.PhotonRadiance();
+            const Image& B = t.Brightness();
+            Image both(L.width, L.height, 2);
+            for (size_t i = 0; i < L.pixels.size(); ++i) {
+                both.pixels[2 * i] = L.pixels[i];
+                both.pixels[2 * i + 1] = B.pixels[i];
+            }
+            sensors::ExrOptions options;
+            options.channelNames = {"L_p", "B"};
+            sensors::WriteExr(path, both, md, options);
+        } else {
+            sensors::WriteDisplayImage8(path, t.Display(), t.Brightness().width,
+                                        t.Brightness().height, 3, md);
+        }
+        rec.files.push_back(path);
+    }
+}
+
 void ChannelPipeline::Write(FrameRecord& rec) {
     const auto t0 = std::chrono::steady_clock::now();
     sensors::ImageMetadata md = FrameMetadata(world_, channel_, state_, Camera(), ev_);
     char stem[64];
     std::snprintf(stem, sizeof stem, "_%06lld", (long long)rec.frame);
     const std::string base = channel_.name + stem;
+    if (intensifier_) {
+        WriteNvg(md, base, rec);
+        rec.writeMs = MsSince(t0);
+        return;
+    }
     if (imager_) {
         WriteThermal(md, base, rec);
         rec.writeMs = MsSince(t0);

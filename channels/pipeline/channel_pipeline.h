@@ -9,10 +9,12 @@
 #include <vector>
 
 #include "channels/flir/flir_channel.h"
+#include "channels/nvg/nvg_channel.h"
 #include "channels/otw/otw_channel.h"
 #include "scene/world/world.h"
 #include "sensors/display/display_lut.h"
 #include "sensors/display/ocio_display.h"
+#include "sensors/intensifier/intensifier.h"
 #include "sensors/thermal/thermal_imager.h"
 
 namespace seasense::channels {
@@ -41,6 +43,10 @@ class ChannelPipeline {
     // first frame this pipeline renders, and its temporal noise is keyed by the frame index;
     // so frames n0, n0 + 1, … rendered by any two pipelines from the same first frame n0 are
     // bit-identical.
+    // Nvg channels: the sensor is the channel's sensors::Intensifier (stateful ABC, settled at
+    // the first frame rendered, noise keyed by the frame index, as the thermal imager). Files
+    // per frame: exr (L_p: photocathode-weighted photon radiance at the aperture, photons
+    // s⁻¹ m⁻² sr⁻¹; B: screen brightness 0–1), png/tiff (8-bit P43 phosphor display).
     ChannelPipeline(const scene::World& world, const scene::ChannelSettings& channel,
                     std::filesystem::path outDir, std::vector<std::string> formats,
                     const std::filesystem::path& ocioConfig);
@@ -67,6 +73,9 @@ class ChannelPipeline {
     // The channel renderer: Otw() for kind otw, Flir() for kind flir (CHECK-fails otherwise).
     const OtwChannel& Otw() const;
     const FlirChannel& Flir() const;
+    const NvgChannel& Nvg() const;
+    // Nvg channels: the image intensifier (its last frame).
+    const sensors::Intensifier& GetIntensifier() const;
     // Flir channels: the thermal imager (its last frame's counts, display, measured radiance
     // and apparent temperature).
     const sensors::ThermalImager& Imager() const;
@@ -83,6 +92,10 @@ class ChannelPipeline {
     std::unique_ptr<OtwChannel> otw_;
     std::unique_ptr<FlirChannel> flir_;
     std::unique_ptr<sensors::ThermalImager> imager_;  // flir
+    std::unique_ptr<NvgChannel> nvg_;
+    std::unique_ptr<sensors::Intensifier> intensifier_;  // nvg
+    // Nvg: the frame's files (Write for kind nvg).
+    void WriteNvg(const sensors::ImageMetadata& md, const std::string& base, FrameRecord& rec);
     std::unique_ptr<sensors::OcioDisplay> display_;
     Image samples_;
     Image pixels_;                   // otw: the last frame's sensor image (linear)

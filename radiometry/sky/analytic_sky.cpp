@@ -199,6 +199,7 @@ glm::dvec3 AnalyticSky::Radiance(const glm::dvec3& dIn) const {
     if (c.darkZenithLuminance_cdm2 > 0.0)
         grey += DarkSkyLuminance_cdm2(zenith_rad, c.extinctionV_magPerAirmass,
                                       c.darkZenithLuminance_cdm2);
+    const double dark = grey;
     if (c.moon) {
         // The aureole's ρ⁻² peak is held at its 4° value inside 4° of the moon: the sky
         // table (128² over the hemisphere, ~1° texels) cannot carry a steeper peak without
@@ -210,6 +211,9 @@ glm::dvec3 AnalyticSky::Radiance(const glm::dvec3& dIn) const {
                                          c.moonPhaseAngle_rad, c.moonDistance_m,
                                          c.extinctionV_magPerAirmass);
     }
+    if (c.basis)  // each light's luminance in its own spectral basis vector
+        return LuminanceRec709(L) * c.basis->daylight + dark * c.basis->night +
+               (grey - dark) * c.basis->moonlit;
     return L + glm::dvec3(grey);
 }
 

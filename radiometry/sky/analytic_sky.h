@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <glm/glm.hpp>
+#include <optional>
 #include <vector>
 
 #include "radiometry/sky/night_sky.h"
@@ -29,6 +30,14 @@ struct SkyConditions {
     glm::dvec3 moonDirection{0.0, 0.0, -1.0};  // unit vector toward the moon (apparent)
     double moonPhaseAngle_rad = 3.14159265358979323846;
     double moonDistance_m = 3.844e8;
+    // --- Band basis (channels/nvg) ---
+    // When set, the three components are not Rec.709 but the sub-bands of another band (NVG:
+    // radiometry/nvg): the daylight sky is its luminance × daylight, the moonless night sky
+    // × night, the moonlit sky × moonlit (each: that light's component per cd/m²).
+    struct BandBasis {
+        glm::dvec3 daylight{1.0}, night{1.0}, moonlit{1.0};
+    };
+    std::optional<BandBasis> basis{};
 };
 
 // Illuminance (lx, Rec.709 RGB; D65 white, so equal components) of the sun on a plane normal

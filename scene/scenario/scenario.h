@@ -152,6 +152,9 @@ struct ChannelSettings {
     // and take its field of view from the imager's focal length and pixel pitch.
     std::optional<ConfigValue> imager;
     bool hfovGiven = true;
+    // Nvg channels: the `intensifier:` mapping as written, parsed where the channel is built
+    // (channels/nvg, sensors/intensifier). Absent: the default Gen III goggle.
+    std::optional<ConfigValue> intensifier;
 };
 
 struct MaterialSettings {

@@ -364,6 +364,7 @@ ChannelSettings ReadChannel(const ConfigValue& value) {
             channel.exposure = ReadExposure(*exposure);
         if (channel.kind == ChannelKind::Flir)
             channel.band = InfraredBand(c.GetEnum("band", kInfraredBands, 0));
+        if (channel.kind == ChannelKind::Nvg) channel.intensifier = c.Find("intensifier");
         if (std::optional<ConfigValue> view = c.Find("ocio_view")) {
             channel.ocioView = view->AsString();
             if (channel.ocioView.empty()) view->Fail("a non-empty OpenColorIO view name");

@@ -189,14 +189,17 @@ TEST(Run, WritesImagesSyncLogMosaicAndSummaryUnderTheFrameLock) {
     fs::remove_all(out);
 }
 
-TEST(Run, EveryFrameOfEveryChannelEqualsCapture) {
-    const fs::path runOut = TempDir("equiv_run"), capOut = TempDir("equiv_cap");
+// Runs `scenario` for four frames and captures each of `channels` alone: every frame's EXR and
+// PNG must be identical.
+void ExpectRunEqualsCapture(const std::string& scenario, const std::vector<std::string>& channels,
+                            const std::string& tag) {
+    const fs::path runOut = TempDir(tag + "_run"), capOut = TempDir(tag + "_cap");
     const int frames = 4;
-    auto r = Shell(kBinary + " run --config " + kScenario + " --frames " + std::to_string(frames) +
-                   " --no-video --out " + runOut.string() + " --run-id " + RunId("eq"));
+    auto r = Shell(kBinary + " run --config " + scenario + " --frames " + std::to_string(frames) +
+                   " --no-video --out " + runOut.string() + " --run-id " + RunId(tag));
     ASSERT_EQ(r.status, 0) << r.output;
-    for (const std::string& ch : kChannels) {
-        r = Shell(kBinary + " capture --config " + kScenario + " --channel " + ch + " --frames " +
+    for (const std::string& ch : channels) {
+        r = Shell(kBinary + " capture --config " + scenario + " --channel " + ch + " --frames " +
                   std::to_string(frames) + " --threads 1 --out " + capOut.string());
         ASSERT_EQ(r.status, 0) << r.output;
         for (int f = 0; f < frames; ++f) {
@@ -214,6 +217,16 @@ TEST(Run, EveryFrameOfEveryChannelEqualsCapture) {
     }
     fs::remove_all(runOut);
     fs::remove_all(capOut);
+}
+
+TEST(Run, EveryFrameOfEveryChannelEqualsCapture) {
+    ExpectRunEqualsCapture(kScenario, kChannels, "eq");
+}
+
+// An NVG channel (stateful ABC, scintillation noise keyed by frame and pixel) beside an OTW one.
+TEST(Run, NvgChannelFramesEqualCapture) {
+    ExpectRunEqualsCapture(std::string(SEASENSE_SOURCE_DIR) + "/tests/data/scenarios/run-nvg.yaml",
+                           {"otw", "nvg"}, "nvg");
 }
 
 TEST(Run, KilledRendererStopsTheRunWithStatusOne) {

@@ -1,0 +1,241 @@
+// Image intensifier: photon radiance → photoelectrons → MCP noise → halo → tube MTF → ABC → P43.
+#include "sensors/intensifier/intensifier.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "radiometry/color/rec709.h"
+#include "scene/core/check.h"
+#include "scene/core/rng.h"
+
+namespace seasense::sensors {
+
+namespace {
+
+// P43 (Gd₂O₂S:Tb) phosphor chromaticity, CIE 1931 x = 0.333, y = 0.556 (EIA/JEDEC TEP116-C,
+// "Optical characteristics of cathode-ray tube screens", 1993).
+constexpr double kP43x = 0.333, kP43y = 0.556;
+// Contrast at the limiting resolution: the resolution of a tube is read where its MTF falls to
+// ≈ 3 % (the threshold contrast of visual bar-target readings, Csorba 1985 ch. 8).
+constexpr double kLimitingMtf = 0.03;
+constexpr int kLutSize = 4096;
+
+// sRGB encoding of linear v in [0, 1] (IEC 61966-2-1:1999).
+double SrgbEncode(double v) {
+    return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
+}
+
+}  // namespace
+
+double PoissonDeviate(double mean, uint64_t seed, uint64_t stream) {
+    if (mean <= 0.0) return 0.0;
+    if (mean <= 30.0) {
+        const double limit = std::exp(-mean);
+        double product = 1.0;
+        for (uint64_t k = 0;; ++k) {
+            product *= scene::Uniform01(seed, stream, k);
+            if (product <= limit) return double(k);
+        }
+    }
+    // Box–Muller from two uniforms; u1 in (0, 1].
+    const double u1 = 1.0 - scene::Uniform01(seed, stream, 0);
+    const double u2 = scene::Uniform01(seed, stream, 1);
+    const double z = std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * std::numbers::pi * u2);
+    return std::max(0.0, std::round(mean + std::sqrt(mean) * z));
+}
+
+Intensifier::Intensifier(const IntensifierSettings& settings, int supersampling)
+    : s_(settings), n_(supersampling) {
+    CHECK(n_ >= 1 && s_.width_px > 0 && s_.height_px > 0);
+    const double pitch_m = s_.PixelPitch_m();
+    // Étendue of a pixel behind an f/F objective: A · π/(4F²) (projected solid angle of the
+    // exit pupil, small-angle).
+    pePerRadiance_ = s_.qePeak * s_.opticsTransmission * pitch_m * pitch_m * std::numbers::pi /
+                     (4.0 * s_.fNumber * s_.fNumber) * s_.frameTime_s;
+    const double tanPerPixel = 2.0 * std::tan(0.5 * s_.hfov_rad) / s_.width_px;
+    haloRadius_px_ = std::tan(0.5 * s_.halo_rad) / tanPerPixel;
+    // Gaussian MTF exp(−2π²σ²f²) = kLimitingMtf at the limiting resolution.
+    const double sigma_m = std::sqrt(std::log(1.0 / kLimitingMtf) / 2.0) / std::numbers::pi /
+                           (s_.resolution_lp_mm * 1e3);
+    mtfSigma_px_ = sigma_m / pitch_m;
+    const int r = std::max(1, int(std::ceil(3.0 * mtfSigma_px_)));
+    mtfKernel_.assign(size_t(2 * r + 1), 0.0f);
+    double sum = 0.0;
+    for (int i = -r; i <= r; ++i) {
+        const double w = std::exp(-0.5 * i * i / (mtfSigma_px_ * mtfSigma_px_));
+        mtfKernel_[size_t(i + r)] = float(w);
+        sum += w;
+    }
+    for (float& w : mtfKernel_) w = float(w / sum);
+    // The field stop: pixels whose centre ray is within fieldStop/2 of the optical axis.
+    const int w = s_.width_px, h = s_.height_px;
+    const double tanHalfH = std::tan(0.5 * s_.hfov_rad), tanHalfV = tanHalfH * h / w;
+    const double tanStop = std::tan(0.5 * s_.fieldStop_rad);
+    mask_.assign(size_t(w) * size_t(h), 0);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const double u = ((x + 0.5) / w * 2.0 - 1.0) * tanHalfH;
+            const double v = ((y + 0.5) / h * 2.0 - 1.0) * tanHalfV;
+            mask_[size_t(y) * size_t(w) + size_t(x)] = u * u + v * v <= tanStop * tanStop;
+        }
+    // Phosphor: screen luminance ∝ brightness, in P43's colour, scaled so that saturation is
+    // the brightest displayable P43 green.
+    glm::dvec3 p43 = radiometry::Rec709FromYxy(1.0, kP43x, kP43y);
+    p43 = glm::max(p43, glm::dvec3(0.0));
+    p43 /= std::max({p43.r, p43.g, p43.b});
+    phosphorLut_.resize(size_t(kLutSize) * 3);
+    for (int i = 0; i < kLutSize; ++i)
+        for (int c = 0; c < 3; ++c)
+            phosphorLut_[size_t(i) * 3 + size_t(c)] =
+                uint8_t(std::lround(255.0 * SrgbEncode(double(i) / (kLutSize - 1) * p43[c])));
+    radiance_ = Image(w, h, 1);
+    electrons_ = Image(w, h, 1);
+    halo_ = Image(w, h, 1);
+    brightness_ = Image(w, h, 1);
+    display_.assign(size_t(w) * size_t(h) * 3, 0);
+}
+
+void Intensifier::Process(const Image& samples, double time_s, int64_t frame) {
+    const int w = s_.width_px, h = s_.height_px, n = n_;
+    CHECK(samples.width == w * n && samples.height == h * n);
+    const int comps = samples.channels;
+    // Footprint: the pixel's photon radiance is the mean over its samples, summed over bands.
+    tbb::parallel_for(0, h, [&](int y) {
+        for (int x = 0; x < w; ++x) {
+            double sum = 0.0;
+            for (int j = 0; j < n; ++j) {
+                const float* row = samples.At(x * n, y * n + j);
+                for (int i = 0; i < n * comps; ++i) sum += row[i];
+            }
+            *radiance_.At(x, y) = float(sum / (n * n));
+        }
+    });
+    // Mean photoelectrons over the field (fixed-order sums: deterministic) as the photocathode
+    // delivers them; BSP limits their mean.
+    double total = 0.0;
+    size_t count = 0;
+    for (size_t i = 0; i < mask_.size(); ++i)
+        if (mask_[i]) {
+            total += radiance_.pixels[i] * pePerRadiance_;
+            ++count;
+        }
+    meanPe_ = count ? total / double(count) : 0.0;
+    const double bsp = s_.PixelFramePe(s_.bspThreshold_pe_s_mm2);
+    duty_ = meanPe_ > bsp ? bsp / meanPe_ : 1.0;
+    // The mean as the ABC senses it through the screen current at gain g: each pixel counts at
+    // most the photoelectrons that saturate it (1/g).
+    const auto sensed = [&](double g) {
+        const double cap = 1.0 / g;
+        double sum = 0.0;
+        for (size_t i = 0; i < mask_.size(); ++i)
+            if (mask_[i]) sum += std::min(radiance_.pixels[i] * pePerRadiance_ * duty_, cap);
+        return count ? sum / double(count) : 0.0;
+    };
+    // ABC: the gain that puts the sensed mean at abcLevel (capped at its value at the
+    // threshold), sensed at the previous frame's gain; the first frame starts settled, at the
+    // fixed point g = level / sensed(g) (sensed(g)·g rises with g: bisection on log g).
+    const double maxGain = s_.abcLevel / s_.PixelFramePe(s_.abcThreshold_pe_s_mm2);
+    const auto targetAt = [&](double g) {
+        return std::min(maxGain, s_.abcLevel / std::max(sensed(g), 1e-300));
+    };
+    const double dt = time_s - lastTime_s_;
+    if (!started_ || !(dt > 0.0) || s_.abcTimeConstant_s <= 0.0) {
+        double lo = maxGain * 1e-12, hi = maxGain;
+        if (targetAt(hi) >= hi) {
+            gain_ = hi;
+        } else {
+            for (int i = 0; i < 60; ++i) {
+                const double mid = std::sqrt(lo * hi);
+                (targetAt(mid) > mid ? lo : hi) = mid;
+            }
+            gain_ = std::sqrt(lo * hi);
+        }
+    } else {
+        const double target = targetAt(gain_);
+        gain_ = target + (gain_ - target) * std::exp(-dt / s_.abcTimeConstant_s);
+    }
+    started_ = true;
+    lastTime_s_ = time_s;
+
+    // Scintillation: S = F · Poisson(N/F), mean N, variance F·N (SNR √(N/F)).
+    const double F = s_.noiseFactor;
+    const double scale = pePerRadiance_ * duty_ / F;
+    tbb::parallel_for(0, h, [&](int y) {
+        for (int x = 0; x < w; ++x) {
+            const size_t i = size_t(y) * size_t(w) + size_t(x);
+            const uint64_t stream = scene::HashBits(s_.seed, uint64_t(frame), i);
+            electrons_.pixels[i] =
+                float(F * PoissonDeviate(double(radiance_.pixels[i]) * scale, s_.seed, stream));
+        }
+    });
+    // Halo: a fixed share of each pixel's electrons spread uniformly over a disc of the halo's
+    // angular radius (row prefix sums: O(radius) per pixel).
+    const int R = int(std::floor(haloRadius_px_));
+    const double f = s_.haloFraction;
+    if (f > 0.0 && R >= 1) {
+        std::vector<double>& prefix = prefix_;  // every entry is written below
+        prefix.resize(size_t(h) * size_t(w + 1));
+        tbb::parallel_for(0, h, [&](int y) {
+            double* p = &prefix[size_t(y) * size_t(w + 1)];
+            p[0] = 0.0;
+            for (int x = 0; x < w; ++x) p[x + 1] = p[x] + electrons_.pixels[size_t(y) * w + x];
+        });
+        std::vector<int> halfWidth(size_t(2 * R + 1));
+        double discCount = 0.0;
+        for (int dy = -R; dy <= R; ++dy) {
+            halfWidth[size_t(dy + R)] = int(std::floor(std::sqrt(double(R * R - dy * dy))));
+            discCount += 2 * halfWidth[size_t(dy + R)] + 1;
+        }
+        tbb::parallel_for(0, h, [&](int y) {
+            for (int x = 0; x < w; ++x) {
+                double sum = 0.0;
+                for (int dy = -R; dy <= R; ++dy) {
+                    const int yy = y + dy;
+                    if (yy < 0 || yy >= h) continue;
+                    const int hw = halfWidth[size_t(dy + R)];
+                    const int x0 = std::max(0, x - hw), x1 = std::min(w, x + hw + 1);
+                    const double* p = &prefix[size_t(yy) * size_t(w + 1)];
+                    sum += p[x1] - p[x0];
+                }
+                const size_t i = size_t(y) * size_t(w) + size_t(x);
+                halo_.pixels[i] = float((1.0 - f) * electrons_.pixels[i] + f * sum / discCount);
+            }
+        });
+    } else {
+        halo_.pixels = electrons_.pixels;
+    }
+    // Tube MTF (Gaussian, separable, edges clamped), then ABC gain, screen saturation and the
+    // field stop.
+    const int r = int(mtfKernel_.size() / 2);
+    tbb::parallel_for(0, h, [&](int y) {
+        for (int x = 0; x < w; ++x) {
+            float v = 0.0f;
+            for (int k = -r; k <= r; ++k)
+                v += mtfKernel_[size_t(k + r)] * *halo_.At(std::clamp(x + k, 0, w - 1), y);
+            *brightness_.At(x, y) = v;  // horizontal pass
+        }
+    });
+    tbb::parallel_for(0, h, [&](int y) {
+        for (int x = 0; x < w; ++x) {
+            const size_t i = size_t(y) * size_t(w) + size_t(x);
+            float v = 0.0f;
+            for (int k = -r; k <= r; ++k)
+                v += mtfKernel_[size_t(k + r)] * *brightness_.At(x, std::clamp(y + k, 0, h - 1));
+            halo_.pixels[i] = v;  // the blurred electrons (halo_ is free again)
+        }
+    });
+    tbb::parallel_for(0, h, [&](int y) {
+        for (int x = 0; x < w; ++x) {
+            const size_t i = size_t(y) * size_t(w) + size_t(x);
+            const float b = mask_[i] ? std::min(1.0f, float(gain_) * halo_.pixels[i]) : 0.0f;
+            brightness_.pixels[i] = b;
+            const size_t code = size_t(std::lround(b * (kLutSize - 1)));
+            for (int c = 0; c < 3; ++c) display_[3 * i + size_t(c)] = phosphorLut_[3 * code + c];
+        }
+    });
+}
+
+}  // namespace seasense::sensors
