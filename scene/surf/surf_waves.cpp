@@ -83,6 +83,7 @@ SurfWaves::SurfWaves(const Bathymetry& bathymetry, std::vector<SurfComponent> co
     for (size_t j = 0; j < components_.size(); ++j) {
         const SurfComponent& c = components_[j];
         if (c.amplitude_m > components_[dominant].amplitude_m) dominant = j;
+        dominant_ = dominant;
         Track& tr = tracks_[j];
         tr.k0 = WavenumberForOmega(c.omega_radps, depthForDeep);
         tr.cg0 = GroupSpeed(tr.k0, depthForDeep);
@@ -155,7 +156,68 @@ SurfWaves::SurfWaves(const Bathymetry& bathymetry, std::vector<SurfComponent> co
             breakTime_s_[size_t(i)] = time;
         }
     }
+    BuildShelters();
 }
+
+// --- Sandbar shelter (see surf_waves.h).
+double SurfWaves::FluxProxy(double h) const {
+    if (h <= kMinDepth_m) return 0.0;
+    return h * std::sqrt(DepthTable(tracks_[dominant_].cg, h));
+}
+
+void SurfWaves::BuildShelters() {
+    const SurfSettings& st = bathy_.Settings();
+    if (components_.empty() || st.depthGrid || st.regions.empty()) return;
+    shelterOfRegion_.assign(st.regions.size(), -1);
+    constexpr double kDu_m = 1.0;
+    double regionStart = 0.0;
+    for (size_t r = 0; r < st.regions.size(); ++r) {
+        const SurfRegionSettings& region = st.regions[r];
+        if (region.sandbar) {
+            const SandbarSettings& bar = *region.sandbar;
+            BarShelter sh;
+            const double halfU = 0.5 * bar.length_m + bar.sideSlope_m;
+            sh.u0_m = std::max(0.0, 0.5 * region.width_m - halfU);
+            sh.du_m = kDu_m;
+            sh.nu = int(std::ceil(2.0 * halfU / kDu_m)) + 1;
+            sh.s0_m = bar.distance_m + 0.5 * bar.width_m + bar.sideSlope_m;
+            sh.ns = std::max(1, int(std::ceil((sh.s0_m - sShore_m_) / ds_m_)) + 1);
+            sh.fluxMin.resize(size_t(sh.nu) * size_t(sh.ns));
+            for (int c = 0; c < sh.nu; ++c) {
+                const double u = regionStart + std::min(sh.u0_m + c * kDu_m, region.width_m);
+                double running = std::numeric_limits<double>::infinity();
+                for (int i = 0; i < sh.ns; ++i) {
+                    running =
+                        std::min(running, FluxProxy(bathy_.DepthAtShore_m(sh.s0_m - i * ds_m_, u)));
+                    sh.fluxMin[size_t(c) * size_t(sh.ns) + size_t(i)] = running;
+                }
+            }
+            shelterOfRegion_[r] = int(shelters_.size());
+            shelters_.push_back(std::move(sh));
+        }
+        regionStart += region.width_m;
+    }
+}
+
+double SurfWaves::Shelter(double s_m, double u_m, double h) const {
+    if (shelters_.empty() || h <= kMinDepth_m) return 1.0;
+    double offset = 0.0;
+    const int region = bathy_.RegionAt(u_m, &offset);
+    if (region < 0 || shelterOfRegion_[size_t(region)] < 0) return 1.0;
+    const BarShelter& sh = shelters_[size_t(shelterOfRegion_[size_t(region)])];
+    const double cu = (offset - sh.u0_m) / sh.du_m;
+    if (cu < 0.0 || cu > double(sh.nu - 1) || s_m > sh.s0_m) return 1.0;
+    // The minimum over the samples at or seaward of s; the local value itself is exact.
+    const size_t row = size_t(std::min(std::floor((sh.s0_m - s_m) / ds_m_), double(sh.ns - 1)));
+    const size_t c0 = std::min(size_t(cu), size_t(sh.nu - 1));
+    const size_t c1 = std::min(c0 + 1, size_t(sh.nu - 1));
+    const double f = cu - double(c0);
+    const size_t ns = size_t(sh.ns);
+    const double seaward = (1.0 - f) * sh.fluxMin[c0 * ns + row] + f * sh.fluxMin[c1 * ns + row];
+    const double local = FluxProxy(h);
+    return seaward >= local ? 1.0 : seaward / local;
+}
+// --- end sandbar shelter
 
 double SurfWaves::DepthTable(const std::vector<double>& t, double h) const {
     return Interp(t, h / dh_m_);
@@ -232,7 +294,9 @@ SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* inf
         envelope += a * std::complex<double>(std::cos(psi), std::sin(psi));
     }
     const double A = std::abs(envelope);
-    const double gammaH = settings_.breakerIndex * h;
+    // Behind a sandbar only the energy flux the bar let through arrives (Shelter).
+    const double shelter = Shelter(p.s_m, p.u_m, h);
+    const double gammaH = settings_.breakerIndex * h * shelter;
     const double cap = 2.0 * A > gammaH ? gammaH / (2.0 * A) : 1.0;
     // Steepening: Q rises from its deep value to 1 (the trochoid's cusp) as the group height
     // approaches the breaker height.
@@ -268,7 +332,8 @@ SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* inf
     }
     local.envelope_m = A * cap;
     local.unbrokenHeight_m = 2.0 * A;
-    local.breaking.intensity = cap < 1.0 ? 1.0 - cap * cap : 0.0;
+    // Sheltered waves are already broken down to what the bar let through: no new breaking.
+    local.breaking.intensity = cap < 1.0 && shelter == 1.0 ? 1.0 - cap * cap : 0.0;
     if (info) *info = local;
     return out;
 }

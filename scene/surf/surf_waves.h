@@ -150,6 +150,27 @@ class SurfWaves {
     };
     double DepthTable(const std::vector<double>& t, double h) const;
 
+    // --- Sandbar shelter (seed 003, "Sandbars"): waves that broke on a bar arrive shoreward of
+    // it with only the energy flux the bar let through. Per sandbar region a table over the bar's
+    // alongshore extent and its cross-shore span from the seaward foot to the shoreline holds the
+    // running minimum, walking landward, of the saturated breakers' energy-flux proxy h √cg(h)
+    // ((γh)² cg ∝ E cg at the breaker cap; the dominant component's group speed). Shelter is
+    // that minimum over the local value, at most 1: the local breaker cap γ h becomes
+    // γ h · Shelter. On a plane beach (h √cg falls monotonically shoreward) it is exactly 1.
+    struct BarShelter {
+        double u0_m = 0.0, du_m = 1.0;  // first column's offset in its region, column step
+        double s0_m = 0.0;              // seaward foot of the bar (row 0), rows ds_m_ landward
+        int nu = 0, ns = 0;
+        std::vector<double> fluxMin;  // [column * ns + row]
+    };
+    void BuildShelters();
+    double FluxProxy(double h) const;
+    double Shelter(double s_m, double u_m, double h) const;
+    std::vector<int> shelterOfRegion_;  // index into shelters_ or −1
+    std::vector<BarShelter> shelters_;
+    size_t dominant_ = 0;
+    // --- end sandbar shelter
+
     Bathymetry bathy_;
     std::vector<SurfComponent> components_;
     std::vector<SurfCascade> cascades_;
