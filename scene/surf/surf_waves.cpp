@@ -157,6 +157,7 @@ SurfWaves::SurfWaves(const Bathymetry& bathymetry, std::vector<SurfComponent> co
         }
     }
     BuildShelters();
+    BuildSwash();
 }
 
 // --- Sandbar shelter (see surf_waves.h).
@@ -219,6 +220,86 @@ double SurfWaves::Shelter(double s_m, double u_m, double h) const {
 }
 // --- end sandbar shelter
 
+// --- Swash run-up (see surf_waves.h).
+void SurfWaves::BuildSwash() {
+    const SwashSettings& set = bathy_.Settings().swash;
+    swash_ = {};
+    if (!set.enabled || components_.empty() || !std::isfinite(sBreak_m_)) return;
+    auto profileDepth = [&](double s) { return bathy_.Tide_m() - bathy_.ProfileZ_m(s); };
+    // The still-water line by bisection (depth rises seaward), and the foreshore slope there.
+    double lo = sShore_m_, hi = sShore_m_ + 1.0;
+    if (!(profileDepth(lo) <= 0.0 && profileDepth(hi) > 0.0)) return;
+    for (int i = 0; i < 60; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        (profileDepth(mid) > 0.0 ? hi : lo) = mid;
+    }
+    SwashParameters& p = swash_;
+    p.shoreline_m = 0.5 * (lo + hi);
+    p.foreshoreSlope =
+        (profileDepth(p.shoreline_m + 1.0) - profileDepth(p.shoreline_m - 1.0)) / 2.0;
+    if (!(p.foreshoreSlope > 0.0)) return;
+    const double variance = spectralVariance_m2_ + gerstnerVariance_m2_;
+    p.H0_m = 4.0 * std::sqrt(variance);
+    const double Tp = kTwoPi / components_[dominant_].omega_radps;
+    p.L0_m = kGravity_mps2 * Tp * Tp / kTwoPi;
+    const double hl = p.H0_m * p.L0_m, b = p.foreshoreSlope;
+    p.setup_m = 0.35 * b * std::sqrt(hl);
+    p.significant_m = std::sqrt(hl * (0.563 * b * b + 0.004));
+    p.runup2_m = 1.1 * (p.setup_m + 0.5 * p.significant_m);
+    p.cuspSpacing_m = set.cuspSpacing_m > 0.0 ? set.cuspSpacing_m
+                                              : kGravity_mps2 * Tp * Tp * b / std::numbers::pi;
+    p.cuspAmplitude = set.cuspAmplitude;
+    // The incoming components at the breaker line: shoaled, refracted amplitude and the phase
+    // without the alongshore and time terms.
+    const double hb = std::max(profileDepth(sBreak_m_), kMinDepth_m);
+    const double index = (sRef_m_ - sBreak_m_) / ds_m_;
+    swashAmplitude_.assign(components_.size(), 0.0);
+    swashPhase_.assign(components_.size(), 0.0);
+    double sum2 = 0.0;
+    for (size_t j = 0; j < components_.size(); ++j) {
+        const Track& tr = tracks_[j];
+        if (!tr.incoming) continue;
+        const double k = DepthTable(tr.k, hb), cg = DepthTable(tr.cg, hb);
+        const double cosT = std::max(std::sqrt(std::max(k * k - tr.ku * tr.ku, 0.0)) / k, 1e-3);
+        const double a =
+            components_[j].amplitude_m * std::sqrt(tr.cg0 / cg) * std::sqrt(tr.cos0 / cosT);
+        swashAmplitude_[j] = a;
+        swashPhase_[j] =
+            tr.phaseOrigin + (sBreak_m_ >= sRef_m_ ? tr.ks0 * sBreak_m_
+                                                   : tr.ks0 * sRef_m_ + Interp(tr.phase, index));
+        sum2 += a * a;
+    }
+    p.breakerRms_m = 2.0 * std::sqrt(sum2);
+    p.active = p.breakerRms_m > 0.0 && p.runup2_m > 0.0;
+}
+
+double SurfWaves::Swash_m(double s_m, double u_m, double t, double h) const {
+    const SwashParameters& p = swash_;
+    if (!p.active) return 0.0;
+    double w = 1.0;
+    if (h > 0.0) {
+        w = 1.0 - h / (2.0 * p.runup2_m);
+        if (w <= 0.0) return 0.0;
+    } else if (s_m < p.shoreline_m - 2.0 * p.runup2_m / p.foreshoreSlope - 10.0) {
+        return 0.0;
+    }
+    std::complex<double> envelope(0.0, 0.0);
+    for (size_t j = 0; j < components_.size(); ++j) {
+        if (swashAmplitude_[j] == 0.0) continue;
+        const double psi = swashPhase_[j] + tracks_[j].ku * u_m - components_[j].omega_radps * t;
+        envelope += swashAmplitude_[j] * std::complex<double>(std::cos(psi), std::sin(psi));
+    }
+    // Rayleigh envelope: mean √π/2 H_rms, standard deviation √(1 − π/4) H_rms.
+    const double g =
+        (2.0 * std::abs(envelope) / p.breakerRms_m - 0.5 * std::sqrt(std::numbers::pi)) /
+        std::sqrt(1.0 - 0.25 * std::numbers::pi);
+    const double c = p.cuspAmplitude;
+    const double m =
+        (1.0 + c * std::cos(kTwoPi * u_m / p.cuspSpacing_m)) / std::sqrt(1.0 + 0.5 * c * c);
+    return w * (p.setup_m + 0.25 * p.significant_m * g * m);
+}
+// --- end swash
+
 double SurfWaves::DepthTable(const std::vector<double>& t, double h) const {
     return Interp(t, h / dh_m_);
 }
@@ -265,6 +346,8 @@ SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* inf
         local.breaking.broken = p.s_m <= sBreak_m_;
         local.breaking.timeSinceBreaking_s = Interp(breakTime_s_, tableIndex);
     }
+    // Swash run-up (Swash_m): the waterline's rise and fall, in the inner surf and on the beach.
+    out.displacement.z += Swash_m(p.s_m, p.u_m, t, h);
     if (weights.AllDeep() || h <= 0.0 || components_.empty()) {
         if (info) *info = local;
         return out;
