@@ -190,13 +190,13 @@ TEST_F(SurfConfigTest, ErrorsNameTheKey) {
 }
 
 TEST_F(SurfConfigTest, SprayAndSwashKeysAreRead) {
-    const Scenario s = LoadScenario(Write(WithSurf(
-        "      shoreline: {origin_m: [0, 0], azimuth_deg: 0}\n"
-        "      spray: {enabled: false, radius_m: 90, cell_m: 2.5, interval_s: 0.3,\n"
-        "              probability: 0.4, droplets_per_burst: 7, lifetime_s: 2.2,\n"
-        "              launch_speed_mps: 4.5, drag_time_s: 0.3, clump_radius_m: 0.2,\n"
-        "              opacity: 0.9, max_particles: 5000, seed: 9}\n"
-        "      swash: {enabled: false, cusp_spacing_m: 35, cusp_amplitude: 0.25}\n")));
+    const Scenario s = LoadScenario(Write(
+        WithSurf("      shoreline: {origin_m: [0, 0], azimuth_deg: 0}\n"
+                 "      spray: {enabled: false, radius_m: 90, cell_m: 2.5, interval_s: 0.3,\n"
+                 "              probability: 0.4, droplets_per_burst: 7, lifetime_s: 2.2,\n"
+                 "              launch_speed_mps: 4.5, drag_time_s: 0.3, clump_radius_m: 0.2,\n"
+                 "              opacity: 0.9, max_particles: 5000, seed: 9}\n"
+                 "      swash: {enabled: false, cusp_spacing_m: 35, cusp_amplitude: 0.25}\n")));
     const SpraySettings& p = s.environment.ocean.surf->spray;
     EXPECT_FALSE(p.enabled);
     EXPECT_DOUBLE_EQ(p.radius_m, 90.0);
