@@ -271,6 +271,15 @@ void SurfWaves::BuildSwash() {
     }
     p.breakerRms_m = 2.0 * std::sqrt(sum2);
     p.active = p.breakerRms_m > 0.0 && p.runup2_m > 0.0;
+    if (p.active) {
+        double sumA = 0.0;
+        for (const double a : swashAmplitude_) sumA += a;
+        const double gMax = (2.0 * sumA / p.breakerRms_m - 0.5 * std::sqrt(std::numbers::pi)) /
+                            std::sqrt(1.0 - 0.25 * std::numbers::pi);
+        const double c = p.cuspAmplitude;
+        p.max_m = std::max(0.0, p.setup_m + 0.25 * p.significant_m * gMax * (1.0 + c) /
+                                                std::sqrt(1.0 + 0.5 * c * c));
+    }
 }
 
 double SurfWaves::Swash_m(double s_m, double u_m, double t, double h) const {

@@ -161,6 +161,9 @@ class SurfWaves {
         double cuspSpacing_m = 0.0, cuspAmplitude = 0.0;
         double shoreline_m = 0.0;   // cross-shore s of the still-water line (plane beach)
         double breakerRms_m = 0.0;  // H_rms of the surf components at the breaker line
+        // Largest ζ anywhere, ever (for surface bounds): the envelope at most 2 Σ A_j there, the
+        // cusp factor at most (1 + c) / √(1 + c²/2).
+        double max_m = 0.0;
     };
     const SwashParameters& Swash() const { return swash_; }
     // ζ (m, added to the surface height) at shore point (s, u), time t, still-water depth h.
