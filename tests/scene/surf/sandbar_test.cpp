@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <vector>
 
@@ -142,6 +143,8 @@ TEST(Sandbar, DeeperThanTwiceTheBreakerHeightCrestsPeakWithoutBreaking) {
     // The crests peak: σ over the crest is the shoaled σ at its depth, above the plain's.
     const double ratio = At(bar, bar.rms, kBarDistance_m) / At(plain, plain.rms, kBarDistance_m);
     const double expected = std::sqrt(Variance(d) / Variance(kSlope * kBarDistance_m));
+    std::printf("Hb %.3f m, bar at %.3f m: σ ratio over the crest %.3f (energy flux %.3f)\n", hb, d,
+                ratio, expected);
     EXPECT_GT(expected, 1.05);
     EXPECT_NEAR(ratio, expected, 0.05 * expected);
     // The waves still break on the beach, shoreward.
@@ -159,6 +162,8 @@ TEST(Sandbar, BetweenOneAndTwoBreakerHeightsSomeBreakOnTheBarTheRestShoreward) {
             onBar = std::max(onBar, bar.breaking[i]);
         if (bar.x[i] < kLandwardFoot_m) shoreward = std::max(shoreward, bar.breaking[i]);
     }
+    std::printf("bar at %.3f m: breaking seaward %.3f, on the bar %.3f, shoreward %.3f\n", d,
+                seaward, onBar, shoreward);
     EXPECT_EQ(seaward, 0.0);
     EXPECT_GT(onBar, 0.01);  // some waves break on the bar ...
     EXPECT_LT(onBar, 0.5);   // ... not most
@@ -173,6 +178,9 @@ TEST(Sandbar, ShallowerThanTheBreakerHeightWavesBreakOnItsSeawardSide) {
     double onset = -1.0;
     for (size_t i = 0; i < bar.x.size() && onset < 0.0; ++i)
         if (bar.breaking[i] >= 0.01) onset = bar.x[i];
+    std::printf(
+        "bar at %.3f m: breaking onset at x = %.1f m (crest %.1f-%.1f m), %.3f at its edge\n", d,
+        onset, kLandwardCrest_m, kSeawardCrest_m, At(bar, bar.breaking, kSeawardCrest_m));
     EXPECT_GT(onset, kSeawardCrest_m);
     EXPECT_LT(onset, kSeawardFoot_m);
     EXPECT_GT(At(bar, bar.breaking, kSeawardCrest_m), 0.3);
