@@ -102,14 +102,18 @@ std::vector<SprayParticle> SprayField::Particles(const glm::dvec3& eye, double t
                 SurfPointInfo info;
                 const SurfaceTerms terms = surf_.Terms(x0, y0, tn, &info);
                 const double intensity = info.breaking.intensity;
-                if (intensity <= 0.0 || terms.displacement.z < 0.5 * info.envelope_m) continue;
+                if (intensity <= 0.0) continue;
+                // The wave's own elevation about the swash level (SurfWaves::Swash_m).
+                const ShorePoint sp = surf_.Bathy().Frame().ShoreFromWorld(x0, y0);
+                const double swash = surf_.Swash_m(sp.s_m, sp.u_m, tn, info.depth_m);
+                if (terms.displacement.z - swash < 0.5 * info.envelope_m) continue;
                 if (Uniform01(slot, kSlotChance, 0) >= s.probability * intensity) continue;
                 ++acc.bursts;
                 const glm::dvec3 origin(x0 + terms.displacement.x, y0 + terms.displacement.y,
                                         tide + terms.displacement.z);
                 const glm::dvec2 dir(std::sin(info.direction_rad), std::cos(info.direction_rad));
                 const glm::dvec2 along(-dir.y, dir.x);  // along the crest
-                const double trough = tide - info.envelope_m;
+                const double trough = tide + swash - info.envelope_m;
                 for (int k = 0; k < s.dropletsPerBurst; ++k) {
                     const uint64_t base = uint64_t(k) * 8;
                     const auto u = [&](uint64_t i) {

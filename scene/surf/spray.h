@@ -46,11 +46,11 @@ struct SprayStats {
 // depth is positive and below the deepest depth at which the surf components can break at all,
 // slot n of length interval_s has its instant t_n = (n + U) interval_s and a seeded point in
 // the cell. If at t_n the point is breaking (SurfBreaking::intensity > 0), lies on the crest of
-// its wave group (surf height ≥ ½ the envelope) and a seeded U < probability × intensity, the
-// slot throws dropletsPerBurst particles from the crest, spread along it over the cell, with
-// the local dominant component's group velocity (direction, group speed, ±20 % seeded) plus a
-// seeded upward speed. The particles alive at t are those of slots with t_n in
-// [t − lifetime_s, t] that are still above the trough (tide − envelope): the run and a capture
+// its wave group (surf height about the swash level ≥ ½ the envelope) and a seeded U < probability
+// × intensity, the slot throws dropletsPerBurst particles from the crest, spread along it over the
+// cell, with the local dominant component's group velocity (direction, group speed, ±20 % seeded)
+// plus a seeded upward speed. The particles alive at t are those of slots with t_n in [t −
+// lifetime_s, t] that are still above the trough (tide + swash − envelope): the run and a capture
 // of the same frame see the same particles, for any thread count.
 class SprayField {
   public:
