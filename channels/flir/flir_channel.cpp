@@ -10,6 +10,7 @@
 #include <map>
 
 #include "channels/flir/cloud_infrared.h"
+#include "channels/otw/spray_overlay.h"
 #include "channels/plume/plume_composite.h"
 #include "channels/view/surface_gather.h"
 #include "scene/core/check.h"
@@ -579,6 +580,16 @@ void FlirChannel::Render(const scene::SceneState& state, Image& radiance) {
     }
     // --- end of cloud layers ---
 
+    // --- Surf spray (channels/otw/spray_overlay): foam-emissivity water at the sea temperature
+    // (the reflected (1 − ε_f) part from the zenith sky), through the path. ---
+    DrawSprayInfrared(
+        world_, state, cam, vis,
+        surf_.foamEmissivity * frame.seaB + (1.0f - surf_.foamEmissivity) * skyTable_(1.0f),
+        [&](double range_m, float L) {
+            const float tau = pathTau_(float(std::sqrt(std::min(range_m, kMaxPathRange_m))));
+            return tau * L + (1.0f - tau) * frame.airB;
+        },
+        radiance);
     // Plumes (channels/plume) over the finished radiance.
     plumes_->CompositeFlir(state, cam, vis, *this, radiance);
 }

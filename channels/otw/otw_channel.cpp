@@ -14,6 +14,7 @@
 #include "channels/otw/cloud_layer.h"
 #include "channels/otw/lightning_overlay.h"
 #include "channels/otw/shore_shading.h"
+#include "channels/otw/spray_overlay.h"
 #include "channels/plume/plume_composite.h"
 #include "radiometry/sky/analytic_sky.h"
 #include "radiometry/surface/fresnel.h"
@@ -1066,6 +1067,9 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     }
     // --- end of cloud layers ---
     if (lightning) DrawLightning(cam, vis, *lightning, flashes, beta, radiance);
+    // --- Surf spray (channels/otw/spray_overlay): foam-white droplet clumps, depth-tested. ---
+    DrawSpray(world_, state, cam, vis, {shore_[0].rhoFoam, shore_[1].rhoFoam, shore_[2].rhoFoam},
+              downwelling, beta, radiance);
 
     // Plumes (channels/plume) over the finished radiance.
     plumes_->CompositeOtw(state, cam, vis, sky, radiance);

@@ -85,6 +85,30 @@ DepthGridSettings ReadDepthGrid(const ConfigValue& value, const std::filesystem:
     return g;
 }
 
+void ReadSpray(const ConfigValue& value, SpraySettings& p) {
+    ReadMap(value, [&](ConfigMap& m) {
+        p.enabled = m.GetBool("enabled", p.enabled);
+        p.radius_m = m.GetDouble("radius_m", NumberRange::Closed(1.0, 5000.0, "m"), p.radius_m);
+        p.cell_m = m.GetDouble("cell_m", NumberRange::Closed(0.25, 100.0, "m"), p.cell_m);
+        p.interval_s =
+            m.GetDouble("interval_s", NumberRange::Closed(0.01, 60.0, "s"), p.interval_s);
+        p.probability = m.GetDouble("probability", NumberRange::Closed(0.0, 1.0), p.probability);
+        p.dropletsPerBurst = int(m.GetInt("droplets_per_burst", 1, 1000, p.dropletsPerBurst));
+        p.lifetime_s =
+            m.GetDouble("lifetime_s", NumberRange::Closed(0.05, 60.0, "s"), p.lifetime_s);
+        p.launchSpeed_mps = m.GetDouble("launch_speed_mps", NumberRange::Closed(0.0, 50.0, "m/s"),
+                                        p.launchSpeed_mps);
+        p.dragTime_s =
+            m.GetDouble("drag_time_s", NumberRange::Closed(0.01, 100.0, "s"), p.dragTime_s);
+        p.clumpRadius_m =
+            m.GetDouble("clump_radius_m", NumberRange::Closed(0.001, 10.0, "m"), p.clumpRadius_m);
+        p.opacity = m.GetDouble("opacity", NumberRange::Closed(0.0, 1.0), p.opacity);
+        p.maxParticles = int(m.GetInt("max_particles", 0, 10'000'000, p.maxParticles));
+        p.seed =
+            uint64_t(m.GetInt("seed", 0, std::numeric_limits<int64_t>::max(), int64_t(p.seed)));
+    });
+}
+
 }  // namespace
 
 SurfSettings ParseSurfSettings(ConfigMap& map, const std::filesystem::path& folder,
@@ -113,6 +137,17 @@ SurfSettings ParseSurfSettings(ConfigMap& map, const std::filesystem::path& fold
                                              f.streakElongation);
             f.seed =
                 uint64_t(m.GetInt("seed", 0, std::numeric_limits<int64_t>::max(), int64_t(f.seed)));
+        });
+    }
+
+    if (const std::optional<ConfigValue> spray = map.Find("spray")) ReadSpray(*spray, s.spray);
+    if (const std::optional<ConfigValue> swash = map.Find("swash")) {
+        ReadMap(*swash, [&](ConfigMap& m) {
+            s.swash.enabled = m.GetBool("enabled", s.swash.enabled);
+            s.swash.cuspSpacing_m = m.GetDouble(
+                "cusp_spacing_m", NumberRange::Closed(0.0, 1000.0, "m"), s.swash.cuspSpacing_m);
+            s.swash.cuspAmplitude =
+                m.GetDouble("cusp_amplitude", NumberRange::Closed(0.0, 1.0), s.swash.cuspAmplitude);
         });
     }
 

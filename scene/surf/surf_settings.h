@@ -81,6 +81,47 @@ struct FoamSettings {
     uint64_t seed = 1;  // seeds the streak pattern
 };
 
+// environment.ocean.surf.spray: droplets thrown up where waves break (scene/surf/spray.h). Each
+// particle stands for a clump of droplets of about 1 mm (whose linear-drag time dragTime_s gives
+// their terminal fall speed g τ).
+struct SpraySettings {
+    bool enabled = true;
+    // Breakers are looked for within this horizontal distance of the eyepoint (seed 003: "the
+    // radius of the area of interest (from the observer) in which breaking waves are
+    // simulated"), on a lattice of cells cell_m apart.
+    double radius_m = 120.0;
+    double cell_m = 3.0;
+    // Emission slots: each cell gets one chance per interval_s (at a seeded instant within the
+    // slot) to throw a burst, with this probability at full breaking intensity (the distribution
+    // of breakers, seed 003), scaled by the intensity.
+    double interval_s = 0.25;
+    double probability = 0.6;
+    int dropletsPerBurst = 10;
+    double lifetime_s = 1.6;
+    // Upward launch speed: uniform in [½, 1½] × this; horizontally the wave's group velocity.
+    // Breaking-crest jets and splash-up rise at a few m/s (the crest moves at √(g h) ≈ 3–5 m/s
+    // in 1–2 m of water).
+    double launchSpeed_mps = 3.0;
+    // Linear drag relaxation time τ of dv/dt = g + (w − v)/τ: terminal speed g τ. 1 mm drops fall
+    // at 4.0 m/s (Gunn & Kinzer, J. Meteor. 6, 243 (1949)): τ ≈ 0.41 s.
+    double dragTime_s = 0.41;
+    double clumpRadius_m = 0.12;  // drawn radius of one particle (a clump of droplets)
+    double opacity = 0.6;         // of a fresh clump's disc, fading linearly with age
+    int maxParticles = 20000;     // the pool: nearest to the eyepoint kept
+    uint64_t seed = 1;
+};
+
+// environment.ocean.surf.swash: the waterline running up and down the beach (SurfWaves::Swash).
+struct SwashSettings {
+    bool enabled = true;
+    // Alongshore spacing of the beach cusps whose bays the swash runs farther into; 0: the
+    // subharmonic edge-wave spacing λ = g T² tan β / π of the peak period T and the foreshore
+    // slope β (Guza & Inman, J. Geophys. Res. 80, 2997 (1975)).
+    double cuspSpacing_m = 0.0;
+    // Relative alongshore modulation of the swash excursion by the cusps, in [0, 1].
+    double cuspAmplitude = 0.5;
+};
+
 struct SurfSettings {
     ShorelineSettings shoreline;
     double tide_m = 0.0;  // water level above mean sea level
@@ -99,6 +140,8 @@ struct SurfSettings {
     std::vector<SurfRegionSettings> regions;  // empty: a plane beach without bars
     std::optional<DepthGridSettings> depthGrid;
     FoamSettings foam;
+    SpraySettings spray;
+    SwashSettings swash;
 };
 
 // Reads the environment.ocean.surf mapping (every key documented in docs/configuration.md);

@@ -85,6 +85,7 @@ SurfWaves::SurfWaves(const Bathymetry& bathymetry, std::vector<SurfComponent> co
     for (size_t j = 0; j < components_.size(); ++j) {
         const SurfComponent& c = components_[j];
         if (c.amplitude_m > components_[dominant].amplitude_m) dominant = j;
+        dominant_ = dominant;
         Track& tr = tracks_[j];
         tr.k0 = WavenumberForOmega(c.omega_radps, depthForDeep);
         tr.cg0 = GroupSpeed(tr.k0, depthForDeep);
@@ -178,7 +179,161 @@ SurfWaves::SurfWaves(const Bathymetry& bathymetry, std::vector<SurfComponent> co
             breakTime_s_[size_t(i)] = time;
         }
     }
+    BuildShelters();
+    BuildSwash();
 }
+
+// --- Sandbar shelter (see surf_waves.h).
+double SurfWaves::FluxProxy(double h) const {
+    if (h <= kMinDepth_m) return 0.0;
+    return h * std::sqrt(DepthTable(tracks_[dominant_].cg, h));
+}
+
+void SurfWaves::BuildShelters() {
+    const SurfSettings& st = bathy_.Settings();
+    if (components_.empty() || st.depthGrid || st.regions.empty()) return;
+    shelterOfRegion_.assign(st.regions.size(), -1);
+    constexpr double kDu_m = 1.0;
+    double regionStart = 0.0;
+    for (size_t r = 0; r < st.regions.size(); ++r) {
+        const SurfRegionSettings& region = st.regions[r];
+        if (region.sandbar) {
+            const SandbarSettings& bar = *region.sandbar;
+            BarShelter sh;
+            const double halfU = 0.5 * bar.length_m + bar.sideSlope_m;
+            sh.u0_m = std::max(0.0, 0.5 * region.width_m - halfU);
+            sh.du_m = kDu_m;
+            sh.nu = int(std::ceil(2.0 * halfU / kDu_m)) + 1;
+            sh.s0_m = bar.distance_m + 0.5 * bar.width_m + bar.sideSlope_m;
+            sh.ns = std::max(1, int(std::ceil((sh.s0_m - sShore_m_) / ds_m_)) + 1);
+            sh.fluxMin.resize(size_t(sh.nu) * size_t(sh.ns));
+            for (int c = 0; c < sh.nu; ++c) {
+                const double u = regionStart + std::min(sh.u0_m + c * kDu_m, region.width_m);
+                double running = std::numeric_limits<double>::infinity();
+                for (int i = 0; i < sh.ns; ++i) {
+                    running =
+                        std::min(running, FluxProxy(bathy_.DepthAtShore_m(sh.s0_m - i * ds_m_, u)));
+                    sh.fluxMin[size_t(c) * size_t(sh.ns) + size_t(i)] = running;
+                }
+            }
+            shelterOfRegion_[r] = int(shelters_.size());
+            shelters_.push_back(std::move(sh));
+        }
+        regionStart += region.width_m;
+    }
+}
+
+double SurfWaves::Shelter(double s_m, double u_m, double h) const {
+    if (shelters_.empty() || h <= kMinDepth_m) return 1.0;
+    double offset = 0.0;
+    const int region = bathy_.RegionAt(u_m, &offset);
+    if (region < 0 || shelterOfRegion_[size_t(region)] < 0) return 1.0;
+    const BarShelter& sh = shelters_[size_t(shelterOfRegion_[size_t(region)])];
+    const double cu = (offset - sh.u0_m) / sh.du_m;
+    if (cu < 0.0 || cu > double(sh.nu - 1) || s_m > sh.s0_m) return 1.0;
+    // The minimum over the samples at or seaward of s; the local value itself is exact.
+    const size_t row = size_t(std::min(std::floor((sh.s0_m - s_m) / ds_m_), double(sh.ns - 1)));
+    const size_t c0 = std::min(size_t(cu), size_t(sh.nu - 1));
+    const size_t c1 = std::min(c0 + 1, size_t(sh.nu - 1));
+    const double f = cu - double(c0);
+    const size_t ns = size_t(sh.ns);
+    const double seaward = (1.0 - f) * sh.fluxMin[c0 * ns + row] + f * sh.fluxMin[c1 * ns + row];
+    const double local = FluxProxy(h);
+    return seaward >= local ? 1.0 : seaward / local;
+}
+// --- end sandbar shelter
+
+// --- Swash run-up (see surf_waves.h).
+void SurfWaves::BuildSwash() {
+    const SwashSettings& set = bathy_.Settings().swash;
+    swash_ = {};
+    if (!set.enabled || components_.empty() || !std::isfinite(sBreak_m_)) return;
+    auto profileDepth = [&](double s) { return bathy_.Tide_m() - bathy_.ProfileZ_m(s); };
+    // The still-water line by bisection (depth rises seaward), and the foreshore slope there.
+    double lo = sShore_m_, hi = sShore_m_ + 1.0;
+    if (!(profileDepth(lo) <= 0.0 && profileDepth(hi) > 0.0)) return;
+    for (int i = 0; i < 60; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        (profileDepth(mid) > 0.0 ? hi : lo) = mid;
+    }
+    SwashParameters& p = swash_;
+    p.shoreline_m = 0.5 * (lo + hi);
+    p.foreshoreSlope =
+        (profileDepth(p.shoreline_m + 1.0) - profileDepth(p.shoreline_m - 1.0)) / 2.0;
+    if (!(p.foreshoreSlope > 0.0)) return;
+    const double variance = spectralVariance_m2_ + gerstnerVariance_m2_;
+    p.H0_m = 4.0 * std::sqrt(variance);
+    const double Tp = kTwoPi / components_[dominant_].omega_radps;
+    p.L0_m = kGravity_mps2 * Tp * Tp / kTwoPi;
+    const double hl = p.H0_m * p.L0_m, b = p.foreshoreSlope;
+    p.setup_m = 0.35 * b * std::sqrt(hl);
+    p.significant_m = std::sqrt(hl * (0.563 * b * b + 0.004));
+    p.runup2_m = 1.1 * (p.setup_m + 0.5 * p.significant_m);
+    p.cuspSpacing_m = set.cuspSpacing_m > 0.0 ? set.cuspSpacing_m
+                                              : kGravity_mps2 * Tp * Tp * b / std::numbers::pi;
+    p.cuspAmplitude = set.cuspAmplitude;
+    // The incoming components at the breaker line: shoaled, refracted amplitude and the phase
+    // without the alongshore and time terms.
+    const double hb = std::max(profileDepth(sBreak_m_), kMinDepth_m);
+    const double index = (sRef_m_ - sBreak_m_) / ds_m_;
+    swashAmplitude_.assign(components_.size(), 0.0);
+    swashPhase_.assign(components_.size(), 0.0);
+    double sum2 = 0.0;
+    for (size_t j = 0; j < components_.size(); ++j) {
+        const Track& tr = tracks_[j];
+        if (!tr.incoming) continue;
+        const double k = DepthTable(tr.k, hb), cg = DepthTable(tr.cg, hb);
+        const double cosT = std::max(std::sqrt(std::max(k * k - tr.ku * tr.ku, 0.0)) / k, 1e-3);
+        const double a =
+            components_[j].amplitude_m * std::sqrt(tr.cg0 / cg) * std::sqrt(tr.cos0 / cosT);
+        swashAmplitude_[j] = a;
+        swashPhase_[j] =
+            tr.phaseOrigin + (sBreak_m_ >= sRef_m_ ? tr.ks0 * sBreak_m_
+                                                   : tr.ks0 * sRef_m_ + Interp(tr.phase, index));
+        sum2 += a * a;
+    }
+    p.breakerRms_m = 2.0 * std::sqrt(sum2);
+    p.active = p.breakerRms_m > 0.0 && p.runup2_m > 0.0;
+    if (p.active) {
+        double sumA = 0.0;
+        for (const double a : swashAmplitude_) sumA += a;
+        const double gMax = (2.0 * sumA / p.breakerRms_m - 0.5 * std::sqrt(std::numbers::pi)) /
+                            std::sqrt(1.0 - 0.25 * std::numbers::pi);
+        const double c = p.cuspAmplitude;
+        p.max_m = std::max(0.0, p.setup_m + 0.25 * p.significant_m * gMax * (1.0 + c) /
+                                                std::sqrt(1.0 + 0.5 * c * c));
+    }
+}
+
+double SurfWaves::Swash_m(double s_m, double u_m, double t, double h) const {
+    const SwashParameters& p = swash_;
+    if (!p.active) return 0.0;
+    double w = 1.0;
+    if (h > 0.0) {
+        w = 1.0 - h / (2.0 * p.runup2_m);
+        if (w <= 0.0) return 0.0;
+    } else if (s_m < p.shoreline_m - 2.0 * p.runup2_m / p.foreshoreSlope - 10.0) {
+        return 0.0;
+    }
+    double re = 0.0, im = 0.0;
+    for (size_t j = 0; j < components_.size(); ++j) {
+        if (swashAmplitude_[j] == 0.0) continue;
+        const double psi = swashPhase_[j] + tracks_[j].ku * u_m - components_[j].omega_radps * t;
+        double sn, cs;
+        SinCos(psi, sn, cs);
+        re += swashAmplitude_[j] * cs;
+        im += swashAmplitude_[j] * sn;
+    }
+    // Rayleigh envelope: mean √π/2 H_rms, standard deviation √(1 − π/4) H_rms.
+    const double g =
+        (2.0 * std::sqrt(re * re + im * im) / p.breakerRms_m - 0.5 * std::sqrt(std::numbers::pi)) /
+        std::sqrt(1.0 - 0.25 * std::numbers::pi);
+    const double c = p.cuspAmplitude;
+    const double m =
+        (1.0 + c * std::cos(kTwoPi * u_m / p.cuspSpacing_m)) / std::sqrt(1.0 + 0.5 * c * c);
+    return w * (p.setup_m + 0.25 * p.significant_m * g * m);
+}
+// --- end swash
 
 double SurfWaves::DepthTable(const std::vector<double>& t, double h) const {
     return Interp(t, h / dh_m_);
@@ -241,8 +396,11 @@ SurfWaves::Bound SurfWaves::BoundAtDepths(double minDepth_m, const std::vector<B
             longest = std::max(longest, invTanh);
         }
         // Height: cap · Re(Σ a e^{iψ}) ≤ min(|Σ a e^{iψ}|, γh/2) ≤ min(Σ a, γh/2) (see Terms).
+        // Behind a bar the cap only falls (Shelter ≤ 1); the swash adds at most its maximum where
+        // it reaches (depth below 2 R2).
         const double halfGammaH = 0.5 * settings_.breakerIndex * h1;
         b.height_m += std::min(amplitude, halfGammaH);
+        if (swash_.active && h0 < 2.0 * swash_.runup2_m) b.height_m += swash_.max_m;
         b.horizontal_m += std::min(orbit, halfGammaH * longest);
         out.height_m = std::max(out.height_m, b.height_m);
         out.horizontal_m = std::max(out.horizontal_m, b.horizontal_m);
@@ -274,6 +432,8 @@ SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* inf
         local.breaking.broken = p.s_m <= sBreak_m_;
         local.breaking.timeSinceBreaking_s = Interp(breakTime_s_, tableIndex);
     }
+    // Swash run-up (Swash_m): the waterline's rise and fall, in the inner surf and on the beach.
+    out.displacement.z += Swash_m(p.s_m, p.u_m, t, h);
     if (weights.AllDeep() || h <= 0.0 || incoming_.empty()) {
         if (info) *info = local;
         return out;
@@ -332,7 +492,9 @@ SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* inf
         envelopeIm += a * sn;
     }
     const double A = std::sqrt(envelopeRe * envelopeRe + envelopeIm * envelopeIm);
-    const double gammaH = settings_.breakerIndex * h;
+    // Behind a sandbar only the energy flux the bar let through arrives (Shelter).
+    const double shelter = Shelter(p.s_m, p.u_m, h);
+    const double gammaH = settings_.breakerIndex * h * shelter;
     const double cap = 2.0 * A > gammaH ? gammaH / (2.0 * A) : 1.0;
     // Steepening: Q rises from its deep value to 1 (the trochoid's cusp) as the group height
     // approaches the breaker height.
@@ -391,7 +553,8 @@ SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* inf
     }
     local.envelope_m = A * cap;
     local.unbrokenHeight_m = 2.0 * A;
-    local.breaking.intensity = cap < 1.0 ? 1.0 - cap * cap : 0.0;
+    // Sheltered waves are already broken down to what the bar let through: no new breaking.
+    local.breaking.intensity = cap < 1.0 && shelter == 1.0 ? 1.0 - cap * cap : 0.0;
     if (info) *info = local;
     return out;
 }

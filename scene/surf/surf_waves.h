@@ -151,7 +151,43 @@ class SurfWaves {
     // never break before the shore.
     double BreakerLine_m() const { return sBreak_m_; }
 
+    // --- Swash run-up (seed 003: "the cusp surf sporadically washes farther up inland in various
+    // places and then retreats"). Published scale (Stockdon, Holman, Howd & Sallenger, Coastal
+    // Eng. 53, 573 (2006), eqs. 10-12, deep-water Hs H0, peak wavelength L0 = g Tp²/2π,
+    // foreshore slope β_f): setup η̄ = 0.35 β_f √(H0 L0), significant swash height
+    // S = √(H0 L0 (0.563 β_f² + 0.004)), 2 % run-up R2 = 1.1 (η̄ + S/2).
+    // The water level the swash adds is ζ = w · (η̄ + S/4 · g(t, u) · m(u)):
+    //  g, the surf beat: the incoming wave-group envelope 2A at the mean breaker line (the surf
+    //    components shoaled there, at alongshore u) as (2A/H_rms − √π/2) / √(1 − π/4), zero mean
+    //    and unit variance for a Rayleigh-distributed envelope (Longuet-Higgins 1952), so ζ has
+    //    mean η̄ and significant height 4σ = S;
+    //  m, the cusps: (1 + c cos 2πu/λ) / √(1 + c²/2) (mean square 1) with the cusp spacing λ and
+    //    amplitude c of environment.ocean.surf.swash;
+    //  w, where: 1 on the beach (up to 2 R2 / β_f + 10 m landward of the still-water line, where
+    //    the swash can never reach), falling linearly to 0 at depth 2 R2 seaward.
+    // On the beach the water is flat at tide + ζ and the seabed clamp puts the waterline where the
+    // sand rises above it. 0 without swash (disabled, no components, no breaker line).
+    struct SwashParameters {
+        bool active = false;
+        double H0_m = 0.0, L0_m = 0.0, foreshoreSlope = 0.0;
+        double setup_m = 0.0, significant_m = 0.0, runup2_m = 0.0;  // η̄, S, R2
+        double cuspSpacing_m = 0.0, cuspAmplitude = 0.0;
+        double shoreline_m = 0.0;   // cross-shore s of the still-water line (plane beach)
+        double breakerRms_m = 0.0;  // H_rms of the surf components at the breaker line
+        // Largest ζ anywhere, ever (for surface bounds): the envelope at most 2 Σ A_j there, the
+        // cusp factor at most (1 + c) / √(1 + c²/2).
+        double max_m = 0.0;
+    };
+    const SwashParameters& Swash() const { return swash_; }
+    // ζ (m, added to the surface height) at shore point (s, u), time t, still-water depth h.
+    double Swash_m(double s_m, double u_m, double t_s, double depth_m) const;
+    // --- end swash
+
   private:
+    void BuildSwash();
+    SwashParameters swash_;
+    std::vector<double> swashAmplitude_, swashPhase_;  // per component at the breaker line
+
     struct Track {                             // per component
         double k0 = 0.0, ks0 = 0.0, ku = 0.0;  // deep wavenumber and its shore components
         double cg0 = 0.0, cos0 = 1.0;
@@ -169,6 +205,27 @@ class SurfWaves {
         double k, kx, amplitude, invTanh, cg;
     };
     double DepthTable(const std::vector<double>& t, double h) const;
+
+    // --- Sandbar shelter (seed 003, "Sandbars"): waves that broke on a bar arrive shoreward of
+    // it with only the energy flux the bar let through. Per sandbar region a table over the bar's
+    // alongshore extent and its cross-shore span from the seaward foot to the shoreline holds the
+    // running minimum, walking landward, of the saturated breakers' energy-flux proxy h √cg(h)
+    // ((γh)² cg ∝ E cg at the breaker cap; the dominant component's group speed). Shelter is
+    // that minimum over the local value, at most 1: the local breaker cap γ h becomes
+    // γ h · Shelter. On a plane beach (h √cg falls monotonically shoreward) it is exactly 1.
+    struct BarShelter {
+        double u0_m = 0.0, du_m = 1.0;  // first column's offset in its region, column step
+        double s0_m = 0.0;              // seaward foot of the bar (row 0), rows ds_m_ landward
+        int nu = 0, ns = 0;
+        std::vector<double> fluxMin;  // [column * ns + row]
+    };
+    void BuildShelters();
+    double FluxProxy(double h) const;
+    double Shelter(double s_m, double u_m, double h) const;
+    std::vector<int> shelterOfRegion_;  // index into shelters_ or −1
+    std::vector<BarShelter> shelters_;
+    size_t dominant_ = 0;
+    // --- end sandbar shelter
 
     Bathymetry bathy_;
     std::vector<SurfComponent> components_;

@@ -189,6 +189,51 @@ TEST_F(SurfConfigTest, ErrorsNameTheKey) {
         << missing;
 }
 
+TEST_F(SurfConfigTest, SprayAndSwashKeysAreRead) {
+    const Scenario s = LoadScenario(Write(
+        WithSurf("      shoreline: {origin_m: [0, 0], azimuth_deg: 0}\n"
+                 "      spray: {enabled: false, radius_m: 90, cell_m: 2.5, interval_s: 0.3,\n"
+                 "              probability: 0.4, droplets_per_burst: 7, lifetime_s: 2.2,\n"
+                 "              launch_speed_mps: 4.5, drag_time_s: 0.3, clump_radius_m: 0.2,\n"
+                 "              opacity: 0.9, max_particles: 5000, seed: 9}\n"
+                 "      swash: {enabled: false, cusp_spacing_m: 35, cusp_amplitude: 0.25}\n")));
+    const SpraySettings& p = s.environment.ocean.surf->spray;
+    EXPECT_FALSE(p.enabled);
+    EXPECT_DOUBLE_EQ(p.radius_m, 90.0);
+    EXPECT_DOUBLE_EQ(p.cell_m, 2.5);
+    EXPECT_DOUBLE_EQ(p.interval_s, 0.3);
+    EXPECT_DOUBLE_EQ(p.probability, 0.4);
+    EXPECT_EQ(p.dropletsPerBurst, 7);
+    EXPECT_DOUBLE_EQ(p.lifetime_s, 2.2);
+    EXPECT_DOUBLE_EQ(p.launchSpeed_mps, 4.5);
+    EXPECT_DOUBLE_EQ(p.dragTime_s, 0.3);
+    EXPECT_DOUBLE_EQ(p.clumpRadius_m, 0.2);
+    EXPECT_DOUBLE_EQ(p.opacity, 0.9);
+    EXPECT_EQ(p.maxParticles, 5000);
+    EXPECT_EQ(p.seed, 9u);
+    const SwashSettings& w = s.environment.ocean.surf->swash;
+    EXPECT_FALSE(w.enabled);
+    EXPECT_DOUBLE_EQ(w.cuspSpacing_m, 35.0);
+    EXPECT_DOUBLE_EQ(w.cuspAmplitude, 0.25);
+
+    std::string text = WithSurf(
+        "      shoreline: {origin_m: [0, 0], azimuth_deg: 0}\n"
+        "      spray: {radius_m: 90, lifetme_s: 2}\n");
+    const std::string unknown = ErrorFor(text);
+    EXPECT_EQ(unknown.rfind(At(text, "spray:", "lifetme_s") +
+                                "environment.ocean.surf.spray.lifetme_s: expected one of the keys",
+                            0),
+              0u)
+        << unknown;
+    EXPECT_NE(unknown.find("did you mean 'lifetime_s'?"), std::string::npos) << unknown;
+    text = WithSurf(
+        "      shoreline: {origin_m: [0, 0], azimuth_deg: 0}\n"
+        "      swash: {cusp_amplitude: 1.5}\n");
+    EXPECT_EQ(ErrorFor(text), At(text, "swash:", "1.5") +
+                                  "environment.ocean.surf.swash.cusp_amplitude: expected a number "
+                                  "in [0, 1], found 1.5");
+}
+
 TEST_F(SurfConfigTest, DepthGridExcludesTheSlopeKeys) {
     {
         auto out = OIIO::ImageOutput::create((folder_ / "bathy.tif").string());
