@@ -93,12 +93,16 @@ class AnalyticSky {
   private:
     // Preetham's radiance without the daylight scale and without night terms.
     glm::dvec3 PreethamRadiance(const glm::dvec3& d) const;
-    double Perez(const double coeffs[5], double cosTheta, double gamma) const;
+    // Perez's F(θ, γ) for Y, x and y (Preetham's three coefficient sets) at once.
+    glm::dvec3 Perez(double cosTheta, double gamma, double cosGamma) const;
+    // The grey night-sky part of Radiance (moonless and moonlit sky) toward unit d, z ≥ 0.
+    double NightRadiance(const glm::dvec3& d) const;
 
     SkyConditions conditions_;
     glm::dvec3 sunDir_;
     glm::dvec3 moonDir_{0.0, 0.0, -1.0};
-    double moonZenith_rad_ = 3.14159265358979323846;
+    MoonlitSky moonlit_;    // no moon unless conditions.moon
+    glm::dvec3 sunForSky_;  // the sun, or its azimuth on the horizon once it has set
     double dayScale_ = 1.0;
     glm::dvec3 sunRadiance_;
     glm::dvec3 sunIlluminanceRgb_;

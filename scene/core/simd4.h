@@ -24,6 +24,27 @@ inline F4 Dot4(F4 ax, F4 ay, F4 az, F4 bx, F4 by, F4 bz) {
     return _mm_add_ps(_mm_add_ps(_mm_mul_ps(ax, bx), _mm_mul_ps(ay, by)), _mm_mul_ps(az, bz));
 }
 
+// e^x, four lanes, for x in [−87, 88] (clamped to it: e^−87 < 1.7e-38, e^88 < FLT_MAX):
+// x = n ln 2 + r with |r| ≤ ln 2 / 2 (ln 2 split in two so that n ln 2 is exact, Cody & Waite,
+// "Software Manual for the Elementary Functions" (1980) ch. 6), e^r by its degree-6 Taylor
+// polynomial (remainder ≤ (ln 2 / 2)^7 / 7! · √2 < 1.7e-7 relative), 2^n by the exponent bits.
+inline F4 Exp4(F4 x) {
+    x = _mm_min_ps(_mm_max_ps(x, _mm_set1_ps(-87.0f)), _mm_set1_ps(88.0f));
+    const __m128i n = _mm_cvtps_epi32(_mm_mul_ps(x, _mm_set1_ps(1.44269504f)));  // round
+    const F4 fn = _mm_cvtepi32_ps(n);
+    F4 r = _mm_sub_ps(x, _mm_mul_ps(fn, _mm_set1_ps(0.693359375f)));
+    r = _mm_sub_ps(r, _mm_mul_ps(fn, _mm_set1_ps(-2.12194440e-4f)));
+    F4 p = _mm_set1_ps(1.0f / 720.0f);
+    p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(1.0f / 120.0f));
+    p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(1.0f / 24.0f));
+    p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(1.0f / 6.0f));
+    p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(0.5f));
+    p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(1.0f));
+    p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(1.0f));
+    const F4 scale = _mm_castsi128_ps(_mm_slli_epi32(_mm_add_epi32(n, _mm_set1_epi32(127)), 23));
+    return _mm_mul_ps(p, scale);
+}
+
 // Loads and stores of count ≤ 4 lanes: a partial last group is padded with a harmless value,
 // so every sample goes through the same four-wide code.
 inline F4 LoadLanes(const float* p, size_t count, float pad) {
