@@ -64,6 +64,38 @@ PlumeScreenBins::PlumeScreenBins(const scene::PlumeField& field, const ChannelCa
         if (behind == 8) continue;
         Rect rect{0, 0, width_, height_};
         if (behind == 0) {
+            // The ellipsoid itself projects inside the box's rectangle; when it lies wholly in
+            // front of the eye its exact extent is tighter (the box's corners reach √3 r).
+            // A plane through the eye q_x = u q_y (camera frame) touches the ellipsoid
+            // {c + S^½ w : |w| ≤ 1}, S = r² diag(σh², σh², σz²) turned into the camera
+            // frame, where nᵀ S n = (nᵀ c)², n = (1, −u, 0): a quadratic in u whose roots bound
+            // the ellipsoid's screen columns (likewise rows with n = (0, −v, 1)); the
+            // tangent-plane test of the dual quadric (Hartley & Zisserman, "Multiple View
+            // Geometry" (2004) §8.3).
+            const glm::dvec3 cc = cameraFromWorld * (c - eye);
+            const glm::dmat3 shape =
+                r2 * cameraFromWorld *
+                glm::dmat3(glm::dvec3(sh * sh, 0.0, 0.0), glm::dvec3(0.0, sh * sh, 0.0),
+                           glm::dvec3(0.0, 0.0, sz * sz)) *
+                glm::transpose(cameraFromWorld);
+            const double syy = shape[1][1];
+            if (cc.y - std::sqrt(syy) > camera.near_m) {
+                // a u² − 2 b u + k = 0 with a < 0 (the eye outside, in front of the shape).
+                const auto extent = [&](double sxx, double sxy, double cx, double& lo, double& hi) {
+                    const double a = syy - cc.y * cc.y, b = sxy - cx * cc.y, k = sxx - cx * cx;
+                    const double root = std::sqrt(std::max(b * b - a * k, 0.0));
+                    lo = (b + root) / a, hi = (b - root) / a;
+                };
+                double u0, u1, v0, v1;
+                extent(shape[0][0], shape[1][0], cc.x, u0, u1);
+                extent(shape[2][2], shape[1][2], cc.z, v0, v1);
+                // Rounding margin: a millionth of the extent.
+                const double du = 1e-6 * (u1 - u0 + 1e-9), dv = 1e-6 * (v1 - v0 + 1e-9);
+                xMin = std::max(xMin, ((u0 - du) / tanH + 1.0) * 0.5 * W);
+                xMax = std::min(xMax, ((u1 + du) / tanH + 1.0) * 0.5 * W);
+                yMin = std::max(yMin, (1.0 - (v1 + dv) / tanV) * 0.5 * H);
+                yMax = std::min(yMax, (1.0 - (v0 - dv) / tanV) * 0.5 * H);
+            }
             const auto clampX = [&](double v) { return int(std::clamp(v, 0.0, double(width_))); };
             const auto clampY = [&](double v) { return int(std::clamp(v, 0.0, double(height_))); };
             rect = {clampX(std::floor(xMin) - 1.0), clampY(std::floor(yMin) - 1.0),
@@ -127,6 +159,7 @@ void PlumeScreenBins::Gather(int x0, int y0, int x1, int y1, float smallPixels, 
     out.near_m = std::numeric_limits<float>::infinity();
     out.far_m = 0.0f;
     out.smallOpticalDepth = 0.0f;
+    out.halfSmallOpticalDepth = 0.0f;
     x1 = std::min(x1, width_), y1 = std::min(y1, height_);
     if (x0 < x1 && y0 < y1) {
         // The rectangle's tiles; their lists are merged in kept order, each puff once.
@@ -151,6 +184,7 @@ void PlumeScreenBins::Gather(int x0, int y0, int x1, int y1, float smallPixels, 
             out.near_m = std::min(out.near_m, data_[kNear][k]);
             out.far_m = std::max(out.far_m, far_[k]);
             if (sigmaPixels_[k] < smallPixels) out.smallOpticalDepth += tauMax_[k];
+            if (sigmaPixels_[k] < 0.5f * smallPixels) out.halfSmallOpticalDepth += tauMax_[k];
         };
         if (lists == 1) {
             for (const uint32_t* p = cur[0]; p != end[0]; ++p) take(*p);
