@@ -3,10 +3,12 @@
 #include "radiometry/sky/analytic_sky.h"
 
 #include <tbb/blocked_range.h>
+#include <tbb/cache_aligned_allocator.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "radiometry/color/rec709.h"
 #include "scene/core/simd4.h"
@@ -42,8 +44,6 @@ glm::vec2 HemiOctFromDirection(glm::vec3 d) {
 // Four-lane helpers for the batched lookups. They reproduce the scalar code's std::min,
 // std::max, std::clamp and std::abs exactly (including which operand a tie or −0 returns), so
 // the batched and scalar lookups agree bit for bit.
-F4 Min4(F4 a, F4 b) { return _mm_min_ps(b, a); }  // std::min(a, b): b when b < a, else a
-F4 Clamp4(F4 v, F4 lo, F4 hi) { return Min4(Max4(v, lo), hi); }
 I4 MinI4(I4 a, I4 b) {  // SSE2 has no pminsd
     const I4 bLess = _mm_cmplt_epi32(b, a);
     return _mm_or_si128(_mm_and_si128(bLess, b), _mm_andnot_si128(bLess, a));
@@ -69,26 +69,59 @@ glm::dvec3 DirectionFromHemiOct(double a, double b) {
     return glm::normalize(d);
 }
 
-// E_h = ∫ L cosθ dω over the upper hemisphere, midpoint rule in (cosθ, φ): dω = dμ dφ. Rows of
-// μ in parallel, each summed on its own and the rows added in order: the same sum for any
-// thread count.
-template <typename RadianceFn>
-glm::dvec3 HorizontalIntegral(const RadianceFn& radiance) {
+// The unit directions of the table's texels (i, j) ↔ hemi-octahedral (a, b) = −1 + 2 (i, j) /
+// (kTableSize − 1), index j·kTableSize + i; the same for every sky, made once.
+struct TexelDirections {
+    std::vector<float, tbb::cache_aligned_allocator<float>> x, y, z;
+};
+const TexelDirections& TableDirections() {
+    static const TexelDirections directions = [] {
+        TexelDirections t;
+        const size_t n = size_t(kTableSize) * kTableSize;
+        t.x.resize(n), t.y.resize(n), t.z.resize(n);
+        for (int j = 0; j < kTableSize; ++j)
+            for (int i = 0; i < kTableSize; ++i) {
+                const glm::dvec3 d = DirectionFromHemiOct(-1.0 + 2.0 * i / (kTableSize - 1),
+                                                          -1.0 + 2.0 * j / (kTableSize - 1));
+                const size_t k = size_t(j) * kTableSize + size_t(i);
+                t.x[k] = float(d.x), t.y[k] = float(d.y), t.z[k] = float(d.z);
+            }
+        return t;
+    }();
+    return directions;
+}
+
+// E_h = ∫ L cosθ dω over the upper hemisphere, midpoint rule in (cosθ, φ): dω = dμ dφ.
+// radiance(x, y, z, rgb) evaluates four directions. Rows of μ in parallel, each summed on its
+// own and the rows added in order: the same sum for any thread count.
+template <typename Radiance4Fn>
+glm::dvec3 HorizontalIntegral(const Radiance4Fn& radiance) {
     constexpr int kMu = 64, kPhi = 128;
-    double sinPhi[kPhi], cosPhi[kPhi];
+    static_assert(kPhi % 4 == 0);
+    alignas(16) float sinPhi[kPhi], cosPhi[kPhi];
     for (int i = 0; i < kPhi; ++i) {
         const double phi = 2.0 * M_PI * (i + 0.5) / kPhi;
-        sinPhi[i] = std::sin(phi), cosPhi[i] = std::cos(phi);
+        sinPhi[i] = float(std::sin(phi)), cosPhi[i] = float(std::cos(phi));
     }
     glm::dvec3 rows[kMu];
     tbb::parallel_for(tbb::blocked_range<int>(0, kMu, 4), [&](const tbb::blocked_range<int>& r) {
         for (int j = r.begin(); j != r.end(); ++j) {
             const double mu = (j + 0.5) / kMu;
-            const double s = std::sqrt(1.0 - mu * mu);
+            const F4 s = _mm_set1_ps(float(std::sqrt(1.0 - mu * mu))), z = _mm_set1_ps(float(mu));
+            F4 sum[3] = {_mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps()};
+            for (int i = 0; i < kPhi; i += 4) {
+                F4 rgb[3];
+                radiance(_mm_mul_ps(s, _mm_load_ps(sinPhi + i)),
+                         _mm_mul_ps(s, _mm_load_ps(cosPhi + i)), z, rgb);
+                for (int c = 0; c < 3; ++c) sum[c] = _mm_add_ps(sum[c], rgb[c]);
+            }
+            alignas(16) float lanes[3][4];
+            for (int c = 0; c < 3; ++c) _mm_store_ps(lanes[c], sum[c]);
             glm::dvec3 row(0.0);
-            for (int i = 0; i < kPhi; ++i)
-                row += radiance(glm::dvec3{s * sinPhi[i], s * cosPhi[i], mu}) * mu;
-            rows[j] = row;
+            for (int c = 0; c < 3; ++c)
+                row[c] = (double(lanes[c][0]) + double(lanes[c][1])) +
+                         (double(lanes[c][2]) + double(lanes[c][3]));
+            rows[j] = row * mu;
         }
     });
     glm::dvec3 sum(0.0);
@@ -155,8 +188,9 @@ AnalyticSky::AnalyticSky(const SkyConditions& c)
     zenithYchroma_ = t2 * (0.00275 * s3 - 0.00610 * s2 + 0.00317 * ts) +
                      T * (-0.04214 * s3 + 0.08970 * s2 - 0.04153 * ts + 0.00516) +
                      (0.15346 * s3 - 0.26756 * s2 + 0.06670 * ts + 0.26688);
-    const glm::dvec3 norm = Perez(1.0, ts, std::cos(ts));
-    normY_ = norm[0], normX_ = norm[1], normYc_ = norm[2];
+    F4 norm[3];
+    Perez4(_mm_set1_ps(1.0f), _mm_set1_ps(float(ts)), _mm_set1_ps(float(std::cos(ts))), norm);
+    normY_ = Lane0(norm[0]), normX_ = Lane0(norm[1]), normYc_ = Lane0(norm[2]);
 
     // The sun: white (D65, equal Rec.709 RGB) at the given illuminance; disc solid angle
     // 2π(1 − cos r).
@@ -169,25 +203,32 @@ AnalyticSky::AnalyticSky(const SkyConditions& c)
     // Preetham integral + the night sky's.
     dayScale_ = 1.0;
     const glm::dvec3 preethamHorizontal =
-        HorizontalIntegral([this](const glm::dvec3& d) { return PreethamRadiance(d); });
+        HorizontalIntegral([this](F4 x, F4 y, F4 z, F4(&rgb)[3]) { Preetham4(x, y, z, rgb); });
     const double preethamE = LuminanceRec709(preethamHorizontal);
     const double sunAltitude_rad = std::asin(std::clamp(sunDir_.z, -1.0, 1.0));
     dayScale_ =
         preethamE > 0.0 ? scene::ClearSkyDiffuseIlluminance_lux(sunAltitude_rad) / preethamE : 0.0;
 
     // Every texel on its own: rows in parallel, the same table for any thread count.
+    const TexelDirections& texels = TableDirections();
     table_.resize(size_t(kTableSize) * size_t(kTableSize), glm::vec4(0.0f));
-    tbb::parallel_for(
-        tbb::blocked_range<int>(0, kTableSize, 8), [&](const tbb::blocked_range<int>& r) {
-            for (int j = r.begin(); j != r.end(); ++j) {
-                for (int i = 0; i < kTableSize; ++i) {
-                    const double a = -1.0 + 2.0 * i / (kTableSize - 1),
-                                 b = -1.0 + 2.0 * j / (kTableSize - 1);
-                    table_[size_t(j) * kTableSize + size_t(i)] =
-                        glm::vec4(glm::vec3(Radiance(DirectionFromHemiOct(a, b))), 0.0f);
-                }
-            }
-        });
+    static_assert(kTableSize % 4 == 0);
+    tbb::parallel_for(tbb::blocked_range<int>(0, kTableSize, 8),
+                      [&](const tbb::blocked_range<int>& r) {
+                          for (int j = r.begin(); j != r.end(); ++j) {
+                              for (int i = 0; i < kTableSize; i += 4) {
+                                  const size_t t = size_t(j) * kTableSize + size_t(i);
+                                  F4 rgb[3];
+                                  Radiance4(_mm_load_ps(&texels.x[t]), _mm_load_ps(&texels.y[t]),
+                                            _mm_load_ps(&texels.z[t]), rgb);
+                                  alignas(16) float lanes[3][4];
+                                  for (int c = 0; c < 3; ++c) _mm_store_ps(lanes[c], rgb[c]);
+                                  for (int k = 0; k < 4; ++k)
+                                      table_[t + size_t(k)] =
+                                          glm::vec4(lanes[0][k], lanes[1][k], lanes[2][k], 0.0f);
+                              }
+                          }
+                      });
 
     horizon_.resize(kHorizonSize + 1, glm::vec4(0.0f));
     for (int i = 0; i <= kHorizonSize; ++i) {
@@ -201,26 +242,85 @@ AnalyticSky::AnalyticSky(const SkyConditions& c)
     skyHorizontal_ = dayScale_ * preethamHorizontal;
     if (c.darkZenithLuminance_cdm2 > 0.0 || moonlit_.Up())
         skyHorizontal_ += HorizontalIntegral(
-            [this](const glm::dvec3& d) { return glm::dvec3(NightRadiance(d)); });
+            [this](F4 x, F4 y, F4 z, F4(&rgb)[3]) { rgb[0] = rgb[1] = rgb[2] = Night4(x, y, z); });
 }
 
-glm::dvec3 AnalyticSky::Perez(double cosTheta, double gamma, double cg) const {
+void AnalyticSky::Perez4(F4 cosTheta, F4 gamma, F4 cosGamma, F4 (&F)[3]) const {
     // F(θ, γ) = (1 + A e^{B / cos θ}) (1 + C e^{D γ} + E cos² γ) (Perez, Seals & Michalsky 1993),
-    // the six exponentials in two four-lane Exp4 (relative error < 1.7e-7, far below the
-    // table's float and the model's own accuracy).
-    cosTheta = std::max(cosTheta, 0.01);
-    const double invCos = 1.0 / cosTheta;
+    // cos θ held at 0.01 or above.
+    const F4 one = _mm_set1_ps(1.0f);
+    const F4 invCos = _mm_div_ps(one, Max4(cosTheta, _mm_set1_ps(0.01f)));
+    const F4 cg2 = _mm_mul_ps(cosGamma, cosGamma);
     const double* c[3] = {coefY_, coefX_, coefYc_};
-    alignas(16) float e1[4], e2[4];
-    _mm_store_ps(e1, Exp4(_mm_setr_ps(float(c[0][1] * invCos), float(c[1][1] * invCos),
-                                      float(c[2][1] * invCos), 0.0f)));
-    _mm_store_ps(e2, Exp4(_mm_setr_ps(float(c[0][3] * gamma), float(c[1][3] * gamma),
-                                      float(c[2][3] * gamma), 0.0f)));
-    glm::dvec3 F;
-    for (int k = 0; k < 3; ++k)
-        F[k] =
-            (1.0 + c[k][0] * double(e1[k])) * (1.0 + c[k][2] * double(e2[k]) + c[k][4] * cg * cg);
-    return F;
+    for (int k = 0; k < 3; ++k) {
+        const auto C = [&](int i) { return _mm_set1_ps(float(c[k][i])); };
+        const F4 horizon = _mm_add_ps(one, _mm_mul_ps(C(0), Exp4(_mm_mul_ps(C(1), invCos))));
+        const F4 sun = _mm_add_ps(_mm_add_ps(one, _mm_mul_ps(C(2), Exp4(_mm_mul_ps(C(3), gamma)))),
+                                  _mm_mul_ps(C(4), cg2));
+        F[k] = _mm_mul_ps(horizon, sun);
+    }
+}
+
+void AnalyticSky::Preetham4(F4 x, F4 y, F4 z, F4 (&rgb)[3]) const {
+    const F4 cosGamma =
+        Clamp4(Dot4(x, y, z, _mm_set1_ps(float(sunForSky_.x)), _mm_set1_ps(float(sunForSky_.y)),
+                    _mm_set1_ps(float(sunForSky_.z))),
+               _mm_set1_ps(-1.0f), _mm_set1_ps(1.0f));
+    F4 F[3];
+    Perez4(z, Acos4(cosGamma), cosGamma, F);
+    const F4 Y = _mm_mul_ps(_mm_set1_ps(float(zenithY_ / normY_)), F[0]);
+    const F4 cx = _mm_mul_ps(_mm_set1_ps(float(zenithX_ / normX_)), F[1]);
+    const F4 cy = _mm_mul_ps(_mm_set1_ps(float(zenithYchroma_ / normYc_)), F[2]);
+    // Rec709FromYxy (X = x / y · Y, Z = (1 − x − y) / y · Y; black where y ≤ 0), negative
+    // components clipped.
+    const F4 positive = _mm_cmpgt_ps(cy, _mm_setzero_ps());
+    const F4 perY = _mm_div_ps(Y, cy);
+    const F4 X = _mm_mul_ps(cx, perY);
+    const F4 Z = _mm_mul_ps(_mm_sub_ps(_mm_sub_ps(_mm_set1_ps(1.0f), cx), cy), perY);
+    const glm::dvec3 m[3] = {Rec709FromXyz({1, 0, 0}), Rec709FromXyz({0, 1, 0}),
+                             Rec709FromXyz({0, 0, 1})};
+    for (int c = 0; c < 3; ++c) {
+        const F4 v = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_set1_ps(float(m[0][c])), X),
+                                           _mm_mul_ps(_mm_set1_ps(float(m[1][c])), Y)),
+                                _mm_mul_ps(_mm_set1_ps(float(m[2][c])), Z));
+        rgb[c] = _mm_and_ps(positive, Max4(v, _mm_setzero_ps()));
+    }
+}
+
+F4 AnalyticSky::Night4(F4 x, F4 y, F4 z) const {
+    const SkyConditions& c = conditions_;
+    F4 grey = _mm_setzero_ps();
+    if (c.darkZenithLuminance_cdm2 > 0.0)
+        grey = DarkSkyLuminanceFromCos4(z, float(c.extinctionV_magPerAirmass),
+                                        float(c.darkZenithLuminance_cdm2));
+    if (moonlit_.Up()) {
+        // The aureole's ρ⁻² peak is held at its 4° value inside 4° of the moon: the sky
+        // table (128² over the hemisphere, ~1° texels) cannot carry a steeper peak without
+        // drawing its texels.
+        constexpr double kMinSeparation_rad = 4.0 * M_PI / 180.0;
+        const F4 cosSeparation =
+            Clamp4(Dot4(x, y, z, _mm_set1_ps(float(moonDir_.x)), _mm_set1_ps(float(moonDir_.y)),
+                        _mm_set1_ps(float(moonDir_.z))),
+                   _mm_set1_ps(-1.0f), _mm_set1_ps(1.0f));
+        const F4 separation = Acos4(cosSeparation);
+        const F4 inside = _mm_cmplt_ps(separation, _mm_set1_ps(float(kMinSeparation_rad)));
+        grey = _mm_add_ps(
+            grey,
+            moonlit_.Luminance4(
+                z, Select4(inside, _mm_set1_ps(float(kMinSeparation_rad)), separation),
+                Select4(inside, _mm_set1_ps(float(std::cos(kMinSeparation_rad))), cosSeparation)));
+    }
+    return grey;
+}
+
+void AnalyticSky::Radiance4(F4 x, F4 y, F4 z, F4 (&rgb)[3]) const {
+    const F4 night = Night4(x, y, z);
+    if (dayScale_ > 0.0) {
+        Preetham4(x, y, z, rgb);
+        for (F4& v : rgb) v = _mm_add_ps(_mm_mul_ps(_mm_set1_ps(float(dayScale_)), v), night);
+    } else {
+        rgb[0] = rgb[1] = rgb[2] = night;
+    }
 }
 
 glm::dvec3 AnalyticSky::Radiance(const glm::dvec3& dIn) const {
@@ -228,39 +328,9 @@ glm::dvec3 AnalyticSky::Radiance(const glm::dvec3& dIn) const {
     if (d.z < 0.0) d = glm::dvec3(d.x, d.y, 0.0);
     const double len = glm::length(d);
     d = len > 0.0 ? d / len : glm::dvec3(0, 0, 1);
-    const glm::dvec3 L = dayScale_ > 0.0 ? dayScale_ * PreethamRadiance(d) : glm::dvec3(0.0);
-    return L + glm::dvec3(NightRadiance(d));
-}
-
-double AnalyticSky::NightRadiance(const glm::dvec3& d) const {
-    const SkyConditions& c = conditions_;
-    double grey = 0.0;
-    if (c.darkZenithLuminance_cdm2 > 0.0)
-        grey += DarkSkyLuminanceFromCos_cdm2(d.z, c.extinctionV_magPerAirmass,
-                                             c.darkZenithLuminance_cdm2);
-    if (moonlit_.Up()) {
-        // The aureole's ρ⁻² peak is held at its 4° value inside 4° of the moon: the sky
-        // table (128² over the hemisphere, ~1° texels) cannot carry a steeper peak without
-        // drawing its texels.
-        constexpr double kMinSeparation_rad = 4.0 * M_PI / 180.0;
-        const double cosSeparation = std::clamp(glm::dot(d, moonDir_), -1.0, 1.0);
-        const double separation_rad = std::acos(cosSeparation);
-        grey +=
-            separation_rad >= kMinSeparation_rad
-                ? moonlit_.Luminance_cdm2(d.z, separation_rad, cosSeparation)
-                : moonlit_.Luminance_cdm2(d.z, kMinSeparation_rad, std::cos(kMinSeparation_rad));
-    }
-    return grey;
-}
-
-glm::dvec3 AnalyticSky::PreethamRadiance(const glm::dvec3& d) const {
-    const double cosGamma = std::clamp(glm::dot(d, sunForSky_), -1.0, 1.0);
-    const double gamma = std::acos(cosGamma);
-    const glm::dvec3 F = Perez(d.z, gamma, cosGamma);
-    const double Y = zenithY_ * F[0] / normY_;
-    const double x = zenithX_ * F[1] / normX_;
-    const double y = zenithYchroma_ * F[2] / normYc_;
-    return glm::max(Rec709FromYxy(Y, x, y), glm::dvec3(0.0));
+    F4 rgb[3];
+    Radiance4(_mm_set1_ps(float(d.x)), _mm_set1_ps(float(d.y)), _mm_set1_ps(float(d.z)), rgb);
+    return {Lane0(rgb[0]), Lane0(rgb[1]), Lane0(rgb[2])};
 }
 
 glm::vec3 AnalyticSky::LookUp(const glm::vec3& d) const {

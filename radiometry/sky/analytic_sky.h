@@ -91,12 +91,14 @@ class AnalyticSky {
     const SkyConditions& Conditions() const { return conditions_; }
 
   private:
-    // Preetham's radiance without the daylight scale and without night terms.
-    glm::dvec3 PreethamRadiance(const glm::dvec3& d) const;
-    // Perez's F(θ, γ) for Y, x and y (Preetham's three coefficient sets) at once.
-    glm::dvec3 Perez(double cosTheta, double gamma, double cosGamma) const;
-    // The grey night-sky part of Radiance (moonless and moonlit sky) toward unit d, z ≥ 0.
-    double NightRadiance(const glm::dvec3& d) const;
+    // Four-lane float forms over unit directions (x, y, z) with z ≥ 0 (the scalar functions are
+    // their lane 0): Perez's F(θ, γ) for Y, x and y (Preetham's three coefficient sets);
+    // Preetham's radiance (no daylight scale); the grey night sky (moonless and moonlit);
+    // Radiance.
+    void Perez4(simd4::F4 cosTheta, simd4::F4 gamma, simd4::F4 cosGamma, simd4::F4 (&F)[3]) const;
+    void Preetham4(simd4::F4 x, simd4::F4 y, simd4::F4 z, simd4::F4 (&rgb)[3]) const;
+    simd4::F4 Night4(simd4::F4 x, simd4::F4 y, simd4::F4 z) const;
+    void Radiance4(simd4::F4 x, simd4::F4 y, simd4::F4 z, simd4::F4 (&rgb)[3]) const;
 
     SkyConditions conditions_;
     glm::dvec3 sunDir_;

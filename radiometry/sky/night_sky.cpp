@@ -13,8 +13,19 @@ constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr double kMoonSemidiameter_rad = 15.54 / 60.0 * kDeg;
 constexpr double kMeanMoonDistance_m = 3.844e8;
 
+using namespace simd4;
+
 // 10^x by e^(x ln 10): cheaper than std::pow.
 double Pow10(double x) { return std::exp(x * std::numbers::ln10); }
+F4 Pow10_4(F4 x) { return Exp4(_mm_mul_ps(x, _mm_set1_ps(std::numbers::ln10_v<float>))); }
+
+// ScatteringAirMassFromCos on four lanes.
+F4 AirMass4(F4 cosZenith) {
+    const F4 c = Clamp4(cosZenith, _mm_setzero_ps(), _mm_set1_ps(1.0f));
+    return _mm_div_ps(_mm_set1_ps(1.0f),
+                      _mm_sqrt_ps(_mm_add_ps(_mm_set1_ps(0.04f),
+                                             _mm_mul_ps(_mm_set1_ps(0.96f), _mm_mul_ps(c, c)))));
+}
 
 }  // namespace
 
@@ -34,8 +45,15 @@ double DarkSkyLuminance_cdm2(double zenith_rad, double k, double zenithLuminance
 }
 
 double DarkSkyLuminanceFromCos_cdm2(double cosZenith, double k, double zenithLuminance_cdm2) {
-    const double X = ScatteringAirMassFromCos(cosZenith);
-    return zenithLuminance_cdm2 * Pow10(-0.4 * k * (X - 1.0)) * X;
+    return Lane0(DarkSkyLuminanceFromCos4(_mm_set1_ps(float(cosZenith)), float(k),
+                                          float(zenithLuminance_cdm2)));
+}
+
+F4 DarkSkyLuminanceFromCos4(F4 cosZenith, float k, float zenithLuminance_cdm2) {
+    const F4 X = AirMass4(cosZenith);
+    const F4 extinction =
+        Pow10_4(_mm_mul_ps(_mm_set1_ps(-0.4f * k), _mm_sub_ps(X, _mm_set1_ps(1.0f))));
+    return _mm_mul_ps(_mm_mul_ps(_mm_set1_ps(zenithLuminance_cdm2), extinction), X);
 }
 
 MoonlitSky::MoonlitSky(double moonZenith_rad, double phaseAngle_rad, double moonDistance_m,
@@ -55,17 +73,31 @@ MoonlitSky::MoonlitSky(double moonZenith_rad, double phaseAngle_rad, double moon
 double MoonlitSky::Luminance_cdm2(double cosZenith, double separation_rad,
                                   double cosSeparation) const {
     if (!(scale_cdm2_ > 0.0)) return 0.0;
-    const double rho_deg = std::max(separation_rad / kDeg, 0.25);  // inside the disc: its edge
-    const double c = cosSeparation;
+    return Lane0(Luminance4(_mm_set1_ps(float(cosZenith)), _mm_set1_ps(float(separation_rad)),
+                            _mm_set1_ps(float(cosSeparation))));
+}
+
+F4 MoonlitSky::Luminance4(F4 cosZenith, F4 separation_rad, F4 cosSeparation) const {
+    if (!(scale_cdm2_ > 0.0)) return _mm_setzero_ps();
+    // Inside the disc: its edge.
+    const F4 rho_deg =
+        Max4(_mm_mul_ps(separation_rad, _mm_set1_ps(float(1.0 / kDeg))), _mm_set1_ps(0.25f));
     // 10^5.36 = 229 086.77.
-    const double fRayleigh = 229086.76527677748 * (1.06 + c * c);
+    const F4 fRayleigh =
+        _mm_mul_ps(_mm_set1_ps(229086.77f),
+                   _mm_add_ps(_mm_set1_ps(1.06f), _mm_mul_ps(cosSeparation, cosSeparation)));
     // K&S switch from the exponential to the ρ⁻² form at 10°, leaving a 28 % step (7.9e5 vs
     // 6.2e5); switching where the two forms meet, 8.45°, keeps the sky continuous.
-    constexpr double kMieSwitch_deg = 8.45;
-    const double fMie =
-        rho_deg >= kMieSwitch_deg ? Pow10(6.15 - rho_deg / 40.0) : 6.2e7 / (rho_deg * rho_deg);
-    const double X = ScatteringAirMassFromCos(cosZenith);
-    return scale_cdm2_ * (fRayleigh + fMie) * (1.0 - Pow10(-0.4 * k_ * X));
+    constexpr float kMieSwitch_deg = 8.45f;
+    const F4 fMie = Select4(
+        _mm_cmpge_ps(rho_deg, _mm_set1_ps(kMieSwitch_deg)),
+        Pow10_4(_mm_sub_ps(_mm_set1_ps(6.15f), _mm_mul_ps(rho_deg, _mm_set1_ps(1.0f / 40.0f)))),
+        _mm_div_ps(_mm_set1_ps(6.2e7f), _mm_mul_ps(rho_deg, rho_deg)));
+    const F4 X = AirMass4(cosZenith);
+    const F4 sky =
+        _mm_sub_ps(_mm_set1_ps(1.0f), Pow10_4(_mm_mul_ps(_mm_set1_ps(-0.4f * float(k_)), X)));
+    return _mm_mul_ps(_mm_mul_ps(_mm_set1_ps(float(scale_cdm2_)), _mm_add_ps(fRayleigh, fMie)),
+                      sky);
 }
 
 double MoonlitSkyLuminance_cdm2(double skyZenith_rad, double moonZenith_rad, double separation_rad,

@@ -3,6 +3,8 @@
 // PASP 103, 1033 (1991) (K&S below).
 #pragma once
 
+#include "scene/core/simd4.h"
+
 namespace seasense::radiometry {
 
 // One nanolambert in cd/m²: 1 L = 1/π cd/cm² = 10⁴/π cd/m².
@@ -27,6 +29,9 @@ double DarkSkyLuminance_cdm2(double zenith_rad, double k_magPerAirmass,
 // The same from the cosine of the zenith distance.
 double DarkSkyLuminanceFromCos_cdm2(double cosZenith, double k_magPerAirmass,
                                     double zenithLuminance_cdm2);
+// Four lanes of DarkSkyLuminanceFromCos_cdm2 in float (the scalar forms are its lane 0).
+simd4::F4 DarkSkyLuminanceFromCos4(simd4::F4 cosZenith, float k_magPerAirmass,
+                                   float zenithLuminance_cdm2);
 
 // Luminance (cd/m²) of the sky at zenith distance z_rad lit by moonlight: K&S eqs. 15–21,
 // B = f(ρ) · I* · 10^(−0.4 k X_moon) · [1 − 10^(−0.4 k X)] nL, with the scattering function
@@ -51,6 +56,9 @@ class MoonlitSky {
     // Luminance (cd/m²) toward a sky direction with cos zenith cosZenith at separation_rad
     // from the moon (cosSeparation = cos separation_rad, given to save the cosine).
     double Luminance_cdm2(double cosZenith, double separation_rad, double cosSeparation) const;
+    // Four lanes of it in float (Luminance_cdm2 is its lane 0).
+    simd4::F4 Luminance4(simd4::F4 cosZenith, simd4::F4 separation_rad,
+                         simd4::F4 cosSeparation) const;
     // Whether any of the moon's disc is up (else every luminance is 0).
     bool Up() const { return scale_cdm2_ > 0.0; }
 

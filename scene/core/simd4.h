@@ -16,6 +16,9 @@ inline F4 Set4(float v) { return _mm_set1_ps(v); }
 inline F4 Abs4(F4 v) { return _mm_andnot_ps(_mm_set1_ps(-0.0f), v); }
 // std::max(a, b): b when a < b, else a (same NaN and ±0 behaviour).
 inline F4 Max4(F4 a, F4 b) { return _mm_max_ps(b, a); }
+// std::min(a, b): b when b < a, else a.
+inline F4 Min4(F4 a, F4 b) { return _mm_min_ps(b, a); }
+inline F4 Clamp4(F4 v, F4 lo, F4 hi) { return Min4(Max4(v, lo), hi); }
 inline F4 Select4(F4 mask, F4 a, F4 b) {
     return _mm_or_ps(_mm_and_ps(mask, a), _mm_andnot_ps(mask, b));
 }
@@ -44,6 +47,26 @@ inline F4 Exp4(F4 x) {
     const F4 scale = _mm_castsi128_ps(_mm_slli_epi32(_mm_add_epi32(n, _mm_set1_epi32(127)), 23));
     return _mm_mul_ps(p, scale);
 }
+
+// acos x, four lanes, x clamped to [−1, 1]: Abramowitz & Stegun 4.4.46,
+// acos|x| = √(1 − |x|) Σ a_k |x|^k with |error| ≤ 2e-8 rad (plus float rounding), and
+// acos x = π − acos|x| for x < 0.
+inline F4 Acos4(F4 x) {
+    const F4 ax = _mm_min_ps(Abs4(x), _mm_set1_ps(1.0f));
+    F4 p = _mm_set1_ps(-0.0012624911f);
+    p = _mm_add_ps(_mm_mul_ps(p, ax), _mm_set1_ps(0.0066700901f));
+    p = _mm_add_ps(_mm_mul_ps(p, ax), _mm_set1_ps(-0.0170881256f));
+    p = _mm_add_ps(_mm_mul_ps(p, ax), _mm_set1_ps(0.0308918810f));
+    p = _mm_add_ps(_mm_mul_ps(p, ax), _mm_set1_ps(-0.0501743046f));
+    p = _mm_add_ps(_mm_mul_ps(p, ax), _mm_set1_ps(0.0889789874f));
+    p = _mm_add_ps(_mm_mul_ps(p, ax), _mm_set1_ps(-0.2145988016f));
+    p = _mm_add_ps(_mm_mul_ps(p, ax), _mm_set1_ps(1.5707963050f));
+    const F4 r = _mm_mul_ps(_mm_sqrt_ps(_mm_sub_ps(_mm_set1_ps(1.0f), ax)), p);
+    return Select4(_mm_cmplt_ps(x, _mm_setzero_ps()), _mm_sub_ps(_mm_set1_ps(3.14159265f), r), r);
+}
+
+// Lane 0 of v.
+inline float Lane0(F4 v) { return _mm_cvtss_f32(v); }
 
 // Loads and stores of count ≤ 4 lanes: a partial last group is padded with a harmless value,
 // so every sample goes through the same four-wide code.
