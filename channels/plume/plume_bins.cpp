@@ -64,6 +64,38 @@ PlumeScreenBins::PlumeScreenBins(const scene::PlumeField& field, const ChannelCa
         if (behind == 8) continue;
         Rect rect{0, 0, width_, height_};
         if (behind == 0) {
+            // The ellipsoid itself projects inside the box's rectangle; when it lies wholly in
+            // front of the eye its exact extent is tighter (the box's corners reach √3 r).
+            // A plane through the eye q_x = u q_y (camera frame) touches the ellipsoid
+            // {c + S^½ w : |w| ≤ 1}, S = r² diag(σh², σh², σz²) turned into the camera
+            // frame, where nᵀ S n = (nᵀ c)², n = (1, −u, 0): a quadratic in u whose roots bound
+            // the ellipsoid's screen columns (likewise rows with n = (0, −v, 1)); the
+            // tangent-plane test of the dual quadric (Hartley & Zisserman, "Multiple View
+            // Geometry" (2004) §8.3).
+            const glm::dvec3 cc = cameraFromWorld * (c - eye);
+            const glm::dmat3 shape =
+                r2 * cameraFromWorld *
+                glm::dmat3(glm::dvec3(sh * sh, 0.0, 0.0), glm::dvec3(0.0, sh * sh, 0.0),
+                           glm::dvec3(0.0, 0.0, sz * sz)) *
+                glm::transpose(cameraFromWorld);
+            const double syy = shape[1][1];
+            if (cc.y - std::sqrt(syy) > camera.near_m) {
+                // a u² − 2 b u + k = 0 with a < 0 (the eye outside, in front of the shape).
+                const auto extent = [&](double sxx, double sxy, double cx, double& lo, double& hi) {
+                    const double a = syy - cc.y * cc.y, b = sxy - cx * cc.y, k = sxx - cx * cx;
+                    const double root = std::sqrt(std::max(b * b - a * k, 0.0));
+                    lo = (b + root) / a, hi = (b - root) / a;
+                };
+                double u0, u1, v0, v1;
+                extent(shape[0][0], shape[1][0], cc.x, u0, u1);
+                extent(shape[2][2], shape[1][2], cc.z, v0, v1);
+                // Rounding margin: a millionth of the extent.
+                const double du = 1e-6 * (u1 - u0 + 1e-9), dv = 1e-6 * (v1 - v0 + 1e-9);
+                xMin = std::max(xMin, ((u0 - du) / tanH + 1.0) * 0.5 * W);
+                xMax = std::min(xMax, ((u1 + du) / tanH + 1.0) * 0.5 * W);
+                yMin = std::max(yMin, (1.0 - (v1 + dv) / tanV) * 0.5 * H);
+                yMax = std::min(yMax, (1.0 - (v0 - dv) / tanV) * 0.5 * H);
+            }
             const auto clampX = [&](double v) { return int(std::clamp(v, 0.0, double(width_))); };
             const auto clampY = [&](double v) { return int(std::clamp(v, 0.0, double(height_))); };
             rect = {clampX(std::floor(xMin) - 1.0), clampY(std::floor(yMin) - 1.0),
@@ -127,6 +159,7 @@ void PlumeScreenBins::Gather(int x0, int y0, int x1, int y1, float smallPixels, 
     out.near_m = std::numeric_limits<float>::infinity();
     out.far_m = 0.0f;
     out.smallOpticalDepth = 0.0f;
+    out.halfSmallOpticalDepth = 0.0f;
     x1 = std::min(x1, width_), y1 = std::min(y1, height_);
     if (x0 < x1 && y0 < y1) {
         // The rectangle's tiles; their lists are merged in kept order, each puff once.
@@ -151,6 +184,7 @@ void PlumeScreenBins::Gather(int x0, int y0, int x1, int y1, float smallPixels, 
             out.near_m = std::min(out.near_m, data_[kNear][k]);
             out.far_m = std::max(out.far_m, far_[k]);
             if (sigmaPixels_[k] < smallPixels) out.smallOpticalDepth += tauMax_[k];
+            if (sigmaPixels_[k] < 0.5f * smallPixels) out.halfSmallOpticalDepth += tauMax_[k];
         };
         if (lists == 1) {
             for (const uint32_t* p = cur[0]; p != end[0]; ++p) take(*p);
@@ -187,28 +221,8 @@ void PlumeScreenBins::Copy(List& list) const {
 
 namespace {
 
+using simd4::Exp4;
 using simd4::F4;
-
-// e^x for x ≤ 0, four lanes: x = n ln 2 + r with |r| ≤ ln 2 / 2 (ln 2 split in two so that
-// n ln 2 is exact, Cody & Waite, "Software Manual for the Elementary Functions" (1980) ch. 6),
-// e^r by its degree-6 Taylor polynomial (remainder ≤ (ln 2 / 2)^7 / 7! · √2 < 1.7e-7
-// relative), 2^n by the exponent bits. Arguments below −87 give e^−87 (< 1.7e-38, nothing here).
-inline F4 Exp4(F4 x) {
-    x = _mm_max_ps(x, _mm_set1_ps(-87.0f));
-    const __m128i n = _mm_cvtps_epi32(_mm_mul_ps(x, _mm_set1_ps(1.44269504f)));  // round
-    const F4 fn = _mm_cvtepi32_ps(n);
-    F4 r = _mm_sub_ps(x, _mm_mul_ps(fn, _mm_set1_ps(0.693359375f)));
-    r = _mm_sub_ps(r, _mm_mul_ps(fn, _mm_set1_ps(-2.12194440e-4f)));
-    F4 p = _mm_set1_ps(1.0f / 720.0f);
-    p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(1.0f / 120.0f));
-    p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(1.0f / 24.0f));
-    p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(1.0f / 6.0f));
-    p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(0.5f));
-    p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(1.0f));
-    p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(1.0f));
-    const F4 scale = _mm_castsi128_ps(_mm_slli_epi32(_mm_add_epi32(n, _mm_set1_epi32(127)), 23));
-    return _mm_mul_ps(p, scale);
-}
 
 // FastErf on four lanes (A&S 7.1.26 with Exp4; |error| ≤ 1.5e-7 + 2e-7).
 inline F4 Erf4(F4 x) {

@@ -60,12 +60,13 @@ class PlumeScreenBins {
     // tiles), in field order, padded with an inert puff to a multiple of 4; with the nearest
     // and farthest range (m) where they can matter and the sum of the largest optical depths
     // (through the centre along the longest axis) of those with σ under smallPixels pixels at
-    // their distance. With copy, their data is also gathered into contiguous arrays
-    // (worth it when the list serves many rays).
+    // their distance (and of those under half that). With copy, their data is also gathered into
+    // contiguous arrays (worth it when the list serves many rays).
     struct List {
         size_t count = 0;  // puffs (index and the arrays hold count rounded up to 4)
         float near_m = 0.0f, far_m = 0.0f;
         float smallOpticalDepth = 0.0f;
+        float halfSmallOpticalDepth = 0.0f;
         bool copied = false;
         std::vector<uint32_t> index;  // kept positions
         std::vector<float> data[13];  // per field of Arrays, when copied

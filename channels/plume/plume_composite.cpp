@@ -209,7 +209,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     struct CellRow {
         std::vector<uint32_t> index, start, count;
         std::vector<float> near_m, far_m;
-        std::vector<float> smallOpticalDepth;
+        std::vector<float> smallOpticalDepth, halfSmallOpticalDepth;
     };
     std::vector<CellRow> cellRows{size_t(cellsY)};
     // Pass 1, the cells' lists and the nodes traced to the sky: each node by the cell it is
@@ -226,6 +226,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             row.near_m.assign(size_t(cellsX), 0.0f);
             row.far_m.assign(size_t(cellsX), 0.0f);
             row.smallOpticalDepth.assign(size_t(cellsX), 0.0f);
+            row.halfSmallOpticalDepth.assign(size_t(cellsX), 0.0f);
             for (int cx = 0; cx < cellsX; ++cx) {
                 bins.Gather(cx * kCell, cy * kCell, cx * kCell + kCell + 1, cy * kCell + kCell + 1,
                             float(kCell), false, list);
@@ -236,6 +237,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                 row.near_m[size_t(cx)] = list.near_m;
                 row.far_m[size_t(cx)] = list.far_m;
                 row.smallOpticalDepth[size_t(cx)] = list.smallOpticalDepth;
+                row.halfSmallOpticalDepth[size_t(cx)] = list.halfSmallOpticalDepth;
                 for (int k = 0; k < 4; ++k) {
                     const int nx = cx + k % 2, ny = cy + k / 2;
                     if ((nx > cx && nx < cellsX) || (ny > cy && ny < cellsY)) continue;
@@ -248,6 +250,30 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             row.start[size_t(cellsX)] = uint32_t(row.index.size());
         }
     });
+
+    // Whether the sky traces at the four corners of a cell (00, 10, 01, 11) may be blended:
+    // their transmittances agree within kInterpolationTolerance, their temperatures (of the
+    // corners that see absorbing puffs; the others have none) within kInterpolationTolerance_K,
+    // and the puffs the corners could miss are faint (not fine). clear: every corner sees no
+    // puff, so the blend is zero.
+    const auto Smooth = [](const BandTrace* const corner[4], bool fine, bool& clear) {
+        float lo = 1.0f, hi = 0.0f, tauHi = 0.0f;
+        float tLo = std::numeric_limits<float>::infinity(), tHi = 0.0f;
+        for (int k = 0; k < 4; ++k) {
+            const float T = std::exp(-corner[k]->opticalDepth);
+            lo = std::min(lo, T), hi = std::max(hi, T);
+            tauHi = std::max(tauHi, corner[k]->opticalDepth);
+            if (corner[k]->temperature_K > 0.0f) {
+                tLo = std::min(tLo, corner[k]->temperature_K);
+                tHi = std::max(tHi, corner[k]->temperature_K);
+            }
+        }
+        if (tHi == 0.0f) tLo = 0.0f;
+        const bool smooth =
+            !fine && hi - lo <= kInterpolationTolerance && tHi - tLo <= kInterpolationTolerance_K;
+        clear = smooth && tauHi == 0.0f;
+        return smooth;
+    };
 
     // Pass 2, cells in parallel (a row of cells each); each pixel depends only on its own rays
     // and the cell's corner nodes.
@@ -265,35 +291,49 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                     list.near_m = row.near_m[size_t(cx)];
                     list.far_m = row.far_m[size_t(cx)];
                     list.smallOpticalDepth = row.smallOpticalDepth[size_t(cx)];
+                    list.halfSmallOpticalDepth = row.halfSmallOpticalDepth[size_t(cx)];
                     list.copied = false;
                     // The ranges where the cell's puffs can matter.
                     const float dNear = list.near_m, dFar = list.far_m;
-                    const bool fine = list.smallOpticalDepth > kInterpolationTolerance;
                     const BandTrace* corner[4];
                     for (int k = 0; k < 4; ++k)
                         corner[k] =
                             &nodes[size_t(cy + k / 2) * size_t(nodesX) + size_t(cx + k % 2)];
-                    // The corners agree and the puffs the corners could miss are faint:
-                    // bilinear interpolation of the sky traces.
-                    // (Temperatures of corners that see absorbing puffs: the others have none.)
-                    float lo = 1.0f, hi = 0.0f, tauHi = 0.0f;
-                    float tLo = std::numeric_limits<float>::infinity(), tHi = 0.0f;
-                    for (int k = 0; k < 4; ++k) {
-                        const float T = std::exp(-corner[k]->opticalDepth);
-                        lo = std::min(lo, T), hi = std::max(hi, T);
-                        tauHi = std::max(tauHi, corner[k]->opticalDepth);
-                        if (corner[k]->temperature_K > 0.0f) {
-                            tLo = std::min(tLo, corner[k]->temperature_K);
-                            tHi = std::max(tHi, corner[k]->temperature_K);
-                        }
-                    }
-                    if (tHi == 0.0f) tLo = 0.0f;
-                    const bool smooth = !fine && hi - lo <= kInterpolationTolerance &&
-                                        tHi - tLo <= kInterpolationTolerance_K;
-                    // Clear sky at every corner and only faint puffs the corners could miss:
-                    // the sky pixels' blended traces are zero, so only pixels with nearer
-                    // surfaces (which trace their own rays) can change.
-                    const bool clearSky = smooth && tauHi == 0.0f;
+                    bool clearSky = false;
+                    const bool smooth =
+                        Smooth(corner, list.smallOpticalDepth > kInterpolationTolerance, clearSky);
+                    // Where the cell is not smooth, its sky pixels are refined on 2 × 2-pixel
+                    // sub-cells: sky traces at the 3 × 3 nodes every 2 pixels (made when
+                    // the first sky pixel needs them), the same criteria with the puffs
+                    // smaller than a sub-cell, and the pixels of a sub-cell that is not smooth
+                    // traced one by one (the nodes' pixels take their node's trace).
+                    bool refined = false;
+                    BandTrace sub[3][3];
+                    bool subSmooth[2][2], subClear[2][2];
+                    const auto Refine = [&] {
+                        refined = true;
+                        bins.Copy(list);
+                        for (int b = 0; b < 3; ++b)
+                            for (int a = 0; a < 3; ++a) {
+                                if (a % 2 == 0 && b % 2 == 0) {
+                                    sub[b][a] = *corner[(b / 2) * 2 + a / 2];
+                                    continue;
+                                }
+                                const int nx = cx * kCell + a * (kCell / 2),
+                                          ny = cy * kCell + b * (kCell / 2);
+                                sub[b][a] =
+                                    bins.Trace(list, PixelDirection(nx, ny), kPlumeSkyRange_m);
+                                ++rowTraces[size_t(cy)];
+                                rowTests[size_t(cy)] += list.size();
+                            }
+                        const bool subFine = list.halfSmallOpticalDepth > kInterpolationTolerance;
+                        for (int sb = 0; sb < 2; ++sb)
+                            for (int sa = 0; sa < 2; ++sa) {
+                                const BandTrace* c[4] = {&sub[sb][sa], &sub[sb][sa + 1],
+                                                         &sub[sb + 1][sa], &sub[sb + 1][sa + 1]};
+                                subSmooth[sb][sa] = Smooth(c, subFine, subClear[sb][sa]);
+                            }
+                    };
                     for (int py = cy * kCell; py < std::min(H, (cy + 1) * kCell); ++py) {
                         for (int px = cx * kCell; px < std::min(W, (cx + 1) * kCell); ++px) {
                             ++rowCovered[size_t(cy)];
@@ -337,8 +377,24 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                                     const float fy = float(py - cy * kCell) / kCell;
                                     Apply(Bilinear(corner, fx, fy), dir, px, py, range.data(), rMin,
                                           rMax, nullptr);
+                                    continue;
+                                }
+                                if (!refined) Refine();
+                                const int lx = px - cx * kCell, ly = py - cy * kCell;
+                                constexpr int kHalf = kCell / 2;
+                                const int sa = lx / kHalf, sb = ly / kHalf;
+                                const int ix = lx - sa * kHalf, iy = ly - sb * kHalf;
+                                if (ix == 0 && iy == 0) {
+                                    Apply(sub[sb][sa], dir, px, py, range.data(), rMin, rMax,
+                                          nullptr);
+                                } else if (subSmooth[sb][sa]) {
+                                    if (subClear[sb][sa]) continue;
+                                    const BandTrace* c[4] = {&sub[sb][sa], &sub[sb][sa + 1],
+                                                             &sub[sb + 1][sa],
+                                                             &sub[sb + 1][sa + 1]};
+                                    Apply(Bilinear(c, float(ix) / kHalf, float(iy) / kHalf), dir,
+                                          px, py, range.data(), rMin, rMax, nullptr);
                                 } else {
-                                    bins.Copy(list);
                                     ++rowTraces[size_t(cy)];
                                     rowTests[size_t(cy)] += list.size();
                                     Apply(bins.Trace(list, dir, kPlumeSkyRange_m), dir, px, py,

@@ -2,8 +2,13 @@
 // Appendix A.2: Perez distribution coefficients and zenith values for Y, x, y.
 #include "radiometry/sky/analytic_sky.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/cache_aligned_allocator.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "radiometry/color/rec709.h"
 #include "scene/core/simd4.h"
@@ -39,8 +44,6 @@ glm::vec2 HemiOctFromDirection(glm::vec3 d) {
 // Four-lane helpers for the batched lookups. They reproduce the scalar code's std::min,
 // std::max, std::clamp and std::abs exactly (including which operand a tie or −0 returns), so
 // the batched and scalar lookups agree bit for bit.
-F4 Min4(F4 a, F4 b) { return _mm_min_ps(b, a); }  // std::min(a, b): b when b < a, else a
-F4 Clamp4(F4 v, F4 lo, F4 hi) { return Min4(Max4(v, lo), hi); }
 I4 MinI4(I4 a, I4 b) {  // SSE2 has no pminsd
     const I4 bLess = _mm_cmplt_epi32(b, a);
     return _mm_or_si128(_mm_and_si128(bLess, b), _mm_andnot_si128(bLess, a));
@@ -66,19 +69,63 @@ glm::dvec3 DirectionFromHemiOct(double a, double b) {
     return glm::normalize(d);
 }
 
+// The unit directions of the table's texels (i, j) ↔ hemi-octahedral (a, b) = −1 + 2 (i, j) /
+// (kTableSize − 1), index j·kTableSize + i; the same for every sky, made once.
+struct TexelDirections {
+    std::vector<float, tbb::cache_aligned_allocator<float>> x, y, z;
+};
+const TexelDirections& TableDirections() {
+    static const TexelDirections directions = [] {
+        TexelDirections t;
+        const size_t n = size_t(kTableSize) * kTableSize;
+        t.x.resize(n), t.y.resize(n), t.z.resize(n);
+        for (int j = 0; j < kTableSize; ++j)
+            for (int i = 0; i < kTableSize; ++i) {
+                const glm::dvec3 d = DirectionFromHemiOct(-1.0 + 2.0 * i / (kTableSize - 1),
+                                                          -1.0 + 2.0 * j / (kTableSize - 1));
+                const size_t k = size_t(j) * kTableSize + size_t(i);
+                t.x[k] = float(d.x), t.y[k] = float(d.y), t.z[k] = float(d.z);
+            }
+        return t;
+    }();
+    return directions;
+}
+
 // E_h = ∫ L cosθ dω over the upper hemisphere, midpoint rule in (cosθ, φ): dω = dμ dφ.
-template <typename RadianceFn>
-glm::dvec3 HorizontalIntegral(const RadianceFn& radiance) {
+// radiance(x, y, z, rgb) evaluates four directions. Rows of μ in parallel, each summed on its
+// own and the rows added in order: the same sum for any thread count.
+template <typename Radiance4Fn>
+glm::dvec3 HorizontalIntegral(const Radiance4Fn& radiance) {
     constexpr int kMu = 64, kPhi = 128;
-    glm::dvec3 sum(0.0);
-    for (int j = 0; j < kMu; ++j) {
-        const double mu = (j + 0.5) / kMu;
-        const double s = std::sqrt(1.0 - mu * mu);
-        for (int i = 0; i < kPhi; ++i) {
-            const double phi = 2.0 * M_PI * (i + 0.5) / kPhi;
-            sum += radiance(glm::dvec3{s * std::sin(phi), s * std::cos(phi), mu}) * mu;
-        }
+    static_assert(kPhi % 4 == 0);
+    alignas(16) float sinPhi[kPhi], cosPhi[kPhi];
+    for (int i = 0; i < kPhi; ++i) {
+        const double phi = 2.0 * M_PI * (i + 0.5) / kPhi;
+        sinPhi[i] = float(std::sin(phi)), cosPhi[i] = float(std::cos(phi));
     }
+    glm::dvec3 rows[kMu];
+    tbb::parallel_for(tbb::blocked_range<int>(0, kMu, 4), [&](const tbb::blocked_range<int>& r) {
+        for (int j = r.begin(); j != r.end(); ++j) {
+            const double mu = (j + 0.5) / kMu;
+            const F4 s = _mm_set1_ps(float(std::sqrt(1.0 - mu * mu))), z = _mm_set1_ps(float(mu));
+            F4 sum[3] = {_mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps()};
+            for (int i = 0; i < kPhi; i += 4) {
+                F4 rgb[3];
+                radiance(_mm_mul_ps(s, _mm_load_ps(sinPhi + i)),
+                         _mm_mul_ps(s, _mm_load_ps(cosPhi + i)), z, rgb);
+                for (int c = 0; c < 3; ++c) sum[c] = _mm_add_ps(sum[c], rgb[c]);
+            }
+            alignas(16) float lanes[3][4];
+            for (int c = 0; c < 3; ++c) _mm_store_ps(lanes[c], sum[c]);
+            glm::dvec3 row(0.0);
+            for (int c = 0; c < 3; ++c)
+                row[c] = (double(lanes[c][0]) + double(lanes[c][1])) +
+                         (double(lanes[c][2]) + double(lanes[c][3]));
+            rows[j] = row * mu;
+        }
+    });
+    glm::dvec3 sum(0.0);
+    for (const glm::dvec3& row : rows) sum += row;
     return sum * (1.0 / kMu) * (2.0 * M_PI / kPhi);
 }
 
@@ -111,11 +158,13 @@ AnalyticSky::AnalyticSky(const SkyConditions& c)
     const double sunIlluminance_lux = c.sunIlluminance_lux;
     if (c.moon) {
         moonDir_ = glm::normalize(c.moonDirection);
-        moonZenith_rad_ = std::acos(std::clamp(moonDir_.z, -1.0, 1.0));
+        moonlit_ = MoonlitSky(std::acos(std::clamp(moonDir_.z, -1.0, 1.0)), c.moonPhaseAngle_rad,
+                              c.moonDistance_m, c.extinctionV_magPerAirmass);
     }
-    glm::dvec3 sunForSky = sunDir_;
-    if (sunForSky.z < 0.0) sunForSky = glm::normalize(glm::dvec3(sunForSky.x, sunForSky.y, 0.0));
-    thetaSun_ = std::acos(std::clamp(sunForSky.z, -1.0, 1.0));
+    sunForSky_ = sunDir_;
+    if (sunForSky_.z < 0.0)
+        sunForSky_ = glm::normalize(glm::dvec3(sunForSky_.x, sunForSky_.y, 0.0));
+    thetaSun_ = std::acos(std::clamp(sunForSky_.z, -1.0, 1.0));
     const double ts = thetaSun_;
 
     // Perez coefficients A..E as linear functions of turbidity (Preetham et al. 1999, A.2).
@@ -139,9 +188,9 @@ AnalyticSky::AnalyticSky(const SkyConditions& c)
     zenithYchroma_ = t2 * (0.00275 * s3 - 0.00610 * s2 + 0.00317 * ts) +
                      T * (-0.04214 * s3 + 0.08970 * s2 - 0.04153 * ts + 0.00516) +
                      (0.15346 * s3 - 0.26756 * s2 + 0.06670 * ts + 0.26688);
-    normY_ = Perez(coefY_, 1.0, ts);
-    normX_ = Perez(coefX_, 1.0, ts);
-    normYc_ = Perez(coefYc_, 1.0, ts);
+    F4 norm[3];
+    Perez4(_mm_set1_ps(1.0f), _mm_set1_ps(float(ts)), _mm_set1_ps(float(std::cos(ts))), norm);
+    normY_ = Lane0(norm[0]), normX_ = Lane0(norm[1]), normYc_ = Lane0(norm[2]);
 
     // The sun: white (D65, equal Rec.709 RGB) at the given illuminance; disc solid angle
     // 2π(1 − cos r).
@@ -150,22 +199,36 @@ AnalyticSky::AnalyticSky(const SkyConditions& c)
 
     // Daylight scale: Preetham's dome integrated over the hemisphere against the measured
     // clear-sky diffuse illuminance at the sun's altitude.
+    // Radiance is dayScale × Preetham + night, so the dome's illuminance is dayScale × the
+    // Preetham integral + the night sky's.
     dayScale_ = 1.0;
-    const double preethamE = LuminanceRec709(
-        HorizontalIntegral([this](const glm::dvec3& d) { return PreethamRadiance(d); }));
+    const glm::dvec3 preethamHorizontal =
+        HorizontalIntegral([this](F4 x, F4 y, F4 z, F4(&rgb)[3]) { Preetham4(x, y, z, rgb); });
+    const double preethamE = LuminanceRec709(preethamHorizontal);
     const double sunAltitude_rad = std::asin(std::clamp(sunDir_.z, -1.0, 1.0));
     dayScale_ =
         preethamE > 0.0 ? scene::ClearSkyDiffuseIlluminance_lux(sunAltitude_rad) / preethamE : 0.0;
 
+    // Every texel on its own: rows in parallel, the same table for any thread count.
+    const TexelDirections& texels = TableDirections();
     table_.resize(size_t(kTableSize) * size_t(kTableSize), glm::vec4(0.0f));
-    for (int j = 0; j < kTableSize; ++j) {
-        for (int i = 0; i < kTableSize; ++i) {
-            const double a = -1.0 + 2.0 * i / (kTableSize - 1),
-                         b = -1.0 + 2.0 * j / (kTableSize - 1);
-            table_[size_t(j) * kTableSize + size_t(i)] =
-                glm::vec4(glm::vec3(Radiance(DirectionFromHemiOct(a, b))), 0.0f);
-        }
-    }
+    static_assert(kTableSize % 4 == 0);
+    tbb::parallel_for(tbb::blocked_range<int>(0, kTableSize, 8),
+                      [&](const tbb::blocked_range<int>& r) {
+                          for (int j = r.begin(); j != r.end(); ++j) {
+                              for (int i = 0; i < kTableSize; i += 4) {
+                                  const size_t t = size_t(j) * kTableSize + size_t(i);
+                                  F4 rgb[3];
+                                  Radiance4(_mm_load_ps(&texels.x[t]), _mm_load_ps(&texels.y[t]),
+                                            _mm_load_ps(&texels.z[t]), rgb);
+                                  alignas(16) float lanes[3][4];
+                                  for (int c = 0; c < 3; ++c) _mm_store_ps(lanes[c], rgb[c]);
+                                  for (int k = 0; k < 4; ++k)
+                                      table_[t + size_t(k)] =
+                                          glm::vec4(lanes[0][k], lanes[1][k], lanes[2][k], 0.0f);
+                              }
+                          }
+                      });
 
     horizon_.resize(kHorizonSize + 1, glm::vec4(0.0f));
     for (int i = 0; i <= kHorizonSize; ++i) {
@@ -176,15 +239,112 @@ AnalyticSky::AnalyticSky(const SkyConditions& c)
             glm::vec4(glm::vec3(Radiance(glm::normalize(glm::dvec3(u, v, 0.0)))), 0.0f);
     }
 
-    skyHorizontal_ = HorizontalIntegral([this](const glm::dvec3& d) { return Radiance(d); });
+    if (c.basis) {  // the dome in the basis: every light in its own vector
+        skyHorizontal_ =
+            HorizontalIntegral([this](F4 x, F4 y, F4 z, F4(&rgb)[3]) { Radiance4(x, y, z, rgb); });
+        return;
+    }
+    skyHorizontal_ = dayScale_ * preethamHorizontal;
+    if (c.darkZenithLuminance_cdm2 > 0.0 || moonlit_.Up())
+        skyHorizontal_ += HorizontalIntegral(
+            [this](F4 x, F4 y, F4 z, F4(&rgb)[3]) { rgb[0] = rgb[1] = rgb[2] = Night4(x, y, z); });
 }
 
-double AnalyticSky::Perez(const double c[5], double cosTheta, double gamma) const {
-    // F(θ, γ) = (1 + A e^{B / cos θ}) (1 + C e^{D γ} + E cos² γ) (Perez, Seals & Michalsky 1993).
-    cosTheta = std::max(cosTheta, 0.01);
-    const double cg = std::cos(gamma);
-    return (1.0 + c[0] * std::exp(c[1] / cosTheta)) *
-           (1.0 + c[2] * std::exp(c[3] * gamma) + c[4] * cg * cg);
+void AnalyticSky::Perez4(F4 cosTheta, F4 gamma, F4 cosGamma, F4 (&F)[3]) const {
+    // F(θ, γ) = (1 + A e^{B / cos θ}) (1 + C e^{D γ} + E cos² γ) (Perez, Seals & Michalsky 1993),
+    // cos θ held at 0.01 or above.
+    const F4 one = _mm_set1_ps(1.0f);
+    const F4 invCos = _mm_div_ps(one, Max4(cosTheta, _mm_set1_ps(0.01f)));
+    const F4 cg2 = _mm_mul_ps(cosGamma, cosGamma);
+    const double* c[3] = {coefY_, coefX_, coefYc_};
+    for (int k = 0; k < 3; ++k) {
+        const auto C = [&](int i) { return _mm_set1_ps(float(c[k][i])); };
+        const F4 horizon = _mm_add_ps(one, _mm_mul_ps(C(0), Exp4(_mm_mul_ps(C(1), invCos))));
+        const F4 sun = _mm_add_ps(_mm_add_ps(one, _mm_mul_ps(C(2), Exp4(_mm_mul_ps(C(3), gamma)))),
+                                  _mm_mul_ps(C(4), cg2));
+        F[k] = _mm_mul_ps(horizon, sun);
+    }
+}
+
+void AnalyticSky::Preetham4(F4 x, F4 y, F4 z, F4 (&rgb)[3]) const {
+    const F4 cosGamma =
+        Clamp4(Dot4(x, y, z, _mm_set1_ps(float(sunForSky_.x)), _mm_set1_ps(float(sunForSky_.y)),
+                    _mm_set1_ps(float(sunForSky_.z))),
+               _mm_set1_ps(-1.0f), _mm_set1_ps(1.0f));
+    F4 F[3];
+    Perez4(z, Acos4(cosGamma), cosGamma, F);
+    const F4 Y = _mm_mul_ps(_mm_set1_ps(float(zenithY_ / normY_)), F[0]);
+    const F4 cx = _mm_mul_ps(_mm_set1_ps(float(zenithX_ / normX_)), F[1]);
+    const F4 cy = _mm_mul_ps(_mm_set1_ps(float(zenithYchroma_ / normYc_)), F[2]);
+    // Rec709FromYxy (X = x / y · Y, Z = (1 − x − y) / y · Y; black where y ≤ 0), negative
+    // components clipped.
+    const F4 positive = _mm_cmpgt_ps(cy, _mm_setzero_ps());
+    const F4 perY = _mm_div_ps(Y, cy);
+    const F4 X = _mm_mul_ps(cx, perY);
+    const F4 Z = _mm_mul_ps(_mm_sub_ps(_mm_sub_ps(_mm_set1_ps(1.0f), cx), cy), perY);
+    const glm::dvec3 m[3] = {Rec709FromXyz({1, 0, 0}), Rec709FromXyz({0, 1, 0}),
+                             Rec709FromXyz({0, 0, 1})};
+    for (int c = 0; c < 3; ++c) {
+        const F4 v = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_set1_ps(float(m[0][c])), X),
+                                           _mm_mul_ps(_mm_set1_ps(float(m[1][c])), Y)),
+                                _mm_mul_ps(_mm_set1_ps(float(m[2][c])), Z));
+        rgb[c] = _mm_and_ps(positive, Max4(v, _mm_setzero_ps()));
+    }
+}
+
+F4 AnalyticSky::Night4(F4 x, F4 y, F4 z, F4* moonlitOut) const {
+    const SkyConditions& c = conditions_;
+    F4 grey = _mm_setzero_ps();
+    if (c.darkZenithLuminance_cdm2 > 0.0)
+        grey = DarkSkyLuminanceFromCos4(z, float(c.extinctionV_magPerAirmass),
+                                        float(c.darkZenithLuminance_cdm2));
+    if (moonlit_.Up()) {
+        // The aureole's ρ⁻² peak is held at its 4° value inside 4° of the moon: the sky
+        // table (128² over the hemisphere, ~1° texels) cannot carry a steeper peak without
+        // drawing its texels.
+        constexpr double kMinSeparation_rad = 4.0 * M_PI / 180.0;
+        const F4 cosSeparation =
+            Clamp4(Dot4(x, y, z, _mm_set1_ps(float(moonDir_.x)), _mm_set1_ps(float(moonDir_.y)),
+                        _mm_set1_ps(float(moonDir_.z))),
+                   _mm_set1_ps(-1.0f), _mm_set1_ps(1.0f));
+        const F4 separation = Acos4(cosSeparation);
+        const F4 inside = _mm_cmplt_ps(separation, _mm_set1_ps(float(kMinSeparation_rad)));
+        const F4 moonPart = moonlit_.Luminance4(
+            z, Select4(inside, _mm_set1_ps(float(kMinSeparation_rad)), separation),
+            Select4(inside, _mm_set1_ps(float(std::cos(kMinSeparation_rad))), cosSeparation));
+        grey = _mm_add_ps(grey, moonPart);
+        if (moonlitOut) *moonlitOut = moonPart;
+    }
+    return grey;
+}
+
+void AnalyticSky::Radiance4(F4 x, F4 y, F4 z, F4 (&rgb)[3]) const {
+    F4 moonlit = _mm_setzero_ps();
+    const F4 night = Night4(x, y, z, &moonlit);
+    if (const std::optional<SkyConditions::BandBasis>& basis = conditions_.basis) {
+        // Each light's luminance in its own spectral basis vector (channels/nvg).
+        F4 day = _mm_setzero_ps();
+        if (dayScale_ > 0.0) {
+            Preetham4(x, y, z, rgb);
+            // Luminance Y of linear Rec.709 RGB (ITU-R BT.709-6), times the daylight scale.
+            day = _mm_mul_ps(_mm_set1_ps(float(dayScale_)),
+                             _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_set1_ps(0.2126f), rgb[0]),
+                                                   _mm_mul_ps(_mm_set1_ps(0.7152f), rgb[1])),
+                                        _mm_mul_ps(_mm_set1_ps(0.0722f), rgb[2])));
+        }
+        const F4 dark = _mm_sub_ps(night, moonlit);
+        for (int c = 0; c < 3; ++c)
+            rgb[c] = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_set1_ps(float(basis->daylight[c])), day),
+                                           _mm_mul_ps(_mm_set1_ps(float(basis->night[c])), dark)),
+                                _mm_mul_ps(_mm_set1_ps(float(basis->moonlit[c])), moonlit));
+        return;
+    }
+    if (dayScale_ > 0.0) {
+        Preetham4(x, y, z, rgb);
+        for (F4& v : rgb) v = _mm_add_ps(_mm_mul_ps(_mm_set1_ps(float(dayScale_)), v), night);
+    } else {
+        rgb[0] = rgb[1] = rgb[2] = night;
+    }
 }
 
 glm::dvec3 AnalyticSky::Radiance(const glm::dvec3& dIn) const {
@@ -192,39 +352,9 @@ glm::dvec3 AnalyticSky::Radiance(const glm::dvec3& dIn) const {
     if (d.z < 0.0) d = glm::dvec3(d.x, d.y, 0.0);
     const double len = glm::length(d);
     d = len > 0.0 ? d / len : glm::dvec3(0, 0, 1);
-    glm::dvec3 L = dayScale_ > 0.0 ? dayScale_ * PreethamRadiance(d) : glm::dvec3(0.0);
-    const SkyConditions& c = conditions_;
-    const double zenith_rad = std::acos(std::clamp(d.z, 0.0, 1.0));
-    double grey = 0.0;
-    if (c.darkZenithLuminance_cdm2 > 0.0)
-        grey += DarkSkyLuminance_cdm2(zenith_rad, c.extinctionV_magPerAirmass,
-                                      c.darkZenithLuminance_cdm2);
-    const double dark = grey;
-    if (c.moon) {
-        // The aureole's ρ⁻² peak is held at its 4° value inside 4° of the moon: the sky
-        // table (128² over the hemisphere, ~1° texels) cannot carry a steeper peak without
-        // drawing its texels.
-        constexpr double kMinSeparation_rad = 4.0 * M_PI / 180.0;
-        const double separation_rad =
-            std::max(kMinSeparation_rad, std::acos(std::clamp(glm::dot(d, moonDir_), -1.0, 1.0)));
-        grey += MoonlitSkyLuminance_cdm2(zenith_rad, moonZenith_rad_, separation_rad,
-                                         c.moonPhaseAngle_rad, c.moonDistance_m,
-                                         c.extinctionV_magPerAirmass);
-    }
-    if (c.basis)  // each light's luminance in its own spectral basis vector
-        return LuminanceRec709(L) * c.basis->daylight + dark * c.basis->night +
-               (grey - dark) * c.basis->moonlit;
-    return L + glm::dvec3(grey);
-}
-
-glm::dvec3 AnalyticSky::PreethamRadiance(const glm::dvec3& d) const {
-    glm::dvec3 sunForSky = sunDir_;
-    if (sunForSky.z < 0.0) sunForSky = glm::normalize(glm::dvec3(sunForSky.x, sunForSky.y, 0.0));
-    const double gamma = std::acos(std::clamp(glm::dot(d, sunForSky), -1.0, 1.0));
-    const double Y = zenithY_ * Perez(coefY_, d.z, gamma) / normY_;
-    const double x = zenithX_ * Perez(coefX_, d.z, gamma) / normX_;
-    const double y = zenithYchroma_ * Perez(coefYc_, d.z, gamma) / normYc_;
-    return glm::max(Rec709FromYxy(Y, x, y), glm::dvec3(0.0));
+    F4 rgb[3];
+    Radiance4(_mm_set1_ps(float(d.x)), _mm_set1_ps(float(d.y)), _mm_set1_ps(float(d.z)), rgb);
+    return {Lane0(rgb[0]), Lane0(rgb[1]), Lane0(rgb[2])};
 }
 
 glm::vec3 AnalyticSky::LookUp(const glm::vec3& d) const {

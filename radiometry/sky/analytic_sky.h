@@ -66,7 +66,8 @@ class AnalyticSky {
     AnalyticSky(const glm::dvec3& sunDirection, double sunIlluminance_lux, double turbidity);
 
     // Sky radiance (cd/m², linear Rec.709) toward unit ENU direction d, without the sun disc.
-    // Directions below the horizon see the horizon's radiance.
+    // Directions below the horizon see the horizon's radiance. Evaluated in float by the same
+    // four-lane code that builds the table (within ~1e-5 of the formulas in double precision).
     glm::dvec3 Radiance(const glm::dvec3& d) const;
     // As Radiance, bilinear from a precomputed table over the upper hemisphere in the
     // hemi-octahedral parameterisation (no trigonometry per lookup); within 1 % of Radiance
@@ -100,14 +101,22 @@ class AnalyticSky {
     const SkyConditions& Conditions() const { return conditions_; }
 
   private:
-    // Preetham's radiance without the daylight scale and without night terms.
-    glm::dvec3 PreethamRadiance(const glm::dvec3& d) const;
-    double Perez(const double coeffs[5], double cosTheta, double gamma) const;
+    // Four-lane float forms over unit directions (x, y, z) with z ≥ 0 (the scalar functions are
+    // their lane 0): Perez's F(θ, γ) for Y, x and y (Preetham's three coefficient sets);
+    // Preetham's radiance (no daylight scale); the grey night sky (moonless and moonlit);
+    // Radiance.
+    void Perez4(simd4::F4 cosTheta, simd4::F4 gamma, simd4::F4 cosGamma, simd4::F4 (&F)[3]) const;
+    void Preetham4(simd4::F4 x, simd4::F4 y, simd4::F4 z, simd4::F4 (&rgb)[3]) const;
+    // The night sky's luminance (cd/m²): the moonless sky plus the moonlit sky, which is also
+    // returned alone through moonlit when given.
+    simd4::F4 Night4(simd4::F4 x, simd4::F4 y, simd4::F4 z, simd4::F4* moonlit = nullptr) const;
+    void Radiance4(simd4::F4 x, simd4::F4 y, simd4::F4 z, simd4::F4 (&rgb)[3]) const;
 
     SkyConditions conditions_;
     glm::dvec3 sunDir_;
     glm::dvec3 moonDir_{0.0, 0.0, -1.0};
-    double moonZenith_rad_ = 3.14159265358979323846;
+    MoonlitSky moonlit_;    // no moon unless conditions.moon
+    glm::dvec3 sunForSky_;  // the sun, or its azimuth on the horizon once it has set
     double dayScale_ = 1.0;
     glm::dvec3 sunRadiance_;
     glm::dvec3 sunIlluminanceRgb_;

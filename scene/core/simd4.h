@@ -16,6 +16,9 @@ inline F4 Set4(float v) { return _mm_set1_ps(v); }
 inline F4 Abs4(F4 v) { return _mm_andnot_ps(_mm_set1_ps(-0.0f), v); }
 // std::max(a, b): b when a < b, else a (same NaN and ±0 behaviour).
 inline F4 Max4(F4 a, F4 b) { return _mm_max_ps(b, a); }
+// std::min(a, b): b when b < a, else a.
+inline F4 Min4(F4 a, F4 b) { return _mm_min_ps(b, a); }
+inline F4 Clamp4(F4 v, F4 lo, F4 hi) { return Min4(Max4(v, lo), hi); }
 inline F4 Select4(F4 mask, F4 a, F4 b) {
     return _mm_or_ps(_mm_and_ps(mask, a), _mm_andnot_ps(mask, b));
 }
@@ -23,6 +26,47 @@ inline F4 Select4(F4 mask, F4 a, F4 b) {
 inline F4 Dot4(F4 ax, F4 ay, F4 az, F4 bx, F4 by, F4 bz) {
     return _mm_add_ps(_mm_add_ps(_mm_mul_ps(ax, bx), _mm_mul_ps(ay, by)), _mm_mul_ps(az, bz));
 }
+
+// e^x, four lanes, for x in [−87, 88] (clamped to it: e^−87 < 1.7e-38, e^88 < FLT_MAX):
+// x = n ln 2 + r with |r| ≤ ln 2 / 2 (ln 2 split in two so that n ln 2 is exact, Cody & Waite,
+// "Software Manual for the Elementary Functions" (1980) ch. 6), e^r by its degree-6 Taylor
+// polynomial (remainder ≤ (ln 2 / 2)^7 / 7! · √2 < 1.7e-7 relative), 2^n by the exponent bits.
+inline F4 Exp4(F4 x) {
+    x = _mm_min_ps(_mm_max_ps(x, _mm_set1_ps(-87.0f)), _mm_set1_ps(88.0f));
+    const __m128i n = _mm_cvtps_epi32(_mm_mul_ps(x, _mm_set1_ps(1.44269504f)));  // round
+    const F4 fn = _mm_cvtepi32_ps(n);
+    F4 r = _mm_sub_ps(x, _mm_mul_ps(fn, _mm_set1_ps(0.693359375f)));
+    r = _mm_sub_ps(r, _mm_mul_ps(fn, _mm_set1_ps(-2.12194440e-4f)));
+    F4 p = _mm_set1_ps(1.0f / 720.0f);
+    p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(1.0f / 120.0f));
+    p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(1.0f / 24.0f));
+    p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(1.0f / 6.0f));
+    p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(0.5f));
+    p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(1.0f));
+    p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(1.0f));
+    const F4 scale = _mm_castsi128_ps(_mm_slli_epi32(_mm_add_epi32(n, _mm_set1_epi32(127)), 23));
+    return _mm_mul_ps(p, scale);
+}
+
+// acos x, four lanes, x clamped to [−1, 1]: Abramowitz & Stegun 4.4.46,
+// acos|x| = √(1 − |x|) Σ a_k |x|^k with |error| ≤ 2e-8 rad (plus float rounding), and
+// acos x = π − acos|x| for x < 0.
+inline F4 Acos4(F4 x) {
+    const F4 ax = _mm_min_ps(Abs4(x), _mm_set1_ps(1.0f));
+    F4 p = _mm_set1_ps(-0.0012624911f);
+    p = _mm_add_ps(_mm_mul_ps(p, ax), _mm_set1_ps(0.0066700901f));
+    p = _mm_add_ps(_mm_mul_ps(p, ax), _mm_set1_ps(-0.0170881256f));
+    p = _mm_add_ps(_mm_mul_ps(p, ax), _mm_set1_ps(0.0308918810f));
+    p = _mm_add_ps(_mm_mul_ps(p, ax), _mm_set1_ps(-0.0501743046f));
+    p = _mm_add_ps(_mm_mul_ps(p, ax), _mm_set1_ps(0.0889789874f));
+    p = _mm_add_ps(_mm_mul_ps(p, ax), _mm_set1_ps(-0.2145988016f));
+    p = _mm_add_ps(_mm_mul_ps(p, ax), _mm_set1_ps(1.5707963050f));
+    const F4 r = _mm_mul_ps(_mm_sqrt_ps(_mm_sub_ps(_mm_set1_ps(1.0f), ax)), p);
+    return Select4(_mm_cmplt_ps(x, _mm_setzero_ps()), _mm_sub_ps(_mm_set1_ps(3.14159265f), r), r);
+}
+
+// Lane 0 of v.
+inline float Lane0(F4 v) { return _mm_cvtss_f32(v); }
 
 // Loads and stores of count ≤ 4 lanes: a partial last group is padded with a harmless value,
 // so every sample goes through the same four-wide code.

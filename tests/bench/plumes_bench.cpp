@@ -246,5 +246,25 @@ BENCHMARK(BM_SkyClockPlumesUpdate)
     ->Arg(1)
     ->Unit(benchmark::kMillisecond);
 
+// Building the sky table alone (AnalyticSky with the moon up, dusk sun) at state.range(0)
+// threads: the part of BM_SkyClockPlumesUpdate/sky_every_frame:1 that a sky rebuild adds.
+void BM_AnalyticSkyBuild(benchmark::State& state) {
+    radiometry::SkyConditions c;
+    c.sunDirection = glm::normalize(glm::dvec3(-0.9, 0.2, 0.05));
+    c.sunIlluminance_lux = 2.0e4;
+    c.turbidity = 3.0;
+    c.moon = true;
+    c.moonDirection = glm::normalize(glm::dvec3(0.8, -0.3, 0.2));
+    c.moonPhaseAngle_rad = 0.3;
+    tbb::task_arena arena(int(state.range(0)));
+    for (auto _ : state) {
+        arena.execute([&] {
+            const radiometry::AnalyticSky sky(c);
+            benchmark::DoNotOptimize(sky.HorizontalSkyIlluminance());
+        });
+    }
+}
+BENCHMARK(BM_AnalyticSkyBuild)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 }  // namespace
 }  // namespace seasense::scene

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <numbers>
@@ -161,6 +162,68 @@ TEST(PlumeScreenBins, DropsOnlyPuffsBelowTolerance) {
     const PlumeScreenBins bins(field, cam, ObscurantBand::Visible);
     EXPECT_FLOAT_EQ(bins.PuffTolerance(), 5e-4f);
     EXPECT_EQ(bins.KeptPuffs(), 1u);
+}
+
+// A puff's screen rectangle is the screen extent of its cutoff ellipsoid (τ_max e^(−r²/2) = ε):
+// every point of the ellipsoid projects into it, and it reaches at most 2 pixels beyond the
+// projected points (the extent of the ellipsoid's bounding box would reach ~13 pixels further
+// for this puff 15° off the axis).
+TEST(PlumeScreenBins, FootprintIsTheCutoffEllipsoidsScreenExtent) {
+    const double sh = 6.0, sz = 3.0;
+    scene::PlumeField field(1, 1);
+    const scene::ObscurantOptics optics = scene::KindOptics(scene::PlumeKind::Smoke, 0.3);
+    field.SetOptics(0, optics);
+    field.Clear(0.0);
+    const double az = 15.0 * std::numbers::pi / 180.0;
+    scene::Puff p;
+    p.centre_m = {200.0 * std::sin(az), 200.0 * std::cos(az), 14.0};
+    p.sigmaH_m = sh;
+    p.sigmaZ_m = sz;
+    p.mass_kg = 50.0;
+    field.Add(p);
+    field.Build();
+    const ChannelCamera cam = NorthCamera({0.0, 0.0, 10.0}, 320, 240, 60.0, 0.0);
+    const PlumeScreenBins bins(field, cam, ObscurantBand::Visible);
+    ASSERT_EQ(bins.KeptPuffs(), 1u);
+    // Peak density M / ((2π)^{3/2} σh² σz); τ_max through the centre along the longest axis.
+    const double alpha = optics.massExtinction_m2pkg[0];
+    const double peak = p.mass_kg / (std::pow(2.0 * std::numbers::pi, 1.5) * sh * sh * sz);
+    const double tauMax = alpha * peak * std::sqrt(2.0 * std::numbers::pi) * sh;
+    const double r = std::sqrt(2.0 * std::log(tauMax / double(bins.PuffTolerance())));
+    ASSERT_GT(r, 2.0);
+    const glm::dvec3 eye = cam.worldFromCamera.position_m;
+    const glm::dmat3 cameraFromWorld = glm::transpose(cam.worldFromCamera.worldFromBody);
+    double xMin = 1e9, xMax = -1e9, yMin = 1e9, yMax = -1e9;
+    PlumeScreenBins::List list;
+    for (int i = 0; i < 60; ++i) {
+        for (int j = 0; j <= 30; ++j) {
+            const double phi = 2.0 * std::numbers::pi * i / 60.0, th = std::numbers::pi * j / 30.0;
+            const glm::dvec3 u{std::sin(th) * std::cos(phi), std::sin(th) * std::sin(phi),
+                               std::cos(th)};
+            const glm::dvec3 q =
+                cameraFromWorld * (p.centre_m + r * glm::dvec3(sh * u.x, sh * u.y, sz * u.z) - eye);
+            const double x = (q.x / (q.y * cam.TanHalfH()) + 1.0) * 0.5 * cam.width;
+            const double y = (1.0 - q.z / (q.y * cam.TanHalfV())) * 0.5 * cam.height;
+            xMin = std::min(xMin, x), xMax = std::max(xMax, x);
+            yMin = std::min(yMin, y), yMax = std::max(yMax, y);
+            bins.Gather(int(x), int(y), int(x) + 1, int(y) + 1, 0.0f, false, list);
+            EXPECT_EQ(list.size(), 1u) << x << " " << y;
+        }
+    }
+    ASSERT_GT(xMin, 0.0);
+    ASSERT_LT(xMax, double(cam.width));
+    int bx0 = cam.width, bx1 = -1, by0 = cam.height, by1 = -1;
+    for (int y = 0; y < cam.height; ++y)
+        for (int x = 0; x < cam.width; ++x) {
+            bins.Gather(x, y, x + 1, y + 1, 0.0f, false, list);
+            if (list.size() == 0) continue;
+            bx0 = std::min(bx0, x), bx1 = std::max(bx1, x);
+            by0 = std::min(by0, y), by1 = std::max(by1, y);
+        }
+    EXPECT_GE(bx0, int(std::floor(xMin)) - 2);
+    EXPECT_LE(bx1, int(std::ceil(xMax)) + 2);
+    EXPECT_GE(by0, int(std::floor(yMin)) - 2);
+    EXPECT_LE(by1, int(std::ceil(yMax)) + 2);
 }
 
 }  // namespace

@@ -2,9 +2,12 @@
 #include "radiometry/sky/analytic_sky.h"
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <vector>
 
 #include "radiometry/color/rec709.h"
@@ -102,6 +105,115 @@ TEST(AnalyticSky, TableLookupMatchesDirectEvaluationAwayFromTheSun) {
         EXPECT_NEAR(b.g, a.g, 0.01 * a.g) << "az " << az << " el " << el;
         const glm::dvec3 h = sky.Radiance({d.x, d.y, 0.0});
         EXPECT_NEAR(sky.HorizonLookUp(glm::vec3(d)).g, h.g, 0.01 * h.g) << "az " << az;
+    }
+}
+
+// Preetham, Shirley & Smits (SIGGRAPH 1999), Appendix A.2, evaluated in double precision
+// straight from the paper: the Perez coefficients as (slope in T, constant) pairs and the
+// zenith chromaticities as [T², T, 1] · M · [θs³, θs², θs, 1]. The sky's four-lane float
+// evaluation (exponentials and arccosines by polynomials) must follow it within 2e-5.
+TEST(AnalyticSky, RadianceFollowsPreethamsFormulasInDoublePrecision) {
+    const double perez[3][5][2] = {{{0.1787, -1.4630},
+                                    {-0.3554, 0.4275},
+                                    {-0.0227, 5.3251},
+                                    {0.1206, -2.5771},
+                                    {-0.0670, 0.3703}},
+                                   {{-0.0193, -0.2592},
+                                    {-0.0665, 0.0008},
+                                    {-0.0004, 0.2125},
+                                    {-0.0641, -0.8989},
+                                    {-0.0033, 0.0452}},
+                                   {{-0.0167, -0.2608},
+                                    {-0.0950, 0.0092},
+                                    {-0.0079, 0.2102},
+                                    {-0.0441, -1.6537},
+                                    {-0.0109, 0.0529}}};
+    const double mx[3][4] = {{0.00166, -0.00375, 0.00209, 0.0},
+                             {-0.02903, 0.06377, -0.03202, 0.00394},
+                             {0.11693, -0.21196, 0.06052, 0.25886}};
+    const double my[3][4] = {{0.00275, -0.00610, 0.00317, 0.0},
+                             {-0.04214, 0.08970, -0.04153, 0.00516},
+                             {0.15346, -0.26756, 0.06670, 0.26688}};
+    double worst = 0.0;
+    for (const double T : {2.0, 3.5, 6.0}) {
+        for (const double elevation : {5.0, 30.0, 70.0}) {
+            const glm::dvec3 sun =
+                glm::normalize(glm::dvec3(0.3, 1.0, 0.0) * std::cos(elevation * M_PI / 180.0) +
+                               glm::dvec3(0.0, 0.0, std::sin(elevation * M_PI / 180.0)));
+            SkyConditions c;
+            c.sunDirection = sun;
+            c.sunIlluminance_lux = 1e5;
+            c.turbidity = T;
+            c.darkZenithLuminance_cdm2 = 0.0;  // Preetham's sky alone
+            const AnalyticSky sky(c);
+            const double ts = std::acos(sun.z);
+            const auto F = [&](int k, double cosTheta, double gamma) {
+                double a[5];
+                for (int i = 0; i < 5; ++i) a[i] = perez[k][i][0] * T + perez[k][i][1];
+                return (1.0 + a[0] * std::exp(a[1] / cosTheta)) *
+                       (1.0 + a[2] * std::exp(a[3] * gamma) +
+                        a[4] * std::cos(gamma) * std::cos(gamma));
+            };
+            const auto chroma = [&](const double(&m)[3][4]) {
+                const double t[3] = {T * T, T, 1.0}, th[4] = {ts * ts * ts, ts * ts, ts, 1.0};
+                double v = 0.0;
+                for (int i = 0; i < 3; ++i)
+                    for (int j = 0; j < 4; ++j) v += t[i] * m[i][j] * th[j];
+                return v;
+            };
+            const double chi = (4.0 / 9.0 - T / 120.0) * (M_PI - 2.0 * ts);
+            const double Yz =
+                1000.0 * ((4.0453 * T - 4.9710) * std::tan(chi) - 0.2155 * T + 2.4192);
+            const double xz = chroma(mx), yz = chroma(my);
+            for (int az = 0; az < 360; az += 15) {
+                for (const double el : {2.0, 10.0, 35.0, 60.0, 89.0}) {
+                    const double a = az * M_PI / 180.0, e = el * M_PI / 180.0;
+                    const glm::dvec3 d{std::cos(e) * std::sin(a), std::cos(e) * std::cos(a),
+                                       std::sin(e)};
+                    const double gamma = std::acos(std::clamp(glm::dot(d, sun), -1.0, 1.0));
+                    const double Y = Yz * F(0, d.z, gamma) / F(0, 1.0, ts);
+                    const double x = xz * F(1, d.z, gamma) / F(1, 1.0, ts);
+                    const double y = yz * F(2, d.z, gamma) / F(2, 1.0, ts);
+                    const glm::dvec3 expected = glm::max(Rec709FromYxy(Y, x, y), glm::dvec3(0.0));
+                    const glm::dvec3 got = sky.Radiance(d) / sky.DaylightScale();
+                    for (int k = 0; k < 3; ++k) {
+                        worst = std::max(worst, std::abs(got[k] - expected[k]) / Y);
+                        EXPECT_NEAR(got[k], expected[k], 2e-5 * Y)
+                            << "T " << T << " sun " << elevation << " az " << az << " el " << el;
+                    }
+                }
+            }
+        }
+    }
+    std::printf("largest difference from Preetham's formulas: %.3g of the luminance\n", worst);
+}
+
+// The table and the dome integrals are built in parallel: the same sky for 1, 2 and 3 threads.
+TEST(AnalyticSky, SameSkyForAnyThreadCount) {
+    SkyConditions c;
+    c.sunDirection = glm::normalize(glm::dvec3(-0.9, 0.2, 0.03));
+    c.sunIlluminance_lux = 2e4;
+    c.turbidity = 3.0;
+    c.moon = true;
+    c.moonDirection = glm::normalize(glm::dvec3(0.8, -0.3, 0.3));
+    c.moonPhaseAngle_rad = 0.4;
+    const auto build = [&](int threads) {
+        tbb::task_arena arena(threads);
+        std::unique_ptr<AnalyticSky> sky;
+        arena.execute([&] { sky = std::make_unique<AnalyticSky>(c); });
+        return sky;
+    };
+    const auto one = build(1);
+    for (const int threads : {2, 3}) {
+        const auto many = build(threads);
+        EXPECT_EQ(one->HorizontalSkyIlluminance(), many->HorizontalSkyIlluminance());
+        EXPECT_EQ(one->DaylightScale(), many->DaylightScale());
+        for (int i = 0; i < 2000; ++i) {
+            const double az = 0.731 * i, el = 0.5 * M_PI * ((i * 37) % 2000) / 2000.0;
+            const glm::vec3 d(float(std::cos(el) * std::sin(az)),
+                              float(std::cos(el) * std::cos(az)), float(std::sin(el)));
+            EXPECT_EQ(one->LookUp(d), many->LookUp(d)) << i;
+        }
     }
 }
 
