@@ -11,11 +11,12 @@
 #include <vector>
 
 #include "scene/surf/surf_waves.h"
+#include "tests/scene/surf/linear_wave_theory.h"
 
 namespace seasense::scene {
 namespace {
 
-constexpr double kG = 9.80665;
+using linear_waves::kG;
 constexpr double kPi = std::numbers::pi;
 constexpr double kGamma = 0.78;  // McCowan (1894)
 constexpr double kSlope = 0.02;  // plane beach
@@ -26,19 +27,8 @@ constexpr double kHs0_m = 1.0;  // deep-water significant height 4σ
 constexpr double kBarDistance_m = 250.0, kBarWidth_m = 30.0, kBarSide_m = 30.0;
 constexpr double kBarU_m = 150.0, kPlainU_m = 450.0;  // centre of the bar, the bar-less region
 
-// k from ω² = g k tanh(k h) by bisection, and the group speed (linear theory).
-double K(double omega, double h) {
-    double lo = 1e-8, hi = 1e3;
-    for (int i = 0; i < 200; ++i) {
-        const double mid = 0.5 * (lo + hi);
-        (kG * mid * std::tanh(mid * h) < omega * omega ? lo : hi) = mid;
-    }
-    return 0.5 * (lo + hi);
-}
-double Cg(double omega, double h) {
-    const double k = K(omega, h);
-    return 0.5 * omega / k * (1.0 + 2.0 * k * h / std::sinh(2.0 * k * h));
-}
+using linear_waves::Cg;
+using linear_waves::K;
 
 // A narrow-band random sea travelling west (to the shore at x = 0): equal amplitudes, fixed
 // incommensurate phases; Σ A²/2 = (Hs0/4)².

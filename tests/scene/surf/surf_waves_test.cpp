@@ -10,26 +10,16 @@
 #include <numbers>
 
 #include "scene/ocean/ocean_surface.h"
+#include "tests/scene/surf/linear_wave_theory.h"
 
 namespace seasense::scene {
 namespace {
 
-constexpr double kG = 9.80665;
+using linear_waves::kG;
 constexpr double kPi = std::numbers::pi;
 
-// k from ω² = g k tanh(k h) by bisection (independent of the library's solver).
-double K(double omega, double h) {
-    double lo = 1e-8, hi = 1e3;
-    for (int i = 0; i < 200; ++i) {
-        const double mid = 0.5 * (lo + hi);
-        (kG * mid * std::tanh(mid * h) < omega * omega ? lo : hi) = mid;
-    }
-    return 0.5 * (lo + hi);
-}
-double Cg(double omega, double h) {
-    const double k = K(omega, h);
-    return 0.5 * omega / k * (1.0 + 2.0 * k * h / std::sinh(2.0 * k * h));
-}
+using linear_waves::Cg;
+using linear_waves::K;
 
 // Shoreline running north at x = 0 (sea to the east), all zones at one slope, or a flat shelf.
 SurfSettings Beach(double slope) {
