@@ -142,6 +142,11 @@ UniformTable::UniformTable(std::vector<float> nodes, float xMax)
       scale_(float(nodes_.size() - 1) / xMax),
       last_(float(nodes_.size() - 1)) {
     CHECK(nodes_.size() >= 2 && xMax > 0.0f);
+    cells_.resize(2 * (nodes_.size() - 1));
+    for (size_t i = 0; i + 1 < nodes_.size(); ++i) {
+        cells_[2 * i] = nodes_[i];
+        cells_[2 * i + 1] = nodes_[i + 1];
+    }
 }
 
 void UniformTable::operator()(size_t count, const float* x, float* out) const {
@@ -154,10 +159,14 @@ void UniformTable::operator()(size_t count, const float* x, float* out) const {
         const I4 cell = _mm_cvttps_epi32(_mm_min_ps(u, lastCell));
         alignas(16) int32_t c[4];
         _mm_store_si128(reinterpret_cast<__m128i*>(c), cell);
-        const F4 a = _mm_setr_ps(nodes_[size_t(c[0])], nodes_[size_t(c[1])], nodes_[size_t(c[2])],
-                                 nodes_[size_t(c[3])]);
-        const F4 b = _mm_setr_ps(nodes_[size_t(c[0]) + 1], nodes_[size_t(c[1]) + 1],
-                                 nodes_[size_t(c[2]) + 1], nodes_[size_t(c[3]) + 1]);
+        // Each lane's two nodes in one 64-bit load: (a0 b0 a1 b1) and (a2 b2 a3 b3).
+        const auto Cell = [&](int k) {
+            return reinterpret_cast<const __m64*>(cells_.data() + 2 * size_t(c[k]));
+        };
+        const F4 c01 = _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), Cell(0)), Cell(1));
+        const F4 c23 = _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), Cell(2)), Cell(3));
+        const F4 a = _mm_shuffle_ps(c01, c23, _MM_SHUFFLE(2, 0, 2, 0));
+        const F4 b = _mm_shuffle_ps(c01, c23, _MM_SHUFFLE(3, 1, 3, 1));
         const F4 f = _mm_sub_ps(u, _mm_cvtepi32_ps(cell));
         StoreLanes(out + i, lanes, _mm_add_ps(a, _mm_mul_ps(_mm_sub_ps(b, a), f)));
     }

@@ -96,6 +96,9 @@ class UniformTable {
 
   private:
     std::vector<float> nodes_{0.0f, 0.0f};
+    // Cell i as the pair (node i, node i + 1), for one 64-bit load per lane in the four-lane
+    // lookup.
+    std::vector<float> cells_{0.0f, 0.0f};
     float scale_ = 1.0f;  // (n − 1) / xMax
     float last_ = 1.0f;   // n − 1
 };

@@ -2,8 +2,11 @@
 #include "sensors/thermal/normal_deviates.h"
 
 #include <array>
+#include <bit>
 #include <cmath>
 #include <numbers>
+
+#include "scene/core/rng.h"
 
 namespace seasense::sensors {
 
@@ -45,26 +48,43 @@ const QuantileTable& Table() {
     return table;
 }
 
-}  // namespace
-
-float NormalFromBits(uint32_t bits) {
-    const QuantileTable& t = Table();
+// NormalFromBits with the table passed in (the function-local static is looked up once per
+// row in NormalPairsRow).
+inline float FromBits(const QuantileTable& t, uint32_t bits) {
     const uint32_t v = bits >> 1;  // 31 bits of v·2³¹
     const uint32_t k = v >> kFractionBits;
     float z;
-    if (k + 1 < uint32_t(kTableSize)) {
+    if (k + 1 < uint32_t(kTableSize)) [[likely]] {
         const float f = float(v & ((1u << kFractionBits) - 1)) * (1.0f / (1u << kFractionBits));
         z = t.value[k] + f * (t.value[k + 1] - t.value[k]);
     } else {
         // 1 − v for the 31-bit v, exact in double.
         z = float(HalfNormalQuantile(double((1u << 31) - v) * 0x1.0p-31));
     }
-    return (bits & 1u) ? -z : z;
+    // The sign by flipping the sign bit, not by a branch (the bit is random: a branch on it
+    // mispredicts every other deviate).
+    return std::bit_cast<float>(std::bit_cast<uint32_t>(z) ^ (bits << 31));
 }
 
+}  // namespace
+
+float NormalFromBits(uint32_t bits) { return FromBits(Table(), bits); }
+
 void NormalPair(uint64_t bits, float& z0, float& z1) {
-    z0 = NormalFromBits(uint32_t(bits >> 32));
-    z1 = NormalFromBits(uint32_t(bits));
+    const QuantileTable& t = Table();
+    z0 = FromBits(t, uint32_t(bits >> 32));
+    z1 = FromBits(t, uint32_t(bits));
+}
+
+void NormalPairsRow(uint64_t key, uint64_t counter0, size_t count, float* z) {
+    const QuantileTable& t = Table();
+    size_t i = 0;
+    for (uint64_t c = counter0; i + 1 < count; ++c, i += 2) {
+        const uint64_t bits = scene::Mix64(key ^ c);
+        z[i] = FromBits(t, uint32_t(bits >> 32));
+        z[i + 1] = FromBits(t, uint32_t(bits));
+    }
+    if (i < count) z[i] = FromBits(t, uint32_t(scene::Mix64(key ^ (counter0 + i / 2)) >> 32));
 }
 
 }  // namespace seasense::sensors

@@ -1,6 +1,7 @@
 // Standard normal deviates from counter-RNG bits by table inversion of the normal CDF.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 
 namespace seasense::sensors {
@@ -15,5 +16,10 @@ void NormalPair(uint64_t bits, float& z0, float& z1);
 
 // One deviate from 32 random bits (the low half of NormalPair's input gives z1).
 float NormalFromBits(uint32_t bits);
+
+// A row of count deviates: z[2p] and z[2p + 1] are NormalPair(scene::Mix64(key ^ (counter0 +
+// p))) (an odd count drops the last pair's second). The same values as NormalPair one pair at a
+// time, in one call so that the table lookup inlines into the loop.
+void NormalPairsRow(uint64_t key, uint64_t counter0, size_t count, float* z);
 
 }  // namespace seasense::sensors

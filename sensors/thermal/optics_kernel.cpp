@@ -6,7 +6,9 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 #include <sstream>
 
@@ -184,54 +186,135 @@ SamplingKernel BuildSamplingKernel(const radiometry::Band& band, const OpticsGeo
             sum += t;
         }
     // Analytically the taps sum to OTF(0, 0) = 1; dividing by the computed sum removes the
-    // rounding so a uniform scene keeps its radiance. Mirrored rows are averaged so the
-    // y symmetry the row folding relies on holds bit for bit.
+    // rounding so a uniform scene keeps its radiance. Mirrored rows and columns are averaged
+    // so the x and y symmetry the row and column folding rely on holds bit for bit.
     kernel.taps.assign(size_t(K) * size_t(kernel.padded), 0.0f);
+    const auto tap = [&](int i, int j) { return taps[size_t(i) * K + size_t(j)]; };
     for (int i = 0; i < K; ++i)
         for (int j = 0; j < K; ++j) {
-            const double mirrored =
-                0.5 * (taps[size_t(i) * K + size_t(j)] + taps[size_t(K - 1 - i) * K + size_t(j)]);
+            const double mirrored = 0.25 * ((tap(i, j) + tap(K - 1 - i, j)) +
+                                            (tap(i, K - 1 - j) + tap(K - 1 - i, K - 1 - j)));
             kernel.taps[size_t(i) * kernel.padded + size_t(j)] = float(mirrored / sum);
         }
     return kernel;
 }
+
+namespace {
+
+// ⌊a / b⌋ for b > 0.
+int FloorDiv(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
+
+// Pixels per step of the row loop: four four-lane accumulators, so that four independent
+// chains of additions hide the adder's latency (one chain is latency-bound).
+constexpr int kGroups = 4;
+constexpr int kPixelsPerStep = 4 * kGroups;
+
+}  // namespace
 
 void SampleKernelRow(const Image& samples, const SamplingKernel& kernel, int y, float* out,
                      std::vector<float>& scratch) {
     const int n = kernel.supersamples, K = kernel.size, Kp = kernel.padded;
     CHECK(samples.channels == 1 && samples.width % n == 0 && samples.height % n == 0);
     const int W = samples.width, H = samples.height, w = W / n;
-    const int o = (n - K) / 2;  // first tap relative to the pixel's first sample
+    const int o = (n - K) / 2;  // first tap relative to the pixel's first sample (≤ 0)
+    // Tap (i, j) of pixel x reads sample column n·x + o + j. With d = o + j that is
+    // n·(x + ⌊d/n⌋) + (d mod n): entry x + ⌊d/n⌋ of phase d mod n, where phase r of a row
+    // holds its samples r, n + r, 2n + r, … So the taps of four neighbouring pixels are four
+    // consecutive floats of one phase array, and the loop runs four pixels to a lane group.
+    const int mMin = FloorDiv(o, n);
+    const int steps = (w + kPixelsPerStep - 1) / kPixelsPerStep;
+    const int len = steps * kPixelsPerStep + FloorDiv(o + K - 1, n) - mMin + 1;
     // Folded rows: row i holds S[y₀ + i] + S[y₀ + K − 1 − i] (the centre row of an odd K
-    // alone), extended by Kp clamped samples on each side so no pixel needs a border case.
+    // alone), split into its n phases; entry m − mMin of phase r is column n·m + r, clamped to
+    // the image (the border samples repeat outward).
     const int folded = (K + 1) / 2;
-    const int pad = Kp;
-    const size_t stride = size_t(W + 2 * pad);
-    scratch.resize(size_t(folded) * stride);
+    const int pairs = K / 2;  // columns j and K − 1 − j share a tap (even OTF)
+    const size_t phaseStride = size_t(len), rowStride = size_t(n) * phaseStride;
+    const size_t tapFloats = size_t(folded) * size_t(pairs + 1) * 4;
+    scratch.resize(size_t(folded) * rowStride + tapFloats + 4);
+    float* phases = scratch.data();
     for (int i = 0; i < folded; ++i) {
         const float* a = samples.At(0, std::clamp(y * n + o + i, 0, H - 1));
         const float* b = samples.At(0, std::clamp(y * n + o + K - 1 - i, 0, H - 1));
-        float* dst = scratch.data() + size_t(i) * stride + size_t(pad);
-        if (2 * i + 1 == K) {
-            std::copy(a, a + W, dst);
-        } else {
-            for (int x = 0; x < W; ++x) dst[x] = a[x] + b[x];
+        const bool centre = 2 * i + 1 == K;
+        float* row = phases + size_t(i) * rowStride;
+        // Columns n·m + r inside the image for m in [mLo, mHi).
+        const int mLo = std::max(0, mMin), mHi = std::min(W / n, mMin + len);
+        auto at = [&](int c) {
+            c = std::clamp(c, 0, W - 1);
+            return centre ? a[c] : a[c] + b[c];
+        };
+        for (int r = 0; r < n; ++r) {
+            float* dst = row + size_t(r) * phaseStride - mMin;
+            for (int m = mMin; m < mLo; ++m) dst[m] = at(n * m + r);
+            for (int m = std::max(mHi, mLo); m < mMin + len; ++m) dst[m] = at(n * m + r);
         }
-        std::fill(dst - pad, dst, dst[0]);
-        std::fill(dst + W, dst + W + pad, dst[W - 1]);
+        int m = mLo;
+        if (n == 2 && !centre) {
+            // Even and odd samples of eight columns at a time.
+            float* even = row - mMin;
+            float* odd = row + phaseStride - mMin;
+            for (; m + 4 <= mHi; m += 4) {
+                const __m128 s0 = _mm_add_ps(_mm_loadu_ps(a + 2 * m), _mm_loadu_ps(b + 2 * m));
+                const __m128 s1 =
+                    _mm_add_ps(_mm_loadu_ps(a + 2 * m + 4), _mm_loadu_ps(b + 2 * m + 4));
+                _mm_storeu_ps(even + m, _mm_shuffle_ps(s0, s1, _MM_SHUFFLE(2, 0, 2, 0)));
+                _mm_storeu_ps(odd + m, _mm_shuffle_ps(s0, s1, _MM_SHUFFLE(3, 1, 3, 1)));
+            }
+        }
+        for (; m < mHi; ++m)
+            for (int r = 0; r < n; ++r)
+                row[size_t(r) * phaseStride + size_t(m - mMin)] =
+                    centre ? a[n * m + r] : a[n * m + r] + b[n * m + r];
     }
-    for (int x = 0; x < w; ++x) {
-        __m128 acc = _mm_setzero_ps();
-        const size_t x0 = size_t(x * n + o + pad);  // ≥ 0: pad ≥ K > −o
+    // Taps broadcast to four lanes: pairs (and the centre column of an odd K) per folded row.
+    float* taps = phases + size_t(folded) * rowStride;
+    taps += (16 - reinterpret_cast<uintptr_t>(taps) % 16) % 16 / sizeof(float);
+    const int perRow = pairs + K % 2;
+    for (int i = 0; i < folded; ++i)
+        for (int p = 0; p < perRow; ++p)
+            std::fill_n(taps + (size_t(i) * size_t(perRow) + size_t(p)) * 4, 4,
+                        kernel.taps[size_t(i) * size_t(Kp) + size_t(p)]);
+    // Offsets of the two columns of each pair (the centre column twice) within folded row 0.
+    std::array<size_t, (kMaxKernelTaps + 1) / 2> first, second;
+    for (int p = 0; p < perRow; ++p) {
+        const int d1 = o + p, d2 = o + K - 1 - p;
+        first[size_t(p)] =
+            size_t(d1 - FloorDiv(d1, n) * n) * phaseStride + size_t(FloorDiv(d1, n) - mMin);
+        second[size_t(p)] =
+            size_t(d2 - FloorDiv(d2, n) * n) * phaseStride + size_t(FloorDiv(d2, n) - mMin);
+    }
+    // Fixed summation order per pixel (folded rows, then pairs, then the centre column): the
+    // result of a pixel does not depend on its lane or on the threading.
+    for (int step = 0; step < steps; ++step) {
+        const int x = step * kPixelsPerStep;
+        __m128 acc[kGroups];
+        for (__m128& v : acc) v = _mm_setzero_ps();
         for (int i = 0; i < folded; ++i) {
-            const float* src = scratch.data() + size_t(i) * stride + x0;
-            const float* tap = kernel.taps.data() + size_t(i) * size_t(Kp);
-            for (int j = 0; j < Kp; j += 4)
-                acc = _mm_add_ps(acc, _mm_mul_ps(_mm_loadu_ps(src + j), _mm_loadu_ps(tap + j)));
+            const float* row = phases + size_t(i) * rowStride + size_t(x);
+            const float* tap = taps + size_t(i) * size_t(perRow) * 4;
+            for (int p = 0; p < pairs; ++p) {
+                const float* u = row + first[size_t(p)];
+                const float* v = row + second[size_t(p)];
+                const __m128 t = _mm_load_ps(tap + 4 * p);
+                for (int g = 0; g < kGroups; ++g)
+                    acc[g] = _mm_add_ps(acc[g], _mm_mul_ps(t, _mm_add_ps(_mm_loadu_ps(u + 4 * g),
+                                                                         _mm_loadu_ps(v + 4 * g))));
+            }
+            if (K % 2) {
+                const float* u = row + first[size_t(pairs)];
+                const __m128 t = _mm_load_ps(tap + 4 * pairs);
+                for (int g = 0; g < kGroups; ++g)
+                    acc[g] = _mm_add_ps(acc[g], _mm_mul_ps(t, _mm_loadu_ps(u + 4 * g)));
+            }
         }
-        alignas(16) float lanes[4];
-        _mm_store_ps(lanes, acc);
-        out[x] = (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
+        if (x + kPixelsPerStep <= w) {
+            for (int g = 0; g < kGroups; ++g) _mm_storeu_ps(out + x + 4 * g, acc[g]);
+        } else {
+            alignas(16) float lanes[kPixelsPerStep];
+            for (int g = 0; g < kGroups; ++g) _mm_store_ps(lanes + 4 * g, acc[g]);
+            std::copy(lanes, lanes + (w - x), out + x);
+        }
     }
 }
 

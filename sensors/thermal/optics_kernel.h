@@ -45,7 +45,8 @@ double SystemOtf(const radiometry::Band& band, const OpticsGeometry& geometry, d
 // A K×K convolution kernel on the supersample grid (spacing pitch/N) whose taps sit at offsets
 // (j − (K − 1)/2)·pitch/N from a pixel centre; K ≡ N (mod 2), so the taps are the supersamples
 // of the pixel and of its neighbours. taps[i·padded + j] is row i (y), column j (x); columns
-// K … padded − 1 are zero (four-lane loads). Rows i and K − 1 − i are identical (even OTF).
+// K … padded − 1 are zero. Rows i and K − 1 − i are identical, and so are columns j and
+// K − 1 − j (even OTF), bit for bit.
 struct SamplingKernel {
     int supersamples = 1;  // N
     int size = 1;          // K
@@ -75,10 +76,11 @@ int SamplingKernelRadius_px(const radiometry::Band& band, const OpticsGeometry& 
 
 // One row y of the sampled image: out[x] = Σ taps · samples around the centre of pixel (x, y)
 // for x in [0, samples.width / N). samples: 1 channel, (w·N)×(h·N); edges clamp (the border
-// samples repeat outward). The kernel is even in y, so each pair of sample rows at mirrored
-// offsets is summed first and weighted once (half the multiplies). scratch is working memory,
-// reused between calls (one per thread). Fixed summation order per pixel: bit-identical for
-// any threading.
+// samples repeat outward). The kernel is even in y and in x, so each pair of sample rows at
+// mirrored offsets is summed first, and then each pair of mirrored columns, and weighted once
+// (a quarter of the multiplies); the row is split into its N sample phases so that four
+// neighbouring pixels are four lanes. scratch is working memory, reused between calls (one
+// per thread). Fixed summation order per pixel: bit-identical for any threading.
 void SampleKernelRow(const Image& samples, const SamplingKernel& kernel, int y, float* out,
                      std::vector<float>& scratch);
 

@@ -1,6 +1,7 @@
 // Thermal AGC (plateau equalization, linear clip, manual), smoothing, polarity and palettes.
 #include "sensors/thermal/thermal_display.h"
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -37,8 +38,28 @@ int CountAtRank(std::span<const uint32_t> histogram, uint64_t rank) {
 }  // namespace
 
 std::vector<uint32_t> CountHistogram(std::span<const uint16_t> counts) {
+    // Blocks of the frame are counted in parallel and their histograms summed level by level:
+    // integer sums, so the result does not depend on the threading.
+    constexpr size_t kBlock = size_t(1) << 16;
+    const size_t blocks = std::max<size_t>(1, (counts.size() + kBlock - 1) / kBlock);
+    std::vector<uint32_t> partial(blocks * kAdcLevels, 0);
+    tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
+        uint32_t* h = partial.data() + b * kAdcLevels;
+        const size_t end = std::min(counts.size(), (b + 1) * kBlock);
+        for (size_t i = b * kBlock; i < end; ++i) {
+            const uint16_t c = counts[i];
+            ++h[c < kAdcLevels ? c : kAdcMaxCount];
+        }
+    });
+    if (blocks == 1) return partial;
     std::vector<uint32_t> h(kAdcLevels, 0);
-    for (uint16_t c : counts) ++h[c < kAdcLevels ? c : kAdcMaxCount];
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, kAdcLevels, 2048),
+                      [&](const tbb::blocked_range<size_t>& levels) {
+                          for (size_t b = 0; b < blocks; ++b) {
+                              const uint32_t* p = partial.data() + b * kAdcLevels;
+                              for (size_t c = levels.begin(); c < levels.end(); ++c) h[c] += p[c];
+                          }
+                      });
     return h;
 }
 

@@ -1,7 +1,9 @@
 // Thermal imager chain: sampling kernel, lag, NETD noise, fixed pattern, NUC, ADC and AGC.
 #include "sensors/thermal/thermal_imager.h"
 
+#include <emmintrin.h>
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -11,11 +13,15 @@
 
 #include "scene/core/error.h"
 #include "scene/core/rng.h"
+#include "scene/core/simd4.h"
 #include "sensors/thermal/normal_deviates.h"
 
 namespace seasense::sensors {
 
 namespace {
+
+using simd4::LoadLanes;
+using simd4::StoreLanes;
 
 constexpr double kPi = std::numbers::pi;
 
@@ -39,12 +45,6 @@ inline float Gaussian(uint64_t seed, uint64_t stream, uint64_t counter) {
 // Noise counter of pixel (x, y): one hash serves the pair (x, x + 1), x even.
 inline uint64_t PairCounter(int x, int y) {
     return (uint64_t(uint32_t(y)) << 32) | uint32_t(x / 2);
-}
-
-inline uint16_t Quantize(double v) {
-    if (!(v > 0.0)) return 0;  // also NaN
-    if (v >= double(kAdcMaxCount)) return kAdcMaxCount;
-    return uint16_t(v + 0.5);  // round half up; v ≥ 0
 }
 
 void Validate(const ThermalImagerSettings& s, int supersamples) {
@@ -255,33 +255,84 @@ void ThermalImager::Process(const Image& samples, double time_s, int64_t noiseFr
     // the pixel loop.
     const uint64_t key =
         scene::Mix64(scene::Mix64(settings_.seed) ^ (kStreamTemporal + uint64_t(noiseFrame)));
+    // The per-pixel chain in double, two lanes at a time, with the same operations in the same
+    // order as the scalar definition:
+    //   L = τ·blurred, lagged = y + α(L − y) (L on a settled frame), E = kE·lagged,
+    //   s = gain·E + offset + float(noiseScale·σ·z)  (s = E + float(σ·z) for an ideal response),
+    //   counts = Quantize(adcGain·s + adcOffset).
+    const __m128d tau2 = _mm_set1_pd(tau), alpha2 = _mm_set1_pd(alpha), kE2 = _mm_set1_pd(kE);
+    const __m128d adcGain2 = _mm_set1_pd(adcGain_), adcOffset2 = _mm_set1_pd(adcOffset_);
+    const __m128d zero2 = _mm_setzero_pd(), top2 = _mm_set1_pd(double(kAdcMaxCount));
+    const __m128d half2 = _mm_set1_pd(0.5);
+    const __m128 sigma4 = _mm_set1_ps(sigma);
+    const bool settled = alpha == 1.0;
     tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
-        std::vector<float> scratch;
+        RowScratch& scratch = scratch_.local();
+        scratch.noise.resize(size_t(w) + 4);
+        float* z = scratch.noise.data();
         for (int y = rows.begin(); y < rows.end(); ++y) {
             float* rad = radiance_.At(0, y);
             float* sig = signal_.At(0, y);
             uint16_t* cnt = counts_.data() + size_t(y) * size_t(w);
-            SampleKernelRow(samples, kernel_, y, sig, scratch);  // blurred at-aperture radiance
-            for (int x = 0; x < w; x += 2) {
-                float z[2] = {0.0f, 0.0f};
-                if (noisy) NormalPair(scene::Mix64(key ^ PairCounter(x, y)), z[0], z[1]);
-                for (int k = 0; k < 2 && x + k < w; ++k) {
-                    const int xx = x + k;
-                    const double L = tau * double(sig[xx]);
-                    const double lagged = alpha == 1.0 ? L : rad[xx] + alpha * (L - rad[xx]);
-                    rad[xx] = float(lagged);
-                    const double E = kE * lagged;
-                    double s;
-                    if (ideal) {
-                        s = E + double(sigma * z[k]);
-                    } else {
-                        const size_t i = size_t(y) * size_t(w) + size_t(xx);
-                        s = double(gain_[i]) * E + double(offset_[i]) +
-                            double(noiseScale_[i] * sigma * z[k]);
-                    }
-                    sig[xx] = float(s);
-                    cnt[xx] = Quantize(adcGain_ * s + adcOffset_);
+            const size_t row = size_t(y) * size_t(w);
+            // Blurred at-aperture radiance.
+            SampleKernelRow(samples, kernel_, y, sig, scratch.kernel);
+            if (noisy)
+                NormalPairsRow(key, PairCounter(0, y), size_t(w), z);
+            else
+                std::fill_n(z, w, 0.0f);
+            for (int x = 0; x < w; x += 4) {
+                const size_t lanes = size_t(std::min(4, w - x));
+                const __m128 blurred = LoadLanes(sig + x, lanes, 0.0f);
+                const __m128 y4 = LoadLanes(rad + x, lanes, 0.0f);
+                // float(noiseScale·σ·z), left to right as the scalar product.
+                const __m128 z4 = LoadLanes(z + x, lanes, 0.0f);
+                __m128 noise, gain4 = _mm_setzero_ps(), offset4 = _mm_setzero_ps();
+                if (ideal) {
+                    noise = _mm_mul_ps(sigma4, z4);
+                } else {
+                    const float* scale = noiseScale_.data() + row + size_t(x);
+                    noise = _mm_mul_ps(_mm_mul_ps(LoadLanes(scale, lanes, 0.0f), sigma4), z4);
+                    gain4 = LoadLanes(gain_.data() + row + size_t(x), lanes, 0.0f);
+                    offset4 = LoadLanes(offset_.data() + row + size_t(x), lanes, 0.0f);
                 }
+                __m128d lagged[2], signal[2];
+                for (int half = 0; half < 2; ++half) {
+                    // Lanes 2·half, 2·half + 1 as doubles.
+                    const auto Half = [half](__m128 v) {
+                        return _mm_cvtps_pd(half ? _mm_movehl_ps(v, v) : v);
+                    };
+                    const __m128d L = _mm_mul_pd(tau2, Half(blurred));
+                    __m128d lag = L;
+                    if (!settled) {
+                        const __m128d prev = Half(y4);
+                        lag = _mm_add_pd(prev, _mm_mul_pd(alpha2, _mm_sub_pd(L, prev)));
+                    }
+                    const __m128d E = _mm_mul_pd(kE2, lag);
+                    __m128d sv;
+                    if (ideal)
+                        sv = _mm_add_pd(E, Half(noise));
+                    else
+                        sv = _mm_add_pd(_mm_add_pd(_mm_mul_pd(Half(gain4), E), Half(offset4)),
+                                        Half(noise));
+                    lagged[half] = lag;
+                    signal[half] = sv;
+                }
+                const auto Floats = [](const __m128d* v) {
+                    return _mm_movelh_ps(_mm_cvtpd_ps(v[0]), _mm_cvtpd_ps(v[1]));
+                };
+                StoreLanes(rad + x, lanes, Floats(lagged));
+                StoreLanes(sig + x, lanes, Floats(signal));
+                // Quantize: NaN and v ≤ 0 → 0 (maxpd returns its second operand for NaN),
+                // v ≥ 16383 → 16383, else ⌊v + ½⌋.
+                alignas(16) int32_t q[4];
+                for (int half = 0; half < 2; ++half) {
+                    __m128d v = _mm_add_pd(_mm_mul_pd(adcGain2, signal[half]), adcOffset2);
+                    v = _mm_min_pd(_mm_max_pd(v, zero2), top2);
+                    _mm_storel_epi64(reinterpret_cast<__m128i*>(q + 2 * half),
+                                     _mm_cvttpd_epi32(_mm_add_pd(v, half2)));
+                }
+                for (size_t k = 0; k < lanes; ++k) cnt[size_t(x) + k] = uint16_t(q[k]);
             }
         }
     });

@@ -1,6 +1,8 @@
 // The thermal imager: at-aperture band radiance in, 14-bit counts and display frames out.
 #pragma once
 
+#include <tbb/enumerable_thread_specific.h>
+
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -111,6 +113,12 @@ class ThermalImager {
     Image radiance_, signal_;
     std::vector<uint16_t> counts_;
     std::vector<uint8_t> display8_;
+    // Per-thread working memory of Process, kept between frames: the sampling kernel's rows
+    // and one row of noise deviates.
+    struct RowScratch {
+        std::vector<float> kernel, noise;
+    };
+    tbb::enumerable_thread_specific<RowScratch> scratch_;
     int64_t frame_ = 0;           // frames processed
     int64_t lastNoiseFrame_ = 0;  // noiseFrame of the last frame (its frame index)
     double lastTime_s_ = 0.0;

@@ -289,6 +289,28 @@ channels:
     fs::remove_all(dir);
 }
 
+TEST(FlirChannel, UniformTableInterpolatesLinearlyAndItsFourLaneLookupEqualsTheScalarOne) {
+    // Nodes of an uneven function on [0, 2]: linear interpolation returns a node at its abscissa,
+    // the mean of two nodes halfway, and clamps outside [0, xMax].
+    std::vector<float> nodes;
+    for (int i = 0; i < 9; ++i) nodes.push_back(float(std::exp(0.4 * i) - 0.3 * i * i));
+    const UniformTable table(nodes, 2.0f);
+    EXPECT_EQ(table(0.75f), nodes[3]);
+    EXPECT_NEAR(table(0.875f), 0.5f * (nodes[3] + nodes[4]), 1e-6f * std::abs(nodes[4]));
+    EXPECT_EQ(table(-1.0f), nodes[0]);
+    EXPECT_EQ(table(5.0f), nodes[8]);
+    // The four-lane lookup, for every count (partial last groups too), bit for bit.
+    std::vector<float> x;
+    for (int i = 0; i < 37; ++i) x.push_back(-0.3f + 0.071f * float(i));
+    x.push_back(2.0f);
+    x.push_back(0.0f);
+    for (size_t count = 1; count <= x.size(); ++count) {
+        std::vector<float> out(count);
+        table(count, x.data(), out.data());
+        for (size_t i = 0; i < count; ++i) EXPECT_EQ(out[i], table(x[i])) << count << " " << i;
+    }
+}
+
 TEST(FlirChannel, ShadingTransmittanceTableFollowsTheAtmosphere) {
     // The per-sample path transmittance is a table over √range; it must stay with the exact
     // band transmittance of radiometry::Atmosphere from a metre to the table's 200 km.

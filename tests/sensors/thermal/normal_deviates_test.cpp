@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 #include "scene/core/rng.h"
 
@@ -49,6 +50,19 @@ TEST(NormalDeviates, QuantilesAreExactAtTableNodesAndInTheTail) {
         const uint32_t v = (1u << 31) - k;
         const double z = NormalFromBits(v << 1);
         EXPECT_NEAR(std::erfc(z / std::numbers::sqrt2) / (k * 0x1.0p-31), 1.0, 1e-5) << k;
+    }
+}
+
+TEST(NormalDeviates, RowOfPairsEqualsPairByPair) {
+    const uint64_t key = scene::Mix64(12345), counter0 = uint64_t(17) << 32;
+    for (size_t count : {size_t(1), size_t(2), size_t(9), size_t(640)}) {
+        std::vector<float> row(count);
+        NormalPairsRow(key, counter0, count, row.data());
+        for (size_t i = 0; i < count; ++i) {
+            float z[2];
+            NormalPair(scene::Mix64(key ^ (counter0 + i / 2)), z[0], z[1]);
+            EXPECT_EQ(row[i], z[i % 2]) << count << " " << i;
+        }
     }
 }
 

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -101,6 +102,63 @@ TEST(OpticsKernel, MeasuredMtfMatchesAnalyticDiffractionAberrationFootprintProdu
                 << "F/" << c.fNumber << " fill " << c.fill << " N " << c.n << " f (" << f[0] << ", "
                 << f[1] << ") cy/px";
         }
+    }
+}
+
+// The plain definition of the sampling: out(x, y) = Σ_ij taps[i][j]·S(clamp(n·x + o + j),
+// clamp(n·y + o + i)), o = (n − K)/2, summed in double over the full K×K taps.
+Image ReferenceSampling(const Image& s, const SamplingKernel& k) {
+    const int n = k.supersamples, K = k.size, o = (n - K) / 2;
+    Image out(s.width / n, s.height / n, 1);
+    for (int y = 0; y < out.height; ++y)
+        for (int x = 0; x < out.width; ++x) {
+            double sum = 0.0;
+            for (int i = 0; i < K; ++i)
+                for (int j = 0; j < K; ++j) {
+                    const int sx = std::clamp(n * x + o + j, 0, s.width - 1);
+                    const int sy = std::clamp(n * y + o + i, 0, s.height - 1);
+                    sum += double(k.taps[size_t(i * k.padded + j)]) * s.At(sx, sy)[0];
+                }
+            out.At(x, y)[0] = float(sum);
+        }
+    return out;
+}
+
+TEST(OpticsKernel, FoldedPhaseSamplingEqualsTheDirectConvolution) {
+    // Odd and even N (odd and even K), image widths that are not a multiple of the 16-pixel
+    // step, kernels wider than the image: every path of SampleKernelRow against the definition.
+    OpticsGeometry g;
+    g.fNumber = 1.2;
+    g.fillFactor = 0.8;
+    g.aberrationSigma_m = 4e-6;
+    for (int n : {1, 2, 3})
+        for (int w : {5, 23, 40}) {
+            const SamplingKernel k = BuildSamplingKernel(radiometry::Band::Lwir(), g, n, 4);
+            const int h = 7;
+            Image s(w * n, h * n, 1);
+            for (int y = 0; y < s.height; ++y)
+                for (int x = 0; x < s.width; ++x)
+                    s.At(x, y)[0] =
+                        float(30.0 + 10.0 * std::sin(0.7 * x + 1.3 * y) + (x * 7 + y * 3) % 11);
+            const Image fast = ApplySamplingKernel(s, k), ref = ReferenceSampling(s, k);
+            for (size_t i = 0; i < ref.pixels.size(); ++i)
+                ASSERT_NEAR(fast.pixels[i], ref.pixels[i], 2e-6 * ref.pixels[i])
+                    << "N " << n << " w " << w << " pixel " << i;
+        }
+}
+
+TEST(OpticsKernel, TapsAreEvenInBothAxesBitForBit) {
+    OpticsGeometry g;
+    g.fillFactor = 0.7;
+    for (int n : {1, 2, 3}) {
+        const SamplingKernel k = BuildSamplingKernel(radiometry::Band::Lwir(), g, n, 3);
+        const int K = k.size;
+        for (int i = 0; i < K; ++i)
+            for (int j = 0; j < K; ++j) {
+                const float t = k.taps[size_t(i * k.padded + j)];
+                EXPECT_EQ(t, k.taps[size_t((K - 1 - i) * k.padded + j)]);
+                EXPECT_EQ(t, k.taps[size_t(i * k.padded + K - 1 - j)]);
+            }
     }
 }
 
