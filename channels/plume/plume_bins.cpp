@@ -152,14 +152,37 @@ int PlumeScreenBins::TileOf(int px, int py) const {
     return (py / kTile) * tilesX_ + px / kTile;
 }
 
-void PlumeScreenBins::Gather(int x0, int y0, int x1, int y1, float smallPixels, bool copy,
-                             List& out) const {
+void PlumeScreenBins::Begin(List& out) {
     out.count = 0;
     out.index.clear();
     out.near_m = std::numeric_limits<float>::infinity();
     out.far_m = 0.0f;
     out.smallOpticalDepth = 0.0f;
     out.halfSmallOpticalDepth = 0.0f;
+}
+
+inline void PlumeScreenBins::Take(uint32_t k, int x0, int y0, int x1, int y1, float smallPixels,
+                                  List& out) const {
+    const Rect& r = rect_[k];
+    if (r.x1 <= x0 || r.x0 >= x1 || r.y1 <= y0 || r.y0 >= y1) return;
+    out.index.push_back(k);
+    out.near_m = std::min(out.near_m, data_[kNear][k]);
+    out.far_m = std::max(out.far_m, far_[k]);
+    if (sigmaPixels_[k] < smallPixels) out.smallOpticalDepth += tauMax_[k];
+    if (sigmaPixels_[k] < 0.5f * smallPixels) out.halfSmallOpticalDepth += tauMax_[k];
+}
+
+void PlumeScreenBins::Finish(bool copy, List& out) const {
+    out.count = out.index.size();
+    const size_t padded = (out.count + 3) & ~size_t(3);
+    out.index.resize(padded, inert_);
+    out.copied = false;
+    if (copy) Copy(out);
+}
+
+void PlumeScreenBins::Gather(int x0, int y0, int x1, int y1, float smallPixels, bool copy,
+                             List& out) const {
+    Begin(out);
     x1 = std::min(x1, width_), y1 = std::min(y1, height_);
     if (x0 < x1 && y0 < y1) {
         // The rectangle's tiles; their lists are merged in kept order, each puff once.
@@ -177,17 +200,9 @@ void PlumeScreenBins::Gather(int x0, int y0, int x1, int y1, float smallPixels, 
                 end[lists] = tileEntries_.data() + tileStart_[t + 1];
                 if (cur[lists] != end[lists]) ++lists;
             }
-        const auto take = [&](uint32_t k) {
-            const Rect& r = rect_[k];
-            if (r.x1 <= x0 || r.x0 >= x1 || r.y1 <= y0 || r.y0 >= y1) return;
-            out.index.push_back(k);
-            out.near_m = std::min(out.near_m, data_[kNear][k]);
-            out.far_m = std::max(out.far_m, far_[k]);
-            if (sigmaPixels_[k] < smallPixels) out.smallOpticalDepth += tauMax_[k];
-            if (sigmaPixels_[k] < 0.5f * smallPixels) out.halfSmallOpticalDepth += tauMax_[k];
-        };
         if (lists == 1) {
-            for (const uint32_t* p = cur[0]; p != end[0]; ++p) take(*p);
+            for (const uint32_t* p = cur[0]; p != end[0]; ++p)
+                Take(*p, x0, y0, x1, y1, smallPixels, out);
         } else {
             for (;;) {
                 uint32_t k = std::numeric_limits<uint32_t>::max();
@@ -196,15 +211,22 @@ void PlumeScreenBins::Gather(int x0, int y0, int x1, int y1, float smallPixels, 
                 if (k == std::numeric_limits<uint32_t>::max()) break;
                 for (int l = 0; l < lists; ++l)
                     if (cur[l] != end[l] && *cur[l] == k) ++cur[l];
-                take(k);
+                Take(k, x0, y0, x1, y1, smallPixels, out);
             }
         }
     }
-    out.count = out.index.size();
-    const size_t padded = (out.count + 3) & ~size_t(3);
-    out.index.resize(padded, inert_);
-    out.copied = false;
-    if (copy) Copy(out);
+    Finish(copy, out);
+}
+
+void PlumeScreenBins::Gather(const List& from, int x0, int y0, int x1, int y1, float smallPixels,
+                             bool copy, List& out) const {
+    CHECK(&from != &out);
+    Begin(out);
+    x1 = std::min(x1, width_), y1 = std::min(y1, height_);
+    if (x0 < x1 && y0 < y1)
+        for (size_t j = 0; j < from.count; ++j)
+            Take(from.index[j], x0, y0, x1, y1, smallPixels, out);
+    Finish(copy, out);
 }
 
 void PlumeScreenBins::Copy(List& list) const {

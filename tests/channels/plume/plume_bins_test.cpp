@@ -1,6 +1,7 @@
 // Tests of the screen-space puff bins: traces within the stated transmittance tolerance of the
 // exact sum over every puff (no cutoff, double-precision erf) for committed plumes and for a
-// thick flame puff, and the dropping of puffs too thin to matter.
+// thick flame puff, lists taken from larger lists equal to lists from the tiles, and the
+// dropping of puffs too thin to matter.
 #include "channels/plume/plume_bins.h"
 
 #include <gtest/gtest.h>
@@ -114,6 +115,37 @@ TEST(PlumeScreenBins, CommittedPlumesWithinToleranceOfTheExactSum) {
             }
         }
     }
+}
+
+// A cell's list taken from a larger rectangle's list is the list gathered from the tiles: the
+// same puffs in the same order, ranges and small-puff sums bit for bit (CompositePlumes takes
+// each 4 × 4 cell's list from its tile strip's).
+TEST(PlumeScreenBins, GatherFromALargerListEqualsGatherFromTheTiles) {
+    const scene::PlumeField field = CommittedPlumes();
+    const ChannelCamera cam = NorthCamera({0.0, 0.0, 20.0}, 200, 150, 40.0, 3.0);
+    const PlumeScreenBins bins(field, cam, ObscurantBand::Visible);
+    PlumeScreenBins::List strip, fromStrip, fromTiles;
+    size_t nonEmpty = 0;
+    for (int y0 = 0; y0 < cam.height; y0 += 4) {
+        for (int x0 = 0; x0 < cam.width; x0 += PlumeScreenBins::kTile) {
+            bins.Gather(x0, y0, x0 + PlumeScreenBins::kTile + 1, y0 + 5, 4.0f, false, strip);
+            for (int x = x0; x < x0 + PlumeScreenBins::kTile; x += 4) {
+                bins.Gather(strip, x, y0, x + 5, y0 + 5, 4.0f, false, fromStrip);
+                bins.Gather(x, y0, x + 5, y0 + 5, 4.0f, false, fromTiles);
+                ASSERT_EQ(fromStrip.count, fromTiles.count) << x << ", " << y0;
+                EXPECT_EQ(fromStrip.index, fromTiles.index);
+                EXPECT_EQ(std::memcmp(&fromStrip.near_m, &fromTiles.near_m, 4), 0);
+                EXPECT_EQ(std::memcmp(&fromStrip.far_m, &fromTiles.far_m, 4), 0);
+                EXPECT_EQ(
+                    std::memcmp(&fromStrip.smallOpticalDepth, &fromTiles.smallOpticalDepth, 4), 0);
+                EXPECT_EQ(std::memcmp(&fromStrip.halfSmallOpticalDepth,
+                                      &fromTiles.halfSmallOpticalDepth, 4),
+                          0);
+                nonEmpty += fromTiles.count > 0;
+            }
+        }
+    }
+    EXPECT_GT(nonEmpty, 100u);
 }
 
 // A flame puff of optical depth ~300 through its centre: at 3.5 σ (where a fixed cutoff
