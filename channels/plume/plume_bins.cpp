@@ -319,13 +319,18 @@ struct BandAccumulator {
 // u1 = u0 + S √(A/2).
 void PlumeScreenBins::Trace2(const List& list, const glm::vec3& dir, float range_m, float range2_m,
                              BandTrace& first, BandTrace& second) const {
-    if (list.copied)
-        Trace2Impl<true>(list, dir, range_m, range2_m, first, second);
+    const bool two = range2_m != range_m;
+    if (list.copied && two)
+        Trace2Impl<true, true>(list, dir, range_m, range2_m, first, second);
+    else if (list.copied)
+        Trace2Impl<true, false>(list, dir, range_m, range2_m, first, second);
+    else if (two)
+        Trace2Impl<false, true>(list, dir, range_m, range2_m, first, second);
     else
-        Trace2Impl<false>(list, dir, range_m, range2_m, first, second);
+        Trace2Impl<false, false>(list, dir, range_m, range2_m, first, second);
 }
 
-template <bool Copied>
+template <bool Copied, bool Two>
 void PlumeScreenBins::Trace2Impl(const List& l, const glm::vec3& dir, float range_m, float range2_m,
                                  BandTrace& first, BandTrace& second) const {
     // Four puffs' values of field f from k on: contiguous in a copied list, else gathered.
@@ -339,7 +344,6 @@ void PlumeScreenBins::Trace2Impl(const List& l, const glm::vec3& dir, float rang
         }
     };
     BandAccumulator a1, a2;
-    const bool two = range2_m != range_m;
     const F4 dx = _mm_set1_ps(dir.x), dy = _mm_set1_ps(dir.y), dz = _mm_set1_ps(dir.z);
     const F4 dh2 = _mm_set1_ps(dir.x * dir.x + dir.y * dir.y), dz2 = _mm_set1_ps(dir.z * dir.z);
     const F4 end = _mm_set1_ps(std::max(range_m, range2_m));
@@ -373,14 +377,14 @@ void PlumeScreenBins::Trace2Impl(const List& l, const glm::vec3& dir, float rang
                          load(kWg, k)};
         const F4 tau1 = _mm_mul_ps(amplitude, _mm_sub_ps(e1, e0));
         a1.Add(w, _mm_and_ps(_mm_and_ps(use, _mm_cmpgt_ps(tau1, zero)), tau1));
-        if (two) {
+        if constexpr (Two) {
             const F4 e2 = ErfOrSign4(_mm_add_ps(u0, _mm_mul_ps(r2, scale)));
             const F4 tau2 = _mm_mul_ps(amplitude, _mm_sub_ps(e2, e0));
             a2.Add(w, _mm_and_ps(_mm_and_ps(use, _mm_cmpgt_ps(tau2, zero)), tau2));
         }
     }
     first = a1.Result();
-    second = two ? a2.Result() : first;
+    second = Two ? a2.Result() : first;
 }
 
 BandTrace PlumeScreenBins::Trace(const List& list, const glm::vec3& dir, float range_m) const {

@@ -128,7 +128,9 @@ class PlumeScreenBins {
     static void Begin(List& out);
     void Take(uint32_t k, int x0, int y0, int x1, int y1, float smallPixels, List& out) const;
     void Finish(bool copy, List& out) const;
-    template <bool Copied>
+    // Two: the second range differs from the first (a separate loop without it keeps the
+    // accumulators of one trace in registers).
+    template <bool Copied, bool Two>
     void Trace2Impl(const List& list, const glm::vec3& dir, float range_m, float range2_m,
                     BandTrace& first, BandTrace& second) const;
     // Per tile, the kept positions of its puffs in increasing order.
