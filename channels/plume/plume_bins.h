@@ -84,6 +84,12 @@ class PlumeScreenBins {
     // Tile of pixel (px, py).
     int TileOf(int px, int py) const;
 
+    // Whether traces run eight puffs at a time (AVX2, where the CPU has it; the default) or
+    // four (SSE2). The results are bit-identical: the same operations lane for lane (no fused
+    // multiply-add) and the same order of the sums.
+    void UseWideTraces(bool on);
+    bool WideTraces() const { return wide_; }
+
     // The trace along eye + s·dir, s in [0, range_m], over list (gathered for a pixel rectangle
     // containing the pixel that dir points through); dir must be a unit vector. With a second
     // range range2_m ≥ range_m the trace to it goes to second in the same pass. Bit-identical
@@ -128,6 +134,13 @@ class PlumeScreenBins {
     static void Begin(List& out);
     void Take(uint32_t k, int x0, int y0, int x1, int y1, float smallPixels, List& out) const;
     void Finish(bool copy, List& out) const;
+    bool wide_ = false;
+    struct Accumulators;  // one trace's sums (plume_bins.cpp)
+    // Eight puffs at a time from the start of the list while eight remain; returns where the
+    // four-lane loop goes on.
+    template <bool Copied, bool Two>
+    size_t TraceWide(const List& list, const glm::vec3& dir, float range_m, float range2_m,
+                     Accumulators& acc) const;
     // Two: the second range differs from the first (a separate loop without it keeps the
     // accumulators of one trace in registers).
     template <bool Copied, bool Two>
