@@ -247,17 +247,19 @@ namespace {
 using simd4::Exp4;
 using simd4::F4;
 
+// The coefficients a5 … a1 of Abramowitz & Stegun 7.1.26, erf x ≈ 1 − t Σ a_k t^(k−1) e^(−x²)
+// with t = 1 / (1 + 0.3275911 x), highest degree first.
+constexpr float kErfAS[] = {1.061405429f, -1.453152027f, 1.421413741f, -0.284496736f, 0.254829592f};
+
 // FastErf on four lanes (A&S 7.1.26 with Exp4; |error| ≤ 1.5e-7 + 2e-7).
 inline F4 Erf4(F4 x) {
     const F4 sign = _mm_and_ps(x, _mm_set1_ps(-0.0f));
     const F4 ax = simd4::Abs4(x);
     const F4 t = _mm_div_ps(_mm_set1_ps(1.0f),
                             _mm_add_ps(_mm_set1_ps(1.0f), _mm_mul_ps(_mm_set1_ps(0.3275911f), ax)));
-    F4 poly = _mm_set1_ps(1.061405429f);
-    poly = _mm_add_ps(_mm_mul_ps(poly, t), _mm_set1_ps(-1.453152027f));
-    poly = _mm_add_ps(_mm_mul_ps(poly, t), _mm_set1_ps(1.421413741f));
-    poly = _mm_add_ps(_mm_mul_ps(poly, t), _mm_set1_ps(-0.284496736f));
-    poly = _mm_add_ps(_mm_mul_ps(poly, t), _mm_set1_ps(0.254829592f));
+    F4 poly = _mm_set1_ps(kErfAS[0]);
+    for (size_t i = 1; i < std::size(kErfAS); ++i)
+        poly = _mm_add_ps(_mm_mul_ps(poly, t), _mm_set1_ps(kErfAS[i]));
     poly = _mm_mul_ps(poly, t);
     F4 e = _mm_sub_ps(_mm_set1_ps(1.0f),
                       _mm_mul_ps(poly, Exp4(_mm_sub_ps(_mm_setzero_ps(), _mm_mul_ps(ax, ax)))));
@@ -312,6 +314,18 @@ struct BandAccumulator {
     }
 };
 
+// Four values of a field from k on: contiguous in a copied list, else gathered by index.
+template <bool Copied>
+inline F4 Load4(const std::vector<float>& copied, const float* field, const uint32_t* index,
+                size_t k) {
+    if constexpr (Copied) {
+        return _mm_loadu_ps(copied.data() + k);
+    } else {
+        const uint32_t* i = index + k;
+        return _mm_setr_ps(field[i[0]], field[i[1]], field[i[2]], field[i[3]]);
+    }
+}
+
 #if defined(__x86_64__) && defined(__GNUC__)
 #define SEASENSE_PLUME_WIDE 1
 using F8 = __m256;
@@ -323,13 +337,9 @@ __attribute__((target("avx2"))) inline F8 Exp8(F8 x) {
     const F8 fn = _mm256_cvtepi32_ps(n);
     F8 r = _mm256_sub_ps(x, _mm256_mul_ps(fn, _mm256_set1_ps(0.693359375f)));
     r = _mm256_sub_ps(r, _mm256_mul_ps(fn, _mm256_set1_ps(-2.12194440e-4f)));
-    F8 p = _mm256_set1_ps(1.0f / 720.0f);
-    p = _mm256_add_ps(_mm256_mul_ps(p, r), _mm256_set1_ps(1.0f / 120.0f));
-    p = _mm256_add_ps(_mm256_mul_ps(p, r), _mm256_set1_ps(1.0f / 24.0f));
-    p = _mm256_add_ps(_mm256_mul_ps(p, r), _mm256_set1_ps(1.0f / 6.0f));
-    p = _mm256_add_ps(_mm256_mul_ps(p, r), _mm256_set1_ps(0.5f));
-    p = _mm256_add_ps(_mm256_mul_ps(p, r), _mm256_set1_ps(1.0f));
-    p = _mm256_add_ps(_mm256_mul_ps(p, r), _mm256_set1_ps(1.0f));
+    F8 p = _mm256_set1_ps(simd4::kExpTaylor6[0]);
+    for (size_t i = 1; i < std::size(simd4::kExpTaylor6); ++i)
+        p = _mm256_add_ps(_mm256_mul_ps(p, r), _mm256_set1_ps(simd4::kExpTaylor6[i]));
     const F8 scale =
         _mm256_castsi256_ps(_mm256_slli_epi32(_mm256_add_epi32(n, _mm256_set1_epi32(127)), 23));
     return _mm256_mul_ps(p, scale);
@@ -345,11 +355,9 @@ __attribute__((target("avx2"))) inline F8 ErfOrSign8(F8 x) {
     const F8 t = _mm256_div_ps(
         _mm256_set1_ps(1.0f),
         _mm256_add_ps(_mm256_set1_ps(1.0f), _mm256_mul_ps(_mm256_set1_ps(0.3275911f), ax)));
-    F8 poly = _mm256_set1_ps(1.061405429f);
-    poly = _mm256_add_ps(_mm256_mul_ps(poly, t), _mm256_set1_ps(-1.453152027f));
-    poly = _mm256_add_ps(_mm256_mul_ps(poly, t), _mm256_set1_ps(1.421413741f));
-    poly = _mm256_add_ps(_mm256_mul_ps(poly, t), _mm256_set1_ps(-0.284496736f));
-    poly = _mm256_add_ps(_mm256_mul_ps(poly, t), _mm256_set1_ps(0.254829592f));
+    F8 poly = _mm256_set1_ps(kErfAS[0]);
+    for (size_t i = 1; i < std::size(kErfAS); ++i)
+        poly = _mm256_add_ps(_mm256_mul_ps(poly, t), _mm256_set1_ps(kErfAS[i]));
     poly = _mm256_mul_ps(poly, t);
     F8 e = _mm256_sub_ps(
         _mm256_set1_ps(1.0f),
@@ -410,13 +418,7 @@ __attribute__((target("avx2"))) size_t PlumeScreenBins::TraceWide(const List& l,
         return Load8<Copied>(l.data[f], data_[f].data(), l.index.data(), k);
     };
     const auto load4 = [&](int f, size_t k) {
-        if constexpr (Copied) {
-            return _mm_loadu_ps(l.data[f].data() + k);
-        } else {
-            const float* v = data_[f].data();
-            const uint32_t* i = l.index.data() + k;
-            return _mm_setr_ps(v[i[0]], v[i[1]], v[i[2]], v[i[3]]);
-        }
+        return Load4<Copied>(l.data[f], data_[f].data(), l.index.data(), k);
     };
     const F8 dx = _mm256_set1_ps(dir.x), dy = _mm256_set1_ps(dir.y), dz = _mm256_set1_ps(dir.z);
     const F8 dh2 = _mm256_set1_ps(dir.x * dir.x + dir.y * dir.y);
@@ -482,15 +484,8 @@ void PlumeScreenBins::Trace2(const List& list, const glm::vec3& dir, float range
 template <bool Copied, bool Two>
 void PlumeScreenBins::Trace2Impl(const List& l, const glm::vec3& dir, float range_m, float range2_m,
                                  BandTrace& first, BandTrace& second) const {
-    // Four puffs' values of field f from k on: contiguous in a copied list, else gathered.
     const auto load = [&](int f, size_t k) {
-        if constexpr (Copied) {
-            return _mm_loadu_ps(l.data[f].data() + k);
-        } else {
-            const float* v = data_[f].data();
-            const uint32_t* i = l.index.data() + k;
-            return _mm_setr_ps(v[i[0]], v[i[1]], v[i[2]], v[i[3]]);
-        }
+        return Load4<Copied>(l.data[f], data_[f].data(), l.index.data(), k);
     };
     Accumulators acc;
     BandAccumulator &a1 = acc.first, &a2 = acc.second;
