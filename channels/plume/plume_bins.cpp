@@ -15,6 +15,7 @@ namespace seasense::channels {
 PlumeScreenBins::PlumeScreenBins(const scene::PlumeField& field, const ChannelCamera& camera,
                                  scene::ObscurantBand band, float tolerance) {
     CHECK(tolerance > 0.0f);
+    UseWideTraces(true);
     width_ = camera.width + kMargin;
     height_ = camera.height + kMargin;
     tilesX_ = (width_ + kTile - 1) / kTile;
@@ -152,14 +153,37 @@ int PlumeScreenBins::TileOf(int px, int py) const {
     return (py / kTile) * tilesX_ + px / kTile;
 }
 
-void PlumeScreenBins::Gather(int x0, int y0, int x1, int y1, float smallPixels, bool copy,
-                             List& out) const {
+void PlumeScreenBins::Begin(List& out) {
     out.count = 0;
     out.index.clear();
     out.near_m = std::numeric_limits<float>::infinity();
     out.far_m = 0.0f;
     out.smallOpticalDepth = 0.0f;
     out.halfSmallOpticalDepth = 0.0f;
+}
+
+inline void PlumeScreenBins::Take(uint32_t k, int x0, int y0, int x1, int y1, float smallPixels,
+                                  List& out) const {
+    const Rect& r = rect_[k];
+    if (r.x1 <= x0 || r.x0 >= x1 || r.y1 <= y0 || r.y0 >= y1) return;
+    out.index.push_back(k);
+    out.near_m = std::min(out.near_m, data_[kNear][k]);
+    out.far_m = std::max(out.far_m, far_[k]);
+    if (sigmaPixels_[k] < smallPixels) out.smallOpticalDepth += tauMax_[k];
+    if (sigmaPixels_[k] < 0.5f * smallPixels) out.halfSmallOpticalDepth += tauMax_[k];
+}
+
+void PlumeScreenBins::Finish(bool copy, List& out) const {
+    out.count = out.index.size();
+    const size_t padded = (out.count + 3) & ~size_t(3);
+    out.index.resize(padded, inert_);
+    out.copied = false;
+    if (copy) Copy(out);
+}
+
+void PlumeScreenBins::Gather(int x0, int y0, int x1, int y1, float smallPixels, bool copy,
+                             List& out) const {
+    Begin(out);
     x1 = std::min(x1, width_), y1 = std::min(y1, height_);
     if (x0 < x1 && y0 < y1) {
         // The rectangle's tiles; their lists are merged in kept order, each puff once.
@@ -177,17 +201,9 @@ void PlumeScreenBins::Gather(int x0, int y0, int x1, int y1, float smallPixels, 
                 end[lists] = tileEntries_.data() + tileStart_[t + 1];
                 if (cur[lists] != end[lists]) ++lists;
             }
-        const auto take = [&](uint32_t k) {
-            const Rect& r = rect_[k];
-            if (r.x1 <= x0 || r.x0 >= x1 || r.y1 <= y0 || r.y0 >= y1) return;
-            out.index.push_back(k);
-            out.near_m = std::min(out.near_m, data_[kNear][k]);
-            out.far_m = std::max(out.far_m, far_[k]);
-            if (sigmaPixels_[k] < smallPixels) out.smallOpticalDepth += tauMax_[k];
-            if (sigmaPixels_[k] < 0.5f * smallPixels) out.halfSmallOpticalDepth += tauMax_[k];
-        };
         if (lists == 1) {
-            for (const uint32_t* p = cur[0]; p != end[0]; ++p) take(*p);
+            for (const uint32_t* p = cur[0]; p != end[0]; ++p)
+                Take(*p, x0, y0, x1, y1, smallPixels, out);
         } else {
             for (;;) {
                 uint32_t k = std::numeric_limits<uint32_t>::max();
@@ -196,15 +212,22 @@ void PlumeScreenBins::Gather(int x0, int y0, int x1, int y1, float smallPixels, 
                 if (k == std::numeric_limits<uint32_t>::max()) break;
                 for (int l = 0; l < lists; ++l)
                     if (cur[l] != end[l] && *cur[l] == k) ++cur[l];
-                take(k);
+                Take(k, x0, y0, x1, y1, smallPixels, out);
             }
         }
     }
-    out.count = out.index.size();
-    const size_t padded = (out.count + 3) & ~size_t(3);
-    out.index.resize(padded, inert_);
-    out.copied = false;
-    if (copy) Copy(out);
+    Finish(copy, out);
+}
+
+void PlumeScreenBins::Gather(const List& from, int x0, int y0, int x1, int y1, float smallPixels,
+                             bool copy, List& out) const {
+    CHECK(&from != &out);
+    Begin(out);
+    x1 = std::min(x1, width_), y1 = std::min(y1, height_);
+    if (x0 < x1 && y0 < y1)
+        for (size_t j = 0; j < from.count; ++j)
+            Take(from.index[j], x0, y0, x1, y1, smallPixels, out);
+    Finish(copy, out);
 }
 
 void PlumeScreenBins::Copy(List& list) const {
@@ -224,17 +247,19 @@ namespace {
 using simd4::Exp4;
 using simd4::F4;
 
+// The coefficients a5 … a1 of Abramowitz & Stegun 7.1.26, erf x ≈ 1 − t Σ a_k t^(k−1) e^(−x²)
+// with t = 1 / (1 + 0.3275911 x), highest degree first.
+constexpr float kErfAS[] = {1.061405429f, -1.453152027f, 1.421413741f, -0.284496736f, 0.254829592f};
+
 // FastErf on four lanes (A&S 7.1.26 with Exp4; |error| ≤ 1.5e-7 + 2e-7).
 inline F4 Erf4(F4 x) {
     const F4 sign = _mm_and_ps(x, _mm_set1_ps(-0.0f));
     const F4 ax = simd4::Abs4(x);
     const F4 t = _mm_div_ps(_mm_set1_ps(1.0f),
                             _mm_add_ps(_mm_set1_ps(1.0f), _mm_mul_ps(_mm_set1_ps(0.3275911f), ax)));
-    F4 poly = _mm_set1_ps(1.061405429f);
-    poly = _mm_add_ps(_mm_mul_ps(poly, t), _mm_set1_ps(-1.453152027f));
-    poly = _mm_add_ps(_mm_mul_ps(poly, t), _mm_set1_ps(1.421413741f));
-    poly = _mm_add_ps(_mm_mul_ps(poly, t), _mm_set1_ps(-0.284496736f));
-    poly = _mm_add_ps(_mm_mul_ps(poly, t), _mm_set1_ps(0.254829592f));
+    F4 poly = _mm_set1_ps(kErfAS[0]);
+    for (size_t i = 1; i < std::size(kErfAS); ++i)
+        poly = _mm_add_ps(_mm_mul_ps(poly, t), _mm_set1_ps(kErfAS[i]));
     poly = _mm_mul_ps(poly, t);
     F4 e = _mm_sub_ps(_mm_set1_ps(1.0f),
                       _mm_mul_ps(poly, Exp4(_mm_sub_ps(_mm_setzero_ps(), _mm_mul_ps(ax, ax)))));
@@ -289,7 +314,155 @@ struct BandAccumulator {
     }
 };
 
+// Four values of a field from k on: contiguous in a copied list, else gathered by index.
+template <bool Copied>
+inline F4 Load4(const std::vector<float>& copied, const float* field, const uint32_t* index,
+                size_t k) {
+    if constexpr (Copied) {
+        return _mm_loadu_ps(copied.data() + k);
+    } else {
+        const uint32_t* i = index + k;
+        return _mm_setr_ps(field[i[0]], field[i[1]], field[i[2]], field[i[3]]);
+    }
+}
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#define SEASENSE_PLUME_WIDE 1
+using F8 = __m256;
+
+// Exp4 on eight lanes (AVX2), the same operations lane for lane.
+__attribute__((target("avx2"))) inline F8 Exp8(F8 x) {
+    x = _mm256_min_ps(_mm256_max_ps(x, _mm256_set1_ps(-87.0f)), _mm256_set1_ps(88.0f));
+    const __m256i n = _mm256_cvtps_epi32(_mm256_mul_ps(x, _mm256_set1_ps(1.44269504f)));
+    const F8 fn = _mm256_cvtepi32_ps(n);
+    F8 r = _mm256_sub_ps(x, _mm256_mul_ps(fn, _mm256_set1_ps(0.693359375f)));
+    r = _mm256_sub_ps(r, _mm256_mul_ps(fn, _mm256_set1_ps(-2.12194440e-4f)));
+    F8 p = _mm256_set1_ps(simd4::kExpTaylor6[0]);
+    for (size_t i = 1; i < std::size(simd4::kExpTaylor6); ++i)
+        p = _mm256_add_ps(_mm256_mul_ps(p, r), _mm256_set1_ps(simd4::kExpTaylor6[i]));
+    const F8 scale =
+        _mm256_castsi256_ps(_mm256_slli_epi32(_mm256_add_epi32(n, _mm256_set1_epi32(127)), 23));
+    return _mm256_mul_ps(p, scale);
+}
+
+// ErfOrSign4 on eight lanes (Erf4's operations lane for lane; the shortcut when all eight
+// saturate gives what Erf4 gives there, ±1).
+__attribute__((target("avx2"))) inline F8 ErfOrSign8(F8 x) {
+    const F8 sign = _mm256_and_ps(x, _mm256_set1_ps(-0.0f));
+    const F8 ax = _mm256_andnot_ps(_mm256_set1_ps(-0.0f), x);
+    const F8 saturated = _mm256_cmp_ps(ax, _mm256_set1_ps(3.9f), _CMP_GE_OS);
+    if (_mm256_movemask_ps(saturated) == 0xFF) return _mm256_or_ps(_mm256_set1_ps(1.0f), sign);
+    const F8 t = _mm256_div_ps(
+        _mm256_set1_ps(1.0f),
+        _mm256_add_ps(_mm256_set1_ps(1.0f), _mm256_mul_ps(_mm256_set1_ps(0.3275911f), ax)));
+    F8 poly = _mm256_set1_ps(kErfAS[0]);
+    for (size_t i = 1; i < std::size(kErfAS); ++i)
+        poly = _mm256_add_ps(_mm256_mul_ps(poly, t), _mm256_set1_ps(kErfAS[i]));
+    poly = _mm256_mul_ps(poly, t);
+    F8 e = _mm256_sub_ps(
+        _mm256_set1_ps(1.0f),
+        _mm256_mul_ps(poly, Exp8(_mm256_sub_ps(_mm256_setzero_ps(), _mm256_mul_ps(ax, ax)))));
+    e = _mm256_blendv_ps(e, _mm256_set1_ps(1.0f), saturated);
+    return _mm256_or_ps(e, sign);
+}
+
+// Eight values of a field from k on: contiguous in a copied list, else gathered by index.
+template <bool Copied>
+__attribute__((target("avx2"))) inline F8 Load8(const std::vector<float>& copied,
+                                                const float* field, const uint32_t* index,
+                                                size_t k) {
+    if constexpr (Copied) {
+        return _mm256_loadu_ps(copied.data() + k);
+    } else {
+        const uint32_t* i = index + k;
+        return _mm256_setr_ps(field[i[0]], field[i[1]], field[i[2]], field[i[3]], field[i[4]],
+                              field[i[5]], field[i[6]], field[i[7]]);
+    }
+}
+
+// Adds eight optical depths (kept where use and τ > 0) to a, the low four lanes first, as the
+// four-lane loop adds two groups; w: each half's weights.
+__attribute__((target("avx2"))) inline void AddHalves(BandAccumulator& a, const F4 (&w)[2][5],
+                                                      F8 use, F8 tau) {
+    const F8 kept =
+        _mm256_and_ps(_mm256_and_ps(use, _mm256_cmp_ps(tau, _mm256_setzero_ps(), _CMP_GT_OS)), tau);
+    a.Add(w[0], _mm256_castps256_ps128(kept));
+    a.Add(w[1], _mm256_extractf128_ps(kept, 1));
+}
+#endif
+
 }  // namespace
+
+struct PlumeScreenBins::Accumulators {
+    BandAccumulator first, second;
+};
+
+void PlumeScreenBins::UseWideTraces(bool on) {
+#ifdef SEASENSE_PLUME_WIDE
+    wide_ = on && __builtin_cpu_supports("avx2");
+#else
+    wide_ = false;
+    (void)on;
+#endif
+}
+
+#ifdef SEASENSE_PLUME_WIDE
+// Trace2Impl's loop body on eight lanes; each half's sums are added to the four-lane
+// accumulators in list order, as the four-lane loop adds them.
+template <bool Copied, bool Two>
+__attribute__((target("avx2"))) size_t PlumeScreenBins::TraceWide(const List& l,
+                                                                  const glm::vec3& dir,
+                                                                  float range_m, float range2_m,
+                                                                  Accumulators& acc) const {
+    const auto load = [&](int f, size_t k) __attribute__((target("avx2"))) {
+        return Load8<Copied>(l.data[f], data_[f].data(), l.index.data(), k);
+    };
+    const auto load4 = [&](int f, size_t k) {
+        return Load4<Copied>(l.data[f], data_[f].data(), l.index.data(), k);
+    };
+    const F8 dx = _mm256_set1_ps(dir.x), dy = _mm256_set1_ps(dir.y), dz = _mm256_set1_ps(dir.z);
+    const F8 dh2 = _mm256_set1_ps(dir.x * dir.x + dir.y * dir.y);
+    const F8 dz2 = _mm256_set1_ps(dir.z * dir.z);
+    const F8 end = _mm256_set1_ps(std::max(range_m, range2_m));
+    const F8 r1 = _mm256_set1_ps(range_m), r2 = _mm256_set1_ps(range2_m);
+    const F8 zero = _mm256_setzero_ps(), half = _mm256_set1_ps(0.5f);
+    size_t k = 0;
+    for (; k + 8 <= l.index.size(); k += 8) {
+        const F8 qx = load(kQx, k), qy = load(kQy, k), qz = load(kQz, k);
+        const F8 ivh = load(kIvh, k), ivz = load(kIvz, k);
+        const F8 A = _mm256_add_ps(_mm256_mul_ps(dh2, ivh), _mm256_mul_ps(dz2, ivz));
+        const F8 B = _mm256_add_ps(
+            _mm256_mul_ps(_mm256_add_ps(_mm256_mul_ps(dx, qx), _mm256_mul_ps(dy, qy)), ivh),
+            _mm256_mul_ps(_mm256_mul_ps(dz, qz), ivz));
+        const F8 sStar = _mm256_sub_ps(zero, _mm256_div_ps(B, A));
+        const F8 rx = _mm256_add_ps(qx, _mm256_mul_ps(sStar, dx));
+        const F8 ry = _mm256_add_ps(qy, _mm256_mul_ps(sStar, dy));
+        const F8 rz = _mm256_add_ps(qz, _mm256_mul_ps(sStar, dz));
+        const F8 m2 = _mm256_add_ps(
+            _mm256_mul_ps(_mm256_add_ps(_mm256_mul_ps(rx, rx), _mm256_mul_ps(ry, ry)), ivh),
+            _mm256_mul_ps(_mm256_mul_ps(rz, rz), ivz));
+        const F8 use = _mm256_and_ps(_mm256_cmp_ps(m2, load(kCutoff2, k), _CMP_LE_OS),
+                                     _mm256_cmp_ps(load(kNear, k), end, _CMP_LT_OS));
+        if (_mm256_movemask_ps(use) == 0) continue;
+        const F8 scale = _mm256_sqrt_ps(_mm256_mul_ps(half, A));
+        const F8 u0 = _mm256_sub_ps(zero, _mm256_mul_ps(sStar, scale));
+        const F8 amplitude = _mm256_div_ps(
+            _mm256_mul_ps(load(kKappa, k), Exp8(_mm256_mul_ps(_mm256_set1_ps(-0.5f), m2))), scale);
+        const F8 e0 = ErfOrSign8(u0);
+        const F8 e1 = ErfOrSign8(_mm256_add_ps(u0, _mm256_mul_ps(r1, scale)));
+        const F4 w[2][5] = {
+            {load4(kWs, k), load4(kWAbsT, k), load4(kWHot, k), load4(kWHotT, k), load4(kWg, k)},
+            {load4(kWs, k + 4), load4(kWAbsT, k + 4), load4(kWHot, k + 4), load4(kWHotT, k + 4),
+             load4(kWg, k + 4)}};
+        AddHalves(acc.first, w, use, _mm256_mul_ps(amplitude, _mm256_sub_ps(e1, e0)));
+        if constexpr (Two) {
+            const F8 e2 = ErfOrSign8(_mm256_add_ps(u0, _mm256_mul_ps(r2, scale)));
+            AddHalves(acc.second, w, use, _mm256_mul_ps(amplitude, _mm256_sub_ps(e2, e0)));
+        }
+    }
+    return k;
+}
+#endif
 
 // Four puffs at a time. Per puff, along the ray the exponent of the Gaussian is
 // −(A s² + 2 B s + C) / 2, so ∫ over [0, S] = e^(−m²/2) (√π / 2) / √(A/2) · (erf u1 − erf u0),
@@ -297,33 +470,35 @@ struct BandAccumulator {
 // u1 = u0 + S √(A/2).
 void PlumeScreenBins::Trace2(const List& list, const glm::vec3& dir, float range_m, float range2_m,
                              BandTrace& first, BandTrace& second) const {
-    if (list.copied)
-        Trace2Impl<true>(list, dir, range_m, range2_m, first, second);
+    const bool two = range2_m != range_m;
+    if (list.copied && two)
+        Trace2Impl<true, true>(list, dir, range_m, range2_m, first, second);
+    else if (list.copied)
+        Trace2Impl<true, false>(list, dir, range_m, range2_m, first, second);
+    else if (two)
+        Trace2Impl<false, true>(list, dir, range_m, range2_m, first, second);
     else
-        Trace2Impl<false>(list, dir, range_m, range2_m, first, second);
+        Trace2Impl<false, false>(list, dir, range_m, range2_m, first, second);
 }
 
-template <bool Copied>
+template <bool Copied, bool Two>
 void PlumeScreenBins::Trace2Impl(const List& l, const glm::vec3& dir, float range_m, float range2_m,
                                  BandTrace& first, BandTrace& second) const {
-    // Four puffs' values of field f from k on: contiguous in a copied list, else gathered.
     const auto load = [&](int f, size_t k) {
-        if constexpr (Copied) {
-            return _mm_loadu_ps(l.data[f].data() + k);
-        } else {
-            const float* v = data_[f].data();
-            const uint32_t* i = l.index.data() + k;
-            return _mm_setr_ps(v[i[0]], v[i[1]], v[i[2]], v[i[3]]);
-        }
+        return Load4<Copied>(l.data[f], data_[f].data(), l.index.data(), k);
     };
-    BandAccumulator a1, a2;
-    const bool two = range2_m != range_m;
+    Accumulators acc;
+    BandAccumulator &a1 = acc.first, &a2 = acc.second;
+    size_t k = 0;
+#ifdef SEASENSE_PLUME_WIDE
+    if (wide_) k = TraceWide<Copied, Two>(l, dir, range_m, range2_m, acc);
+#endif
     const F4 dx = _mm_set1_ps(dir.x), dy = _mm_set1_ps(dir.y), dz = _mm_set1_ps(dir.z);
     const F4 dh2 = _mm_set1_ps(dir.x * dir.x + dir.y * dir.y), dz2 = _mm_set1_ps(dir.z * dir.z);
     const F4 end = _mm_set1_ps(std::max(range_m, range2_m));
     const F4 r1 = _mm_set1_ps(range_m), r2 = _mm_set1_ps(range2_m);
     const F4 zero = _mm_setzero_ps(), half = _mm_set1_ps(0.5f);
-    for (size_t k = 0; k < l.index.size(); k += 4) {
+    for (; k < l.index.size(); k += 4) {
         const F4 qx = load(kQx, k), qy = load(kQy, k), qz = load(kQz, k);
         const F4 ivh = load(kIvh, k), ivz = load(kIvz, k);
         const F4 A = _mm_add_ps(_mm_mul_ps(dh2, ivh), _mm_mul_ps(dz2, ivz));
@@ -351,14 +526,14 @@ void PlumeScreenBins::Trace2Impl(const List& l, const glm::vec3& dir, float rang
                          load(kWg, k)};
         const F4 tau1 = _mm_mul_ps(amplitude, _mm_sub_ps(e1, e0));
         a1.Add(w, _mm_and_ps(_mm_and_ps(use, _mm_cmpgt_ps(tau1, zero)), tau1));
-        if (two) {
+        if constexpr (Two) {
             const F4 e2 = ErfOrSign4(_mm_add_ps(u0, _mm_mul_ps(r2, scale)));
             const F4 tau2 = _mm_mul_ps(amplitude, _mm_sub_ps(e2, e0));
             a2.Add(w, _mm_and_ps(_mm_and_ps(use, _mm_cmpgt_ps(tau2, zero)), tau2));
         }
     }
     first = a1.Result();
-    second = two ? a2.Result() : first;
+    second = Two ? a2.Result() : first;
 }
 
 BandTrace PlumeScreenBins::Trace(const List& list, const glm::vec3& dir, float range_m) const {

@@ -73,10 +73,22 @@ class PlumeScreenBins {
         size_t size() const { return count; }
     };
     void Gather(int x0, int y0, int x1, int y1, float smallPixels, bool copy, List& out) const;
+    // The same list for a rectangle inside the one that `from` was gathered for, taken from
+    // from's puffs instead of the tiles' (from holds every puff reaching the smaller rectangle,
+    // in field order): the same puffs, ranges and sums bit for bit, for less work when many
+    // small rectangles share one larger one.
+    void Gather(const List& from, int x0, int y0, int x1, int y1, float smallPixels, bool copy,
+                List& out) const;
     // Copies a gathered list's data (no-op when copied already).
     void Copy(List& list) const;
     // Tile of pixel (px, py).
     int TileOf(int px, int py) const;
+
+    // Whether traces run eight puffs at a time (AVX2, where the CPU has it; the default) or
+    // four (SSE2). The results are bit-identical: the same operations lane for lane (no fused
+    // multiply-add) and the same order of the sums.
+    void UseWideTraces(bool on);
+    bool WideTraces() const { return wide_; }
 
     // The trace along eye + s·dir, s in [0, range_m], over list (gathered for a pixel rectangle
     // containing the pixel that dir points through); dir must be a unit vector. With a second
@@ -118,7 +130,20 @@ class PlumeScreenBins {
     std::vector<Rect> rect_;
     std::vector<float> far_, sigmaPixels_, tauMax_;
     uint32_t inert_ = 0;
-    template <bool Copied>
+    // Starts out's list for the rectangle and adds puff k to it if its rectangle overlaps.
+    static void Begin(List& out);
+    void Take(uint32_t k, int x0, int y0, int x1, int y1, float smallPixels, List& out) const;
+    void Finish(bool copy, List& out) const;
+    bool wide_ = false;
+    struct Accumulators;  // one trace's sums (plume_bins.cpp)
+    // Eight puffs at a time from the start of the list while eight remain; returns where the
+    // four-lane loop goes on.
+    template <bool Copied, bool Two>
+    size_t TraceWide(const List& list, const glm::vec3& dir, float range_m, float range2_m,
+                     Accumulators& acc) const;
+    // Two: the second range differs from the first (a separate loop without it keeps the
+    // accumulators of one trace in registers).
+    template <bool Copied, bool Two>
     void Trace2Impl(const List& list, const glm::vec3& dir, float range_m, float range2_m,
                     BandTrace& first, BandTrace& second) const;
     // Per tile, the kept positions of its puffs in increasing order.

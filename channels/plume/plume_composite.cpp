@@ -217,8 +217,10 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     std::vector<BandTrace> nodes(size_t(nodesX) * size_t(nodesY));
     std::vector<uint64_t> rowCovered(size_t(cellsY), 0), rowTraces(size_t(cellsY), 0),
         rowTests(size_t(cellsY), 0);
+    // The nodes' transmittances e^(−τ), for the smoothness test of the four cells around each.
+    std::vector<float> nodeT(nodes.size(), 1.0f);
     tbb::parallel_for(tbb::blocked_range<int>(0, cellsY, 1), [&](const tbb::blocked_range<int>& r) {
-        PlumeScreenBins::List list;
+        PlumeScreenBins::List strip, list;
         for (int cy = r.begin(); cy != r.end(); ++cy) {
             CellRow& row = cellRows[size_t(cy)];
             row.start.assign(size_t(cellsX) + 1, 0);
@@ -228,8 +230,16 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             row.smallOpticalDepth.assign(size_t(cellsX), 0.0f);
             row.halfSmallOpticalDepth.assign(size_t(cellsX), 0.0f);
             for (int cx = 0; cx < cellsX; ++cx) {
-                bins.Gather(cx * kCell, cy * kCell, cx * kCell + kCell + 1, cy * kCell + kCell + 1,
-                            float(kCell), false, list);
+                // The cells of one tile column take their puffs from the list of the strip of
+                // the tile that the row crosses (a cell reaches one pixel beyond itself): fewer
+                // puffs looked at than in the tiles' whole lists.
+                constexpr int kCellsPerTile = PlumeScreenBins::kTile / kCell;
+                static_assert(PlumeScreenBins::kTile % kCell == 0);
+                if (cx % kCellsPerTile == 0)
+                    bins.Gather(cx * kCell, cy * kCell, cx * kCell + PlumeScreenBins::kTile + 1,
+                                cy * kCell + kCell + 1, float(kCell), false, strip);
+                bins.Gather(strip, cx * kCell, cy * kCell, cx * kCell + kCell + 1,
+                            cy * kCell + kCell + 1, float(kCell), false, list);
                 row.start[size_t(cx)] = uint32_t(row.index.size());
                 if (list.size() == 0) continue;
                 row.index.insert(row.index.end(), list.index.begin(), list.index.end());
@@ -241,8 +251,10 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                 for (int k = 0; k < 4; ++k) {
                     const int nx = cx + k % 2, ny = cy + k / 2;
                     if ((nx > cx && nx < cellsX) || (ny > cy && ny < cellsY)) continue;
-                    nodes[size_t(ny) * size_t(nodesX) + size_t(nx)] =
+                    const size_t n = size_t(ny) * size_t(nodesX) + size_t(nx);
+                    nodes[n] =
                         bins.Trace(list, PixelDirection(nx * kCell, ny * kCell), kPlumeSkyRange_m);
+                    nodeT[n] = std::exp(-nodes[n].opticalDepth);
                     ++rowTraces[size_t(cy)];
                     rowTests[size_t(cy)] += list.size();
                 }
@@ -256,11 +268,12 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     // corners that see absorbing puffs; the others have none) within kInterpolationTolerance_K,
     // and the puffs the corners could miss are faint (not fine). clear: every corner sees no
     // puff, so the blend is zero.
-    const auto Smooth = [](const BandTrace* const corner[4], bool fine, bool& clear) {
+    const auto Smooth = [](const BandTrace* const corner[4], const float transmittance[4],
+                           bool fine, bool& clear) {
         float lo = 1.0f, hi = 0.0f, tauHi = 0.0f;
         float tLo = std::numeric_limits<float>::infinity(), tHi = 0.0f;
         for (int k = 0; k < 4; ++k) {
-            const float T = std::exp(-corner[k]->opticalDepth);
+            const float T = transmittance[k];
             lo = std::min(lo, T), hi = std::max(hi, T);
             tauHi = std::max(tauHi, corner[k]->opticalDepth);
             if (corner[k]->temperature_K > 0.0f) {
@@ -275,154 +288,183 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
         return smooth;
     };
 
+    // The depths of cell row cy's samples in its cells with puffs, read once in the visibility
+    // buffer's order (its rows streamed rather than 2 × 2 samples at a time) into kCell·N rows
+    // of vis.width at out; −1 where the sample sees the sky.
+    const auto ReadDepths = [&](int cy, const CellRow& row, float* out) {
+        const int rowSamples = kCell * N, sy0 = cy * rowSamples;
+        for (int j = 0; j < std::min(rowSamples, vis.height - sy0); ++j) {
+            const size_t idx0 = vis.Index(0, sy0 + j);
+            const float* depth = vis.depth.data() + idx0;
+            const uint32_t* primitive = vis.primitive.data() + idx0;
+            float* o = out + size_t(j) * size_t(vis.width);
+            for (int cx = 0; cx < cellsX; ++cx) {
+                if (row.count[size_t(cx)] == 0) continue;
+                for (int sx = cx * rowSamples; sx < std::min((cx + 1) * rowSamples, vis.width);
+                     ++sx) {
+                    const bool sky = primitive[sx] == kNoPrimitive || depth[sx] <= 0.0f;
+                    o[sx] = sky ? -1.0f : depth[sx];
+                }
+            }
+        }
+    };
+
     // Pass 2, cells in parallel (a row of cells each); each pixel depends only on its own rays
     // and the cell's corner nodes.
-    tbb::parallel_for(
-        tbb::blocked_range<int>(0, cellsY, 1), [&](const tbb::blocked_range<int>& rows) {
-            std::vector<float> range(samples);
-            PlumeScreenBins::List list;
-            for (int cy = rows.begin(); cy != rows.end(); ++cy) {
-                const CellRow& row = cellRows[size_t(cy)];
-                for (int cx = 0; cx < cellsX; ++cx) {
-                    if (row.count[size_t(cx)] == 0) continue;
-                    list.count = row.count[size_t(cx)];
-                    list.index.assign(row.index.begin() + row.start[size_t(cx)],
-                                      row.index.begin() + row.start[size_t(cx) + 1]);
-                    list.near_m = row.near_m[size_t(cx)];
-                    list.far_m = row.far_m[size_t(cx)];
-                    list.smallOpticalDepth = row.smallOpticalDepth[size_t(cx)];
-                    list.halfSmallOpticalDepth = row.halfSmallOpticalDepth[size_t(cx)];
-                    list.copied = false;
-                    // The ranges where the cell's puffs can matter.
-                    const float dNear = list.near_m, dFar = list.far_m;
-                    const BandTrace* corner[4];
-                    for (int k = 0; k < 4; ++k)
-                        corner[k] =
-                            &nodes[size_t(cy + k / 2) * size_t(nodesX) + size_t(cx + k % 2)];
-                    bool clearSky = false;
-                    const bool smooth =
-                        Smooth(corner, list.smallOpticalDepth > kInterpolationTolerance, clearSky);
-                    // Where the cell is not smooth, its sky pixels are refined on 2 × 2-pixel
-                    // sub-cells: sky traces at the 3 × 3 nodes every 2 pixels (made when
-                    // the first sky pixel needs them), the same criteria with the puffs
-                    // smaller than a sub-cell, and the pixels of a sub-cell that is not smooth
-                    // traced one by one (the nodes' pixels take their node's trace).
-                    bool refined = false;
-                    BandTrace sub[3][3];
-                    bool subSmooth[2][2], subClear[2][2];
-                    const auto Refine = [&] {
-                        refined = true;
-                        bins.Copy(list);
-                        for (int b = 0; b < 3; ++b)
-                            for (int a = 0; a < 3; ++a) {
-                                if (a % 2 == 0 && b % 2 == 0) {
-                                    sub[b][a] = *corner[(b / 2) * 2 + a / 2];
-                                    continue;
-                                }
-                                const int nx = cx * kCell + a * (kCell / 2),
-                                          ny = cy * kCell + b * (kCell / 2);
-                                sub[b][a] =
-                                    bins.Trace(list, PixelDirection(nx, ny), kPlumeSkyRange_m);
-                                ++rowTraces[size_t(cy)];
-                                rowTests[size_t(cy)] += list.size();
-                            }
-                        const bool subFine = list.halfSmallOpticalDepth > kInterpolationTolerance;
-                        for (int sb = 0; sb < 2; ++sb)
-                            for (int sa = 0; sa < 2; ++sa) {
-                                const BandTrace* c[4] = {&sub[sb][sa], &sub[sb][sa + 1],
-                                                         &sub[sb + 1][sa], &sub[sb + 1][sa + 1]};
-                                subSmooth[sb][sa] = Smooth(c, subFine, subClear[sb][sa]);
-                            }
-                    };
-                    for (int py = cy * kCell; py < std::min(H, (cy + 1) * kCell); ++py) {
-                        for (int px = cx * kCell; px < std::min(W, (cx + 1) * kCell); ++px) {
-                            ++rowCovered[size_t(cy)];
-                            // Samples that see the sky first (no direction needed for them).
-                            bool allSky = true;
-                            for (int j = 0; j < N; ++j)
-                                for (int i = 0; i < N; ++i) {
-                                    const size_t idx = vis.Index(px * N + i, py * N + j);
-                                    const bool sky = vis.primitive[idx] == kNoPrimitive ||
-                                                     vis.depth[idx] <= 0.0f;
-                                    range[size_t(j * N + i)] = sky ? kPlumeSkyRange_m : -1.0f;
-                                    allSky &= sky;
-                                }
-                            if (allSky && clearSky) continue;
-                            const glm::vec3 dir = PixelDirection(px, py);
-                            float rMin = kPlumeSkyRange_m, rMax = 0.0f;
-                            if (allSky) {
-                                rMax = kPlumeSkyRange_m;
-                            } else {
-                                // depth = near / w, w the distance along the optical axis.
-                                const float rangeScale =
-                                    nearM / std::max(glm::dot(dir, forward), 1e-6f);
-                                for (int j = 0; j < N; ++j)
-                                    for (int i = 0; i < N; ++i) {
-                                        float& r = range[size_t(j * N + i)];
-                                        if (r < 0.0f)
-                                            r = std::min(
-                                                rangeScale /
-                                                    vis.depth[vis.Index(px * N + i, py * N + j)],
-                                                kPlumeSkyRange_m);
-                                        rMin = std::min(rMin, r), rMax = std::max(rMax, r);
-                                    }
-                            }
-                            // Every surface in front of the plumes: nothing to add.
-                            if (rMax <= dNear) continue;
-                            if (rMin >= dFar) {
-                                // Every surface behind the plumes: the sky trace is the trace.
-                                if (clearSky) continue;
-                                if (smooth) {
-                                    const float fx = float(px - cx * kCell) / kCell;
-                                    const float fy = float(py - cy * kCell) / kCell;
-                                    Apply(Bilinear(corner, fx, fy), dir, px, py, range.data(), rMin,
-                                          rMax, nullptr);
-                                    continue;
-                                }
-                                if (!refined) Refine();
-                                const int lx = px - cx * kCell, ly = py - cy * kCell;
-                                constexpr int kHalf = kCell / 2;
-                                const int sa = lx / kHalf, sb = ly / kHalf;
-                                const int ix = lx - sa * kHalf, iy = ly - sb * kHalf;
-                                if (ix == 0 && iy == 0) {
-                                    Apply(sub[sb][sa], dir, px, py, range.data(), rMin, rMax,
-                                          nullptr);
-                                } else if (subSmooth[sb][sa]) {
-                                    if (subClear[sb][sa]) continue;
-                                    const BandTrace* c[4] = {&sub[sb][sa], &sub[sb][sa + 1],
-                                                             &sub[sb + 1][sa],
-                                                             &sub[sb + 1][sa + 1]};
-                                    Apply(Bilinear(c, float(ix) / kHalf, float(iy) / kHalf), dir,
-                                          px, py, range.data(), rMin, rMax, nullptr);
-                                } else {
-                                    ++rowTraces[size_t(cy)];
-                                    rowTests[size_t(cy)] += list.size();
-                                    Apply(bins.Trace(list, dir, kPlumeSkyRange_m), dir, px, py,
-                                          range.data(), rMin, rMax, nullptr);
-                                }
+    tbb::parallel_for(tbb::blocked_range<int>(0, cellsY, 1), [&](const tbb::blocked_range<int>&
+                                                                     rows) {
+        std::vector<float> range(samples);
+        PlumeScreenBins::List list;
+        const int rowSamples = kCell * N;
+        std::vector<float> depthRows(size_t(rowSamples) * size_t(vis.width));
+        for (int cy = rows.begin(); cy != rows.end(); ++cy) {
+            const CellRow& row = cellRows[size_t(cy)];
+            const int sy0 = cy * rowSamples;
+            ReadDepths(cy, row, depthRows.data());
+            const auto DepthAt = [&](int sx, int sy) {
+                return depthRows[size_t(sy - sy0) * size_t(vis.width) + size_t(sx)];
+            };
+            for (int cx = 0; cx < cellsX; ++cx) {
+                if (row.count[size_t(cx)] == 0) continue;
+                list.count = row.count[size_t(cx)];
+                list.index.assign(row.index.begin() + row.start[size_t(cx)],
+                                  row.index.begin() + row.start[size_t(cx) + 1]);
+                list.near_m = row.near_m[size_t(cx)];
+                list.far_m = row.far_m[size_t(cx)];
+                list.smallOpticalDepth = row.smallOpticalDepth[size_t(cx)];
+                list.halfSmallOpticalDepth = row.halfSmallOpticalDepth[size_t(cx)];
+                list.copied = false;
+                // The ranges where the cell's puffs can matter.
+                const float dNear = list.near_m, dFar = list.far_m;
+                const BandTrace* corner[4];
+                float cornerT[4];
+                for (int k = 0; k < 4; ++k) {
+                    const size_t n = size_t(cy + k / 2) * size_t(nodesX) + size_t(cx + k % 2);
+                    corner[k] = &nodes[n];
+                    cornerT[k] = nodeT[n];
+                }
+                bool clearSky = false;
+                const bool smooth = Smooth(
+                    corner, cornerT, list.smallOpticalDepth > kInterpolationTolerance, clearSky);
+                // Where the cell is not smooth, its sky pixels are refined on 2 × 2-pixel
+                // sub-cells: sky traces at the 3 × 3 nodes every 2 pixels (made when
+                // the first sky pixel needs them), the same criteria with the puffs
+                // smaller than a sub-cell, and the pixels of a sub-cell that is not smooth
+                // traced one by one (the nodes' pixels take their node's trace).
+                bool refined = false;
+                BandTrace sub[3][3];
+                float subT[3][3];
+                bool subSmooth[2][2], subClear[2][2];
+                const auto Refine = [&] {
+                    refined = true;
+                    bins.Copy(list);
+                    for (int b = 0; b < 3; ++b)
+                        for (int a = 0; a < 3; ++a) {
+                            if (a % 2 == 0 && b % 2 == 0) {
+                                sub[b][a] = *corner[(b / 2) * 2 + a / 2];
+                                subT[b][a] = cornerT[(b / 2) * 2 + a / 2];
                                 continue;
                             }
-                            // One ray to the nearest surface and, at a depth edge, one to the
-                            // farthest (the far samples see what lies beyond the near surface),
-                            // in one pass over the puffs.
-                            bins.Copy(list);
-                            if (rMax > rMin * kDepthEdgeRatio) {
-                                BandTrace nearTrace, farTrace;
-                                bins.Trace2(list, dir, rMin, rMax, nearTrace, farTrace);
-                                rowTraces[size_t(cy)] += 2;
-                                rowTests[size_t(cy)] += list.size();
-                                Apply(nearTrace, dir, px, py, range.data(), rMin, rMax, &farTrace);
+                            const int nx = cx * kCell + a * (kCell / 2),
+                                      ny = cy * kCell + b * (kCell / 2);
+                            sub[b][a] = bins.Trace(list, PixelDirection(nx, ny), kPlumeSkyRange_m);
+                            subT[b][a] = std::exp(-sub[b][a].opticalDepth);
+                            ++rowTraces[size_t(cy)];
+                            rowTests[size_t(cy)] += list.size();
+                        }
+                    const bool subFine = list.halfSmallOpticalDepth > kInterpolationTolerance;
+                    for (int sb = 0; sb < 2; ++sb)
+                        for (int sa = 0; sa < 2; ++sa) {
+                            const BandTrace* c[4] = {&sub[sb][sa], &sub[sb][sa + 1],
+                                                     &sub[sb + 1][sa], &sub[sb + 1][sa + 1]};
+                            const float cT[4] = {subT[sb][sa], subT[sb][sa + 1], subT[sb + 1][sa],
+                                                 subT[sb + 1][sa + 1]};
+                            subSmooth[sb][sa] = Smooth(c, cT, subFine, subClear[sb][sa]);
+                        }
+                };
+                for (int py = cy * kCell; py < std::min(H, (cy + 1) * kCell); ++py) {
+                    for (int px = cx * kCell; px < std::min(W, (cx + 1) * kCell); ++px) {
+                        ++rowCovered[size_t(cy)];
+                        // Samples that see the sky first (no direction needed for them).
+                        bool allSky = true;
+                        for (int j = 0; j < N; ++j)
+                            for (int i = 0; i < N; ++i) {
+                                const bool sky = DepthAt(px * N + i, py * N + j) < 0.0f;
+                                range[size_t(j * N + i)] = sky ? kPlumeSkyRange_m : -1.0f;
+                                allSky &= sky;
+                            }
+                        if (allSky && clearSky) continue;
+                        const glm::vec3 dir = PixelDirection(px, py);
+                        float rMin = kPlumeSkyRange_m, rMax = 0.0f;
+                        if (allSky) {
+                            rMax = kPlumeSkyRange_m;
+                        } else {
+                            // depth = near / w, w the distance along the optical axis.
+                            const float rangeScale =
+                                nearM / std::max(glm::dot(dir, forward), 1e-6f);
+                            for (int j = 0; j < N; ++j)
+                                for (int i = 0; i < N; ++i) {
+                                    float& r = range[size_t(j * N + i)];
+                                    if (r < 0.0f)
+                                        r = std::min(rangeScale / DepthAt(px * N + i, py * N + j),
+                                                     kPlumeSkyRange_m);
+                                    rMin = std::min(rMin, r), rMax = std::max(rMax, r);
+                                }
+                        }
+                        // Every surface in front of the plumes: nothing to add.
+                        if (rMax <= dNear) continue;
+                        if (rMin >= dFar) {
+                            // Every surface behind the plumes: the sky trace is the trace.
+                            if (clearSky) continue;
+                            if (smooth) {
+                                const float fx = float(px - cx * kCell) / kCell;
+                                const float fy = float(py - cy * kCell) / kCell;
+                                Apply(Bilinear(corner, fx, fy), dir, px, py, range.data(), rMin,
+                                      rMax, nullptr);
+                                continue;
+                            }
+                            if (!refined) Refine();
+                            const int lx = px - cx * kCell, ly = py - cy * kCell;
+                            constexpr int kHalf = kCell / 2;
+                            const int sa = lx / kHalf, sb = ly / kHalf;
+                            const int ix = lx - sa * kHalf, iy = ly - sb * kHalf;
+                            if (ix == 0 && iy == 0) {
+                                Apply(sub[sb][sa], dir, px, py, range.data(), rMin, rMax, nullptr);
+                            } else if (subSmooth[sb][sa]) {
+                                if (subClear[sb][sa]) continue;
+                                const BandTrace* c[4] = {&sub[sb][sa], &sub[sb][sa + 1],
+                                                         &sub[sb + 1][sa], &sub[sb + 1][sa + 1]};
+                                Apply(Bilinear(c, float(ix) / kHalf, float(iy) / kHalf), dir, px,
+                                      py, range.data(), rMin, rMax, nullptr);
                             } else {
                                 ++rowTraces[size_t(cy)];
                                 rowTests[size_t(cy)] += list.size();
-                                Apply(bins.Trace(list, dir, rMin), dir, px, py, range.data(), rMin,
-                                      rMax, nullptr);
+                                Apply(bins.Trace(list, dir, kPlumeSkyRange_m), dir, px, py,
+                                      range.data(), rMin, rMax, nullptr);
                             }
+                            continue;
+                        }
+                        // One ray to the nearest surface and, at a depth edge, one to the
+                        // farthest (the far samples see what lies beyond the near surface),
+                        // in one pass over the puffs.
+                        bins.Copy(list);
+                        if (rMax > rMin * kDepthEdgeRatio) {
+                            BandTrace nearTrace, farTrace;
+                            bins.Trace2(list, dir, rMin, rMax, nearTrace, farTrace);
+                            rowTraces[size_t(cy)] += 2;
+                            rowTests[size_t(cy)] += list.size();
+                            Apply(nearTrace, dir, px, py, range.data(), rMin, rMax, &farTrace);
+                        } else {
+                            ++rowTraces[size_t(cy)];
+                            rowTests[size_t(cy)] += list.size();
+                            Apply(bins.Trace(list, dir, rMin), dir, px, py, range.data(), rMin,
+                                  rMax, nullptr);
                         }
                     }
                 }
             }
-        });
+        }
+    });
     for (int y = 0; y < cellsY; ++y) {
         stats.pixelsCovered += rowCovered[size_t(y)];
         stats.traces += rowTraces[size_t(y)];

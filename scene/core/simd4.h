@@ -5,6 +5,7 @@
 #include <immintrin.h>
 
 #include <cstddef>
+#include <iterator>
 
 namespace seasense::simd4 {
 
@@ -31,19 +32,18 @@ inline F4 Dot4(F4 ax, F4 ay, F4 az, F4 bx, F4 by, F4 bz) {
 // x = n ln 2 + r with |r| ≤ ln 2 / 2 (ln 2 split in two so that n ln 2 is exact, Cody & Waite,
 // "Software Manual for the Elementary Functions" (1980) ch. 6), e^r by its degree-6 Taylor
 // polynomial (remainder ≤ (ln 2 / 2)^7 / 7! · √2 < 1.7e-7 relative), 2^n by the exponent bits.
+// The polynomial's coefficients, highest degree first (Horner's scheme).
+inline constexpr float kExpTaylor6[] = {1.0f / 720.0f, 1.0f / 120.0f, 1.0f / 24.0f, 1.0f / 6.0f,
+                                        0.5f,          1.0f,          1.0f};
 inline F4 Exp4(F4 x) {
     x = _mm_min_ps(_mm_max_ps(x, _mm_set1_ps(-87.0f)), _mm_set1_ps(88.0f));
     const __m128i n = _mm_cvtps_epi32(_mm_mul_ps(x, _mm_set1_ps(1.44269504f)));  // round
     const F4 fn = _mm_cvtepi32_ps(n);
     F4 r = _mm_sub_ps(x, _mm_mul_ps(fn, _mm_set1_ps(0.693359375f)));
     r = _mm_sub_ps(r, _mm_mul_ps(fn, _mm_set1_ps(-2.12194440e-4f)));
-    F4 p = _mm_set1_ps(1.0f / 720.0f);
-    p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(1.0f / 120.0f));
-    p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(1.0f / 24.0f));
-    p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(1.0f / 6.0f));
-    p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(0.5f));
-    p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(1.0f));
-    p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(1.0f));
+    F4 p = _mm_set1_ps(kExpTaylor6[0]);
+    for (size_t i = 1; i < std::size(kExpTaylor6); ++i)
+        p = _mm_add_ps(_mm_mul_ps(p, r), _mm_set1_ps(kExpTaylor6[i]));
     const F4 scale = _mm_castsi128_ps(_mm_slli_epi32(_mm_add_epi32(n, _mm_set1_epi32(127)), 23));
     return _mm_mul_ps(p, scale);
 }

@@ -1,6 +1,7 @@
 // Tests of the screen-space puff bins: traces within the stated transmittance tolerance of the
 // exact sum over every puff (no cutoff, double-precision erf) for committed plumes and for a
-// thick flame puff, and the dropping of puffs too thin to matter.
+// thick flame puff, lists taken from larger lists equal to lists from the tiles, eight-lane
+// traces equal to four-lane ones, and the dropping of puffs too thin to matter.
 #include "channels/plume/plume_bins.h"
 
 #include <gtest/gtest.h>
@@ -114,6 +115,72 @@ TEST(PlumeScreenBins, CommittedPlumesWithinToleranceOfTheExactSum) {
             }
         }
     }
+}
+
+// A cell's list taken from a larger rectangle's list is the list gathered from the tiles: the
+// same puffs in the same order, ranges and small-puff sums bit for bit (CompositePlumes takes
+// each 4 × 4 cell's list from its tile strip's).
+TEST(PlumeScreenBins, GatherFromALargerListEqualsGatherFromTheTiles) {
+    const scene::PlumeField field = CommittedPlumes();
+    const ChannelCamera cam = NorthCamera({0.0, 0.0, 20.0}, 200, 150, 40.0, 3.0);
+    const PlumeScreenBins bins(field, cam, ObscurantBand::Visible);
+    PlumeScreenBins::List strip, fromStrip, fromTiles;
+    size_t nonEmpty = 0;
+    for (int y0 = 0; y0 < cam.height; y0 += 4) {
+        for (int x0 = 0; x0 < cam.width; x0 += PlumeScreenBins::kTile) {
+            bins.Gather(x0, y0, x0 + PlumeScreenBins::kTile + 1, y0 + 5, 4.0f, false, strip);
+            for (int x = x0; x < x0 + PlumeScreenBins::kTile; x += 4) {
+                bins.Gather(strip, x, y0, x + 5, y0 + 5, 4.0f, false, fromStrip);
+                bins.Gather(x, y0, x + 5, y0 + 5, 4.0f, false, fromTiles);
+                ASSERT_EQ(fromStrip.count, fromTiles.count) << x << ", " << y0;
+                EXPECT_EQ(fromStrip.index, fromTiles.index);
+                EXPECT_EQ(std::memcmp(&fromStrip.near_m, &fromTiles.near_m, 4), 0);
+                EXPECT_EQ(std::memcmp(&fromStrip.far_m, &fromTiles.far_m, 4), 0);
+                EXPECT_EQ(
+                    std::memcmp(&fromStrip.smallOpticalDepth, &fromTiles.smallOpticalDepth, 4), 0);
+                EXPECT_EQ(std::memcmp(&fromStrip.halfSmallOpticalDepth,
+                                      &fromTiles.halfSmallOpticalDepth, 4),
+                          0);
+                nonEmpty += fromTiles.count > 0;
+            }
+        }
+    }
+    EXPECT_GT(nonEmpty, 100u);
+}
+
+// Eight puffs at a time (AVX2) or four (SSE2): the same traces bit for bit, gathered and
+// copied lists, one range and two, for lists of every length modulo 8.
+TEST(PlumeScreenBins, WideAndNarrowTracesAreBitIdentical) {
+    const scene::PlumeField field = CommittedPlumes();
+    const ChannelCamera cam = NorthCamera({0.0, 0.0, 20.0}, 96, 72, 40.0, 3.0);
+    PlumeScreenBins bins(field, cam, ObscurantBand::Visible);
+    if (!bins.WideTraces()) GTEST_SKIP() << "no AVX2 on this CPU";
+    PlumeScreenBins::List list;
+    int lengths = 0, seen = 0;
+    for (int py = 0; py <= cam.height; py += 3) {
+        for (int px = 0; px <= cam.width; px += 3) {
+            bins.Gather(px, py, px + 2, py + 2, 4.0f, false, list);
+            if (list.size() == 0) continue;
+            lengths |= 1 << (list.index.size() / 4 % 2);
+            const glm::vec3 dir(cam.SampleDirection(px, py));
+            BandTrace t[2][2][2];  // [wide][copied][range]
+            for (int copied = 0; copied < 2; ++copied) {
+                if (copied) bins.Copy(list);
+                for (int wide = 0; wide < 2; ++wide) {
+                    bins.UseWideTraces(wide == 1);
+                    bins.Trace2(list, dir, 1800.0f, kPlumeSkyRange_m, t[wide][copied][0],
+                                t[wide][copied][1]);
+                }
+            }
+            for (int copied = 0; copied < 2; ++copied)
+                for (int r = 0; r < 2; ++r)
+                    EXPECT_EQ(std::memcmp(&t[0][copied][r], &t[1][copied][r], sizeof(BandTrace)), 0)
+                        << px << ", " << py << " copied " << copied << " range " << r;
+            seen += t[0][0][1].opticalDepth > 0.01f;
+        }
+    }
+    EXPECT_EQ(lengths, 3);  // lists of 4 mod 8 and 0 mod 8 puffs (a four-lane tail and none)
+    EXPECT_GT(seen, 50);
 }
 
 // A flame puff of optical depth ~300 through its centre: at 3.5 σ (where a fixed cutoff
