@@ -5,6 +5,7 @@
 #include "channels/nvg/nvg_channel.h"
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <cmath>
 #include <filesystem>
@@ -198,22 +199,27 @@ double Photons(const Image& img, int x, int y) {
     return double(p[0]) + p[1] + p[2];
 }
 
-// A black (albedo 0), cold smoke plume rising in front of the moonlit sky: every sky sample's
-// photocathode current falls by the plume's visible transmittance along its pixel's ray, e^−τ
-// with τ the sum of the puffs' analytic line integrals; the plume neither scatters nor glows.
-TEST(NvgChannel, SmokeDimsTheMoonlitSkyByItsTransmittance) {
-    const scene::Scenario clear = scene::LoadScenario(kConfigs / "nvg.yaml");
-    scene::Scenario smoky = clear;
+// A black (albedo 0), cold smoke source 350 m east, in the goggle's view in nvg.yaml.
+scene::PlumeSourceSettings BlackSmoke() {
     scene::PlumeSourceSettings smoke;
     smoke.kind = scene::PlumeKind::Smoke;
-    smoke.position_m = {350.0, -20.0, 0.0};  // in the goggle's view, east
+    smoke.position_m = {350.0, -20.0, 0.0};
     smoke.start_s = -300.0;
     smoke.albedo = 0.0;
     smoke.massRate_kgps = 0.5;
     smoke.heatRelease_W = 5e6;
     smoke.exitTemperature_K = 290.0;  // far below any visible or NIR glow
     smoke.seed = 5;
-    smoky.plumes.sources.push_back(smoke);
+    return smoke;
+}
+
+// A black (albedo 0), cold smoke plume rising in front of the moonlit sky: every sky sample's
+// photocathode current falls by the plume's visible transmittance along its pixel's ray, e^−τ
+// with τ the sum of the puffs' analytic line integrals; the plume neither scatters nor glows.
+TEST(NvgChannel, SmokeDimsTheMoonlitSkyByItsTransmittance) {
+    const scene::Scenario clear = scene::LoadScenario(kConfigs / "nvg.yaml");
+    scene::Scenario smoky = clear;
+    smoky.plumes.sources.push_back(BlackSmoke());
     const scene::World clearWorld(clear), smokyWorld(smoky);
     NvgChannel a(clearWorld, SmallNvg(clear)), b(smokyWorld, SmallNvg(smoky));
     const scene::SceneState state = smokyWorld.State(3);
@@ -311,6 +317,32 @@ TEST(NvgChannel, CloudDimsTheMoonByExpMinusTauAsInOtw) {
     otwClear.Render(clearWorld.State(0), a);
     otwCloudy.Render(state, b);
     EXPECT_NEAR(b.At(cx, cy)[1] / a.At(cx, cy)[1] / expected, 1.0, 0.01);
+}
+
+// Clouds, plumes (a flame and smoke) and lightning in the NVG channel: 1 and 2 threads give
+// the same radiance bit for bit.
+TEST(NvgChannel, FrameWithCloudsAndPlumesIsIndependentOfThreadCount) {
+    scene::Scenario sc = scene::LoadScenario(kConfigs / "nvg.yaml");
+    sc.plumes.sources.push_back(BlackSmoke());
+    scene::PlumeSourceSettings flame = BlackSmoke();
+    flame.kind = scene::PlumeKind::Flame;
+    flame.flameTemperature_K = 1400.0;
+    flame.albedo = 0.1;
+    sc.plumes.sources.push_back(flame);
+    scene::CloudLayerSettings layer;
+    layer.type = scene::CloudType::Cumulus;
+    layer.coverage = 0.6;
+    layer.base_m = 1200.0;
+    layer.thickness_m = 800.0;
+    sc.environment.clouds = {layer};
+    const scene::World world(sc);
+    const auto render = [&](int threads) {
+        NvgChannel nvg(world, SmallNvg(sc));
+        Image radiance;
+        tbb::task_arena(threads).execute([&] { nvg.Render(world.State(2), radiance); });
+        return radiance.pixels;
+    };
+    EXPECT_EQ(render(1), render(2));
 }
 }  // namespace
 }  // namespace seasense::channels
