@@ -288,13 +288,11 @@ TEST(NvgChannel, CloudDimsTheMoonByExpMinusTauAsInOtw) {
     ch.supersampling = 1;
     ch.hfov_rad = 4.0 * std::numbers::pi / 180.0;
     scene::Scenario cloudy = clear;
-    scene::CloudLayerSettings layer;
-    layer.type = scene::CloudType::Altostratus;
-    layer.coverage = 1.0;
-    layer.base_m = 3000.0;
-    layer.thickness_m = 500.0;
-    layer.opticalDepth = 1.0;
-    cloudy.environment.clouds = {layer};
+    cloudy.environment.clouds = {scene::CloudLayerSettings{.type = scene::CloudType::Altostratus,
+                                                           .coverage = 1.0,
+                                                           .base_m = 3000.0,
+                                                           .thickness_m = 500.0,
+                                                           .opticalDepth = 1.0}};
     const scene::World clearWorld(clear), cloudyWorld(cloudy);
     const scene::SceneState state = cloudyWorld.State(0);
     const scene::CloudHit hit =
@@ -329,12 +327,10 @@ TEST(NvgChannel, FrameWithCloudsAndPlumesIsIndependentOfThreadCount) {
     flame.flameTemperature_K = 1400.0;
     flame.albedo = 0.1;
     sc.plumes.sources.push_back(flame);
-    scene::CloudLayerSettings layer;
-    layer.type = scene::CloudType::Cumulus;
-    layer.coverage = 0.6;
-    layer.base_m = 1200.0;
-    layer.thickness_m = 800.0;
-    sc.environment.clouds = {layer};
+    sc.environment.clouds = {scene::CloudLayerSettings{.type = scene::CloudType::Cumulus,
+                                                       .coverage = 0.6,
+                                                       .base_m = 1200.0,
+                                                       .thickness_m = 800.0}};
     const scene::World world(sc);
     const auto render = [&](int threads) {
         NvgChannel nvg(world, SmallNvg(sc));
