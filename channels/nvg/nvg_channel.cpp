@@ -50,6 +50,8 @@ OtwBandBasis NvgBandBasis(const scene::World& world, const radiometry::PhotonRes
     b.sky.daylight = PhotonsPerPhotometric(response, RayleighScattered(SunSpectrum()));
     b.sky.night = PhotonsPerPhotometric(response, NightSkySpectrum());
     b.sky.moonlit = PhotonsPerPhotometric(response, RayleighScattered(MoonSpectrum()));
+    // Flames glow with Planck's law over the photocathode's sub-bands.
+    b.blackbody = [response](double T_K) { return BlackbodySubBandPhotons(response, T_K); };
 
     const scene::Scenario& sc = world.GetScenario();
     std::unique_ptr<MaterialTable> table;

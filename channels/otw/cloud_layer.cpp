@@ -56,17 +56,21 @@ CloudCover OtwCloudCover(const OtwCloudLighting& light, const glm::dvec3& d,
     // from the side is capped at the sky's total.
     const double tauVertical = std::min(tau * std::abs(d.z), light.totalVerticalDepth);
     const double Td = CloudDiffuseTransmittance(tauVertical, kCloudAsymmetry);
-    double diffuse = 0.0;
-    const double single =
-        BodyLight(light.sunIlluminance_lux, light.sunDirection, d, tau, tauVertical, Td, diffuse) +
-        BodyLight(light.moonIlluminance_lux, light.moonDirection, d, tau, tauVertical, Td, diffuse);
-    const glm::dvec3 base = (glm::dvec3(diffuse) + light.skyIlluminance * Td) / M_PI;
+    // Each body's light in its own components (Rec.709: 1, so the sums are those of grey
+    // light).
+    double sunDiffuse = 0.0, moonDiffuse = 0.0;
+    const double sunSingle = BodyLight(light.sunIlluminance_lux, light.sunDirection, d, tau,
+                                       tauVertical, Td, sunDiffuse);
+    const double moonSingle = BodyLight(light.moonIlluminance_lux, light.moonDirection, d, tau,
+                                        tauVertical, Td, moonDiffuse);
+    const glm::dvec3 diffuse = sunDiffuse * light.sunPerLux + moonDiffuse * light.moonPerLux;
+    const glm::dvec3 single = sunSingle * light.sunPerLux + moonSingle * light.moonPerLux;
+    const glm::dvec3 base = (diffuse + light.skyIlluminance * Td) / M_PI;
     const double opacity = -std::expm1(-tau);
     const double haze = std::exp(
         -light.extinction_perM *
         EquivalentHorizontalPath_m(hit.distance_m, hit.distance_m * d.z, kAerosolScaleHeight_m));
-    const glm::dvec3 L =
-        haze * (opacity * base + glm::dvec3(single)) + (1.0 - haze) * opacity * airlight;
+    const glm::dvec3 L = haze * (opacity * base + single) + (1.0 - haze) * opacity * airlight;
     CloudCover c;
     c.alpha = float(opacity);
     for (int k = 0; k < 3; ++k) c.premultiplied[k] = float(L[k]);
@@ -76,7 +80,8 @@ CloudCover OtwCloudCover(const OtwCloudLighting& light, const glm::dvec3& d,
 CloudSkyStats DrawOtwClouds(CloudSky& pass, const scene::World& world,
                             const scene::SceneState& state, const ChannelCamera& camera,
                             const VisibilityBuffer& vis, const radiometry::AnalyticSky& sky,
-                            double extinction_perM, Image& radiance) {
+                            double extinction_perM, Image& radiance, const glm::dvec3& sunPerLux,
+                            const glm::dvec3& moonPerLux) {
     const scene::CloudField* field = world.Clouds();
     CHECK(field != nullptr);
     const glm::dvec3 eye = state.eyepoint.position_m;
@@ -91,6 +96,8 @@ CloudSkyStats DrawOtwClouds(CloudSky& pass, const scene::World& world,
                                 world.SkyConditionDivisor(eye, state.moon.direction, state.time_s);
     light.skyIlluminance = sky.HorizontalSkyIlluminance();
     light.extinction_perM = extinction_perM;
+    light.sunPerLux = sunPerLux;
+    light.moonPerLux = moonPerLux;
     for (const scene::CloudLayerSettings& l : field->Layers())
         light.totalVerticalDepth += l.opticalDepth;
 

@@ -32,6 +32,9 @@ struct OtwCloudLighting {
     glm::dvec3 skyIlluminance{0.0};   // horizontal, from the clear sky dome (Rec.709, lx)
     double extinction_perM = 0.0;     // Koschmieder β at the surface
     double totalVerticalDepth = 0.0;  // sum of the layers' vertical optical depths
+    // Components per lx of the sun's and moon's light: 1 in Rec.709 (grey); a band basis's
+    // vectors (channels/nvg) in which skyIlluminance and the airlight are then given too.
+    glm::dvec3 sunPerLux{1.0}, moonPerLux{1.0};
 };
 
 // Aerosol scale height for the haze in front of a cloud: 1 km, the maritime aerosol profile
@@ -59,10 +62,14 @@ CloudCover OtwCloudCover(const OtwCloudLighting& light, const glm::dvec3& d,
 
 // Draws the world's clouds over the sky samples of radiance (after the sun, moon and stars,
 // before lightning and plumes): what lights them from state (its illuminances times the
-// sky-condition divisors the world divided them by) and sky.
+// sky-condition divisors the world divided them by) and sky. In a band basis (channels/nvg)
+// radiance and sky are in the basis and sunPerLux, moonPerLux are its sun's and moon's
+// components per lx.
 CloudSkyStats DrawOtwClouds(CloudSky& pass, const scene::World& world,
                             const scene::SceneState& state, const ChannelCamera& camera,
                             const VisibilityBuffer& vis, const radiometry::AnalyticSky& sky,
-                            double extinction_perM, Image& radiance);
+                            double extinction_perM, Image& radiance,
+                            const glm::dvec3& sunPerLux = glm::dvec3(1.0),
+                            const glm::dvec3& moonPerLux = glm::dvec3(1.0));
 
 }  // namespace seasense::channels

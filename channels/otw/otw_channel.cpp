@@ -788,6 +788,31 @@ void ShadeModels(const FrameShading& f, const FrameGeometry& g, const BlockScrat
     }
 }
 
+// The plumes' light in a band basis (channels/nvg), where ChannelPlumes::CompositeOtw's
+// Rec.709 sun and blackbody glow do not apply: the key light (sun or moon, whichever is
+// brighter, in the basis) scatters once off the particles; the ambient radiance is
+// VisibleAmbientRadiance's split, half the sky's solid-angle mean and half the sea's diffuse
+// reflection, with the sea lit by the channel's downwelling irradiance (key, fill lights and sky
+// in the basis); glow the basis's blackbody table.
+PlumeLighting BasisPlumeLighting(const DirectionalLight& key, const glm::vec3& downwelling,
+                                 const radiometry::AnalyticSky& sky,
+                                 const BlackbodyGlowTable* glow) {
+    PlumeLighting light;
+    light.kind = PlumeLighting::Kind::Visible;
+    light.sunDirection = key.dir;
+    light.sunIlluminance = key.dir.z > 0.0f ? key.E : glm::vec3(0.0f);
+    // VisibleAmbientRadiance = ½ (sky mean + ρ E_sky-model / π): its sea half is lit by the sky
+    // model's own sun (Rec.709) and dome, replaced here by the channel's downwelling light.
+    const glm::dvec3 skyModelDown =
+        sky.SunIlluminance() * std::max(sky.SunDirection().z, 0.0) + sky.HorizontalSkyIlluminance();
+    const glm::dvec3 skyMean =
+        2.0 * glm::dvec3(VisibleAmbientRadiance(sky)) - double(kSeaAlbedo) * skyModelDown / M_PI;
+    light.ambientRgb =
+        glm::vec3(0.5 * (skyMean + double(kSeaAlbedo) * glm::dvec3(downwelling) / M_PI));
+    light.glow = glow;
+    return light;
+}
+
 }  // namespace
 
 OtwChannel::OtwChannel(const scene::World& world, const scene::ChannelSettings& settings)
@@ -1023,56 +1048,72 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     scene::MoonState moonAboveClouds = state.moon;
     moonAboveClouds.illuminance_lux *=
         world_.SkyConditionDivisor(state.eyepoint.position_m, state.moon.direction, state.time_s);
-    if (basis_) {
-        // Band basis: the grey overlays drawn alone, then added in their lights' vectors.
-        const auto addOverlay = [&](const auto& draw, const glm::dvec3& perCdm2) {
-            // overlay_ is all zeros between uses: each use clears the samples it drew on.
-            if (overlay_.width != sw || overlay_.height != sh) overlay_ = Image(sw, sh, 3);
-            draw(overlay_);
-            const glm::vec3 v(perCdm2);
-            for (size_t i = 0; i < overlay_.pixels.size(); i += 3) {
-                const float y = overlay_.pixels[i + 1];
-                if (y == 0.0f) continue;
-                for (int c = 0; c < 3; ++c) {
-                    radiance.pixels[i + size_t(c)] += y * v[c];
-                    overlay_.pixels[i + size_t(c)] = 0.0f;
-                }
+    // Band basis: a grey overlay drawn alone, then added in its light's vector; Rec.709: drawn
+    // straight into radiance.
+    const auto overlay = [&](const auto& draw, const glm::dvec3& perCdm2) {
+        if (!basis_) {
+            draw(radiance);
+            return;
+        }
+        // overlay_ is all zeros between uses: each use clears the samples it drew on.
+        if (overlay_.width != sw || overlay_.height != sh) overlay_ = Image(sw, sh, 3);
+        draw(overlay_);
+        const glm::vec3 v(perCdm2);
+        for (size_t i = 0; i < overlay_.pixels.size(); i += 3) {
+            const float y = overlay_.pixels[i + 1];
+            if (y == 0.0f) continue;
+            for (int c = 0; c < 3; ++c) {
+                radiance.pixels[i + size_t(c)] += y * v[c];
+                overlay_.pixels[i + size_t(c)] = 0.0f;
             }
-        };
-        addOverlay(
+        }
+    };
+    if (basis_) {
+        // The moon and the stars have different colours.
+        overlay(
             [&](Image& img) {
                 AddMoonAndStars(cam, vis, MakeMoonDisc(moonAboveClouds, state.sun), {}, img);
             },
             basis_->moon);
-        addOverlay(
+        overlay(
             [&](Image& img) {
                 AddMoonAndStars(cam, vis, MoonDisc{},
                                 scene::VisibleStars(stars_, state.utc, observer), img);
             },
             basis_->stars);
-        if (lightning)
-            addOverlay([&](Image& img) { DrawLightning(cam, vis, *lightning, flashes, beta, img); },
-                       basis_->lightning);
-        return;
+    } else {
+        AddMoonAndStars(cam, vis, MakeMoonDisc(moonAboveClouds, state.sun),
+                        scene::VisibleStars(stars_, state.utc, observer), radiance);
     }
-    AddMoonAndStars(cam, vis, MakeMoonDisc(moonAboveClouds, state.sun),
-                    scene::VisibleStars(stars_, state.utc, observer), radiance);
     // --- Cloud layers (channels/otw/cloud_layer) over the sky, sun, moon and stars. ---
     if (world_.Clouds()) {
         if (!clouds_) clouds_ = std::make_unique<CloudSky>();
         const CloudSkyStats cloud =
-            DrawOtwClouds(*clouds_, world_, state, cam, vis, sky, beta, radiance);
+            basis_ ? DrawOtwClouds(*clouds_, world_, state, cam, vis, sky, beta, radiance,
+                                   basis_->sun, basis_->moon)
+                   : DrawOtwClouds(*clouds_, world_, state, cam, vis, sky, beta, radiance);
         stats_.cloudMs = cloud.ms;
         stats_.cloudTraces = cloud.gridTraces + cloud.exactTraces;
     }
     // --- end of cloud layers ---
-    if (lightning) DrawLightning(cam, vis, *lightning, flashes, beta, radiance);
-    // --- Surf spray (channels/otw/spray_overlay): foam-white droplet clumps, depth-tested. ---
+    if (lightning)
+        overlay([&](Image& img) { DrawLightning(cam, vis, *lightning, flashes, beta, img); },
+                basis_ ? basis_->lightning : glm::dvec3(1.0));
+    // --- Surf spray (channels/otw/spray_overlay): foam-white droplet clumps, depth-tested (the
+    // foam reflectance and the downwelling light are in the basis's components). ---
     DrawSpray(world_, state, cam, vis, {shore_[0].rhoFoam, shore_[1].rhoFoam, shore_[2].rhoFoam},
               downwelling, beta, radiance);
 
     // Plumes (channels/plume) over the finished radiance.
-    plumes_->CompositeOtw(state, cam, vis, sky, radiance);
+    if (!basis_) {
+        plumes_->CompositeOtw(state, cam, vis, sky, radiance);
+        return;
+    }
+    if (!plumes_->Active()) return;
+    if (!basisGlow_ && basis_->blackbody)
+        basisGlow_ = std::make_unique<BlackbodyGlowTable>(basis_->blackbody);
+    const PlumeLighting light = BasisPlumeLighting(key, downwelling, sky, basisGlow_.get());
+    CompositePlumes(plumes_->FieldAt(state.time_s), cam, vis, light, radiance);
 }
 
 }  // namespace seasense::channels

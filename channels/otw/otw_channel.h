@@ -2,6 +2,7 @@
 // Rec.709 luminance units (cd/m²) under an analytic sky and sun, with Embree shadows and fog.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -14,6 +15,7 @@
 
 namespace seasense::channels {
 
+class BlackbodyGlowTable;
 class ChannelPlumes;
 class CloudSky;
 
@@ -26,6 +28,8 @@ struct OtwBandBasis {
     glm::dvec3 sun{1.0}, moon{1.0}, stars{1.0}, lightning{1.0};  // components per lx
     std::vector<glm::dvec3> reflectance;                         // per entity, per component
     ShoreChannel shore[3];                                       // surf-zone optics per component
+    // Radiance components of a blackbody at T_K (the glow of flames); empty: plumes do not glow.
+    std::function<glm::dvec3(double T_K)> blackbody;
 };
 // --- end of band basis ---
 
@@ -46,7 +50,8 @@ class OtwChannel {
     // Builds the occlusion scene from the world's models (committed once; static).
     OtwChannel(const scene::World& world, const scene::ChannelSettings& settings);
     // In a band basis (channels/nvg): the components of Render's image are the basis's, in its
-    // units; clouds and plumes are not drawn (they shade in Rec.709 only).
+    // units; every light (sun, moon, stars, sky, lightning, the glow of flames) in its own
+    // components, on the sky, sea, models, clouds, spray and plumes.
     OtwChannel(const scene::World& world, const scene::ChannelSettings& settings,
                const OtwBandBasis& basis);
     ~OtwChannel();
@@ -81,8 +86,9 @@ class OtwChannel {
     std::unique_ptr<ChannelPlumes> plumes_;  // scenario plumes (channels/plume)
     std::unique_ptr<CloudSky> clouds_;       // cloud pass scratch (environment.clouds)
     OtwFrameStats stats_;
-    std::unique_ptr<OtwBandBasis> basis_;  // null: Rec.709
-    Image overlay_;                        // band basis: grey overlays before conversion
+    std::unique_ptr<OtwBandBasis> basis_;            // null: Rec.709
+    Image overlay_;                                  // band basis: grey overlays before conversion
+    std::unique_ptr<BlackbodyGlowTable> basisGlow_;  // band basis: the flames' glow
 };
 
 }  // namespace seasense::channels

@@ -44,6 +44,14 @@ inline float CompositeThroughPlume(float background, float transmittance, float 
 class BlackbodyGlowTable {
   public:
     BlackbodyGlowTable();
+    // The glow in another three-component basis (channels/nvg: photocathode sub-bands):
+    // components(T_K) tabulated on the same grid, every kStep_K on [kMinT_K, kMaxT_K].
+    static constexpr double kMinT_K = 500.0, kMaxT_K = 3000.0, kStep_K = 10.0;
+    template <class Components>
+    explicit BlackbodyGlowTable(const Components& components) {
+        for (double T = kMinT_K; T <= kMaxT_K + 1e-9; T += kStep_K)
+            rgb_.push_back(glm::vec3(components(T)));
+    }
     glm::vec3 operator()(float T_K) const;
 
   private:

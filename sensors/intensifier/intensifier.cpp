@@ -1,6 +1,7 @@
 // Image intensifier: photon radiance → photoelectrons → MCP noise → halo → tube MTF → ABC → P43.
 #include "sensors/intensifier/intensifier.h"
 
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include "radiometry/color/rec709.h"
 #include "scene/core/check.h"
 #include "scene/core/rng.h"
+#include "sensors/thermal/normal_deviates.h"
 
 namespace seasense::sensors {
 
@@ -22,6 +24,24 @@ constexpr double kP43x = 0.333, kP43y = 0.556;
 // ≈ 3 % (the threshold contrast of visual bar-target readings, Csorba 1985 ch. 8).
 constexpr double kLimitingMtf = 0.03;
 constexpr int kLutSize = 4096;
+// Largest mean drawn exactly (PoissonDeviate); above it the normal approximation, whose
+// skewness 1/√mean is then below 0.18.
+constexpr double kExactPoissonMean = 30.0;
+// 1/k for the sequential search: up to 200, where the CDF of mean 30 is 1 − 1e-70.
+constexpr int kReciprocals = 200;
+
+struct ReciprocalTable {
+    double value[kReciprocals];
+    ReciprocalTable() {
+        value[0] = 0.0;
+        for (int k = 1; k < kReciprocals; ++k) value[k] = 1.0 / k;
+    }
+};
+
+const ReciprocalTable& Reciprocals() {
+    static const ReciprocalTable table;
+    return table;
+}
 
 // sRGB encoding of linear v in [0, 1] (IEC 61966-2-1:1999).
 double SrgbEncode(double v) {
@@ -30,21 +50,27 @@ double SrgbEncode(double v) {
 
 }  // namespace
 
-double PoissonDeviate(double mean, uint64_t seed, uint64_t stream) {
+double PoissonDeviate(double mean, uint64_t bits) {
     if (mean <= 0.0) return 0.0;
-    if (mean <= 30.0) {
-        const double limit = std::exp(-mean);
-        double product = 1.0;
-        for (uint64_t k = 0;; ++k) {
-            product *= scene::Uniform01(seed, stream, k);
-            if (product <= limit) return double(k);
+    if (mean <= kExactPoissonMean) {
+        // Inversion by sequential search (Devroye 1986, §X.3.3): the smallest k whose CDF
+        // exceeds u, the probabilities p_k = p_(k−1) · mean/k from p_0 = e^−mean.
+        const ReciprocalTable& inverse = Reciprocals();
+        const double u = double(bits >> 11) * 0x1.0p-53;
+        double p = std::exp(-mean), cdf = p;
+        int k = 0;
+        while (u >= cdf && k + 1 < kReciprocals) {
+            ++k;
+            p *= mean * inverse.value[size_t(k)];
+            const double next = cdf + p;
+            if (next == cdf) break;  // the tail's probabilities no longer change the sum
+            cdf = next;
         }
+        return double(k);
     }
-    // Box–Muller from two uniforms; u1 in (0, 1].
-    const double u1 = 1.0 - scene::Uniform01(seed, stream, 0);
-    const double u2 = scene::Uniform01(seed, stream, 1);
-    const double z = std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * std::numbers::pi * u2);
-    return std::max(0.0, std::round(mean + std::sqrt(mean) * z));
+    const double z = NormalFromBits(uint32_t(bits));
+    // Rounded half up by truncation of a non-negative value (std::round is a library call).
+    return double(int64_t(std::max(0.0, mean + std::sqrt(mean) * z) + 0.5));
 }
 
 Intensifier::Intensifier(const IntensifierSettings& settings, int supersampling)
@@ -79,7 +105,9 @@ Intensifier::Intensifier(const IntensifierSettings& settings, int supersampling)
         for (int x = 0; x < w; ++x) {
             const double u = ((x + 0.5) / w * 2.0 - 1.0) * tanHalfH;
             const double v = ((y + 0.5) / h * 2.0 - 1.0) * tanHalfV;
-            mask_[size_t(y) * size_t(w) + size_t(x)] = u * u + v * v <= tanStop * tanStop;
+            const bool in = u * u + v * v <= tanStop * tanStop;
+            mask_[size_t(y) * size_t(w) + size_t(x)] = in;
+            fieldCount_ += in;
         }
     // Phosphor: screen luminance ∝ brightness, in P43's colour, scaled so that saturation is
     // the brightest displayable P43 green.
@@ -113,26 +141,34 @@ void Intensifier::Process(const Image& samples, double time_s, int64_t frame) {
             *radiance_.At(x, y) = float(sum / (n * n));
         }
     });
-    // Mean photoelectrons over the field (fixed-order sums: deterministic) as the photocathode
-    // delivers them; BSP limits their mean.
-    double total = 0.0;
-    size_t count = 0;
-    for (size_t i = 0; i < mask_.size(); ++i)
-        if (mask_[i]) {
-            total += radiance_.pixels[i] * pePerRadiance_;
-            ++count;
-        }
-    meanPe_ = count ? total / double(count) : 0.0;
+    // Sums over the field stop: per row in parallel, then the rows in order (deterministic for
+    // any thread count).
+    std::vector<double>& rowSum = rowSum_;
+    rowSum.resize(size_t(h));
+    const auto fieldSum = [&](const auto& term) {
+        tbb::parallel_for(0, h, [&](int y) {
+            const size_t row = size_t(y) * size_t(w);
+            double sum = 0.0;
+            for (size_t i = row; i < row + size_t(w); ++i)
+                if (mask_[i]) sum += term(double(radiance_.pixels[i]));
+            rowSum[size_t(y)] = sum;
+        });
+        double total = 0.0;
+        for (double r : rowSum) total += r;
+        return total;
+    };
+    // Mean photoelectrons over the field as the photocathode delivers them; BSP limits their
+    // mean.
+    const double count = double(fieldCount_);
+    meanPe_ = count > 0.0 ? fieldSum([&](double L) { return L * pePerRadiance_; }) / count : 0.0;
     const double bsp = s_.PixelFramePe(s_.bspThreshold_pe_s_mm2);
     duty_ = meanPe_ > bsp ? bsp / meanPe_ : 1.0;
     // The mean as the ABC senses it through the screen current at gain g: each pixel counts at
     // most the photoelectrons that saturate it (1/g).
     const auto sensed = [&](double g) {
-        const double cap = 1.0 / g;
-        double sum = 0.0;
-        for (size_t i = 0; i < mask_.size(); ++i)
-            if (mask_[i]) sum += std::min(radiance_.pixels[i] * pePerRadiance_ * duty_, cap);
-        return count ? sum / double(count) : 0.0;
+        const double cap = 1.0 / g, scale = pePerRadiance_ * duty_;
+        return count > 0.0 ? fieldSum([&](double L) { return std::min(L * scale, cap); }) / count
+                           : 0.0;
     };
     // ABC: the gain that puts the sensed mean at abcLevel (capped at its value at the
     // threshold), sensed at the previous frame's gain; the first frame starts settled, at the
@@ -160,19 +196,22 @@ void Intensifier::Process(const Image& samples, double time_s, int64_t frame) {
     started_ = true;
     lastTime_s_ = time_s;
 
-    // Scintillation: S = F · Poisson(N/F), mean N, variance F·N (SNR √(N/F)).
+    // Scintillation: S = F · Poisson(N/F), mean N, variance F·N (SNR √(N/F)); one hash of
+    // (seed, frame, pixel) per pixel.
     const double F = s_.noiseFactor;
     const double scale = pePerRadiance_ * duty_ / F;
     tbb::parallel_for(0, h, [&](int y) {
         for (int x = 0; x < w; ++x) {
             const size_t i = size_t(y) * size_t(w) + size_t(x);
-            const uint64_t stream = scene::HashBits(s_.seed, uint64_t(frame), i);
+            const uint64_t bits = scene::HashBits(s_.seed, uint64_t(frame), i);
             electrons_.pixels[i] =
-                float(F * PoissonDeviate(double(radiance_.pixels[i]) * scale, s_.seed, stream));
+                float(F * PoissonDeviate(double(radiance_.pixels[i]) * scale, bits));
         }
     });
     // Halo: a fixed share of each pixel's electrons spread uniformly over a disc of the halo's
-    // angular radius (row prefix sums: O(radius) per pixel).
+    // angular radius, the disc's rows from row prefix sums. Each output row adds the disc's
+    // rows one after another over the whole row (the same sums in the same order per pixel as
+    // a pixel-by-pixel loop, but in runs the compiler vectorizes).
     const int R = int(std::floor(haloRadius_px_));
     const double f = s_.haloFraction;
     if (f > 0.0 && R >= 1) {
@@ -189,19 +228,26 @@ void Intensifier::Process(const Image& samples, double time_s, int64_t frame) {
             halfWidth[size_t(dy + R)] = int(std::floor(std::sqrt(double(R * R - dy * dy))));
             discCount += 2 * halfWidth[size_t(dy + R)] + 1;
         }
+        tbb::enumerable_thread_specific<std::vector<double>> rowSums;
         tbb::parallel_for(0, h, [&](int y) {
+            std::vector<double>& sum = rowSums.local();
+            sum.assign(size_t(w), 0.0);
+            double* __restrict acc = sum.data();
+            for (int dy = -R; dy <= R; ++dy) {
+                const int yy = y + dy;
+                if (yy < 0 || yy >= h) continue;
+                const int hw = halfWidth[size_t(dy + R)];
+                const double* __restrict p = &prefix[size_t(yy) * size_t(w + 1)];
+                // Runs [x − hw, x + hw] clipped to the row: clipped on the left for x < hw,
+                // on the right for x + hw ≥ w, whole in between.
+                const int left = std::min(hw, w), right = std::max(left, w - hw);
+                for (int x = 0; x < left; ++x) acc[x] += p[std::min(w, x + hw + 1)] - p[0];
+                for (int x = left; x < right; ++x) acc[x] += p[x + hw + 1] - p[x - hw];
+                for (int x = right; x < w; ++x) acc[x] += p[w] - p[std::max(0, x - hw)];
+            }
             for (int x = 0; x < w; ++x) {
-                double sum = 0.0;
-                for (int dy = -R; dy <= R; ++dy) {
-                    const int yy = y + dy;
-                    if (yy < 0 || yy >= h) continue;
-                    const int hw = halfWidth[size_t(dy + R)];
-                    const int x0 = std::max(0, x - hw), x1 = std::min(w, x + hw + 1);
-                    const double* p = &prefix[size_t(yy) * size_t(w + 1)];
-                    sum += p[x1] - p[x0];
-                }
                 const size_t i = size_t(y) * size_t(w) + size_t(x);
-                halo_.pixels[i] = float((1.0 - f) * electrons_.pixels[i] + f * sum / discCount);
+                halo_.pixels[i] = float((1.0 - f) * electrons_.pixels[i] + f * acc[x] / discCount);
             }
         });
     } else {

@@ -56,18 +56,21 @@ class Intensifier {
     double haloRadius_px_ = 0.0, mtfSigma_px_ = 0.0;
     std::vector<float> mtfKernel_;
     std::vector<uint8_t> mask_;
+    size_t fieldCount_ = 0;  // pixels inside the field stop
     Image radiance_, electrons_, halo_, brightness_;
     std::vector<uint8_t> display_;
     std::vector<double> prefix_;        // halo: row prefix sums, kept between frames
+    std::vector<double> rowSum_;        // per-row sums over the field stop
     std::vector<uint8_t> phosphorLut_;  // kLutSize × 3: brightness → sRGB P43 colour
     bool started_ = false;
     double lastTime_s_ = 0.0;
     double gain_ = 0.0, duty_ = 1.0, meanPe_ = 0.0;
 };
 
-// A Poisson deviate of the given mean from the counter-based stream (seed, stream): exact
-// (inversion by multiplication of uniforms, Knuth TAOCP vol. 2 §3.4.1) for mean ≤ 30, else
-// the normal approximation rounded to an integer ≥ 0.
-double PoissonDeviate(double mean, uint64_t seed, uint64_t stream);
+// A Poisson deviate of the given mean from 64 random bits (e.g. scene::HashBits): exact for
+// mean ≤ 30 (inversion of the CDF by sequential search from the 53 high bits, Devroye,
+// "Non-Uniform Random Variate Generation", 1986, §X.3.3), else the normal approximation
+// (sensors/thermal NormalFromBits of the low 32 bits) rounded to an integer ≥ 0.
+double PoissonDeviate(double mean, uint64_t bits);
 
 }  // namespace seasense::sensors

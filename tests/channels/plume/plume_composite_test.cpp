@@ -14,38 +14,12 @@
 #include "radiometry/bands/builtin_bands.h"
 #include "radiometry/planck/planck.h"
 #include "scene/plumes/plume_system.h"
+#include "tests/support/sky_view.h"
 
 namespace seasense::channels {
 namespace {
 
 using scene::ObscurantBand;
-
-// A level camera at eye looking north (y), odd-sized so that the centre pixel's ray is the
-// optical axis.
-ChannelCamera NorthCamera(const glm::dvec3& eye, int width, int height, int supersampling) {
-    ChannelCamera cam;
-    cam.worldFromCamera = scene::Pose{eye, glm::dmat3(1.0)};
-    cam.hfov_rad = 30.0 * std::numbers::pi / 180.0;
-    cam.width = width;
-    cam.height = height;
-    cam.supersampling = supersampling;
-    cam.near_m = 0.25;
-    return cam;
-}
-
-// A visibility buffer that sees only sky.
-VisibilityBuffer SkyOnly(const ChannelCamera& cam) {
-    VisibilityBuffer vis;
-    vis.width = cam.SampleWidth();
-    vis.height = cam.SampleHeight();
-    const size_t n = size_t(vis.width) * size_t(vis.height);
-    vis.depth.assign(n, 0.0f);
-    vis.primitive.assign(n, kNoPrimitive);
-    vis.b1.assign(n, 0.0f);
-    vis.b2.assign(n, 0.0f);
-    vis.primitiveBase = {0};
-    return vis;
-}
 
 // A field of the given puffs, all of one plume with the optics of kind and albedo.
 scene::PlumeField OnePlume(scene::PlumeKind kind, double albedo,

@@ -8,6 +8,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "scene/core/rng.h"
+
 namespace seasense::sensors {
 namespace {
 
@@ -215,6 +217,80 @@ TEST(Intensifier, HaloHasTheConfiguredAngularDiameterAndGrowsWithTheSource) {
     EXPECT_GT(a[probe], 0.0f);
     EXPECT_LT(b[probe], 1.0f);
     EXPECT_NEAR(b[probe] / a[probe], 2.0, 0.1);
+}
+
+// The halo against the disc summed pixel by pixel: every pixel within R (the halo radius, whole
+// pixels) of the pixel, over the disc's full pixel count, in the field stop. The tube blur is made
+// negligible (limiting resolution 10⁴ lp/mm: the MTF kernel's side taps are e^(−1/(2σ²)) ≈ 0), so
+// the screen below saturation is the gain times the halo.
+TEST(Intensifier, HaloIsTheDiscMeanOfThePhotoelectrons) {
+    IntensifierSettings s = Small(96, 72);
+    s.halo_rad = 8.0 * kDegToRad;
+    s.haloFraction = 0.4;
+    s.resolution_lp_mm = 1e4;
+    Intensifier t(s, 1);
+    Image scene(96, 72, 3);
+    for (int y = 0; y < 72; ++y)
+        for (int x = 0; x < 96; ++x)
+            scene.At(x, y)[1] = float((50.0 + 40.0 * std::sin(0.3 * x) * std::cos(0.2 * y) +
+                                       (x == 40 && y == 30 ? 5e3 : 0.0)) /
+                                      t.PhotoelectronsPerRadiance());
+    t.Process(scene, 0.0, 0);
+    const int R = int(std::floor(t.HaloRadius_px()));
+    ASSERT_GE(R, 6);
+    int discCount = 0;
+    for (int dy = -R; dy <= R; ++dy)
+        for (int dx = -R; dx <= R; ++dx) discCount += dx * dx + dy * dy <= R * R;
+    const Image& e = t.Photoelectrons();
+    int compared = 0;
+    for (int y = 0; y < 72; ++y)
+        for (int x = 0; x < 96; ++x) {
+            const double b = *t.Brightness().At(x, y);
+            if (!t.InField(x, y) || b >= 1.0) continue;
+            double disc = 0.0;
+            for (int dy = -R; dy <= R; ++dy)
+                for (int dx = -R; dx <= R; ++dx)
+                    if (dx * dx + dy * dy <= R * R && x + dx >= 0 && x + dx < 96 && y + dy >= 0 &&
+                        y + dy < 72)
+                        disc += *e.At(x + dx, y + dy);
+            const double halo =
+                (1.0 - s.haloFraction) * *e.At(x, y) + s.haloFraction * disc / discCount;
+            EXPECT_NEAR(b / (t.Gain() * halo), 1.0, 1e-5) << x << " " << y;
+            ++compared;
+        }
+    EXPECT_GT(compared, 96 * 72 / 3);
+}
+
+// Poisson deviates from hashed bits: the frequencies of 2·10⁵ draws against the Poisson
+// probabilities e^−m mᵏ/k! (exact branch), and mean and variance m (normal branch).
+TEST(Intensifier, PoissonDeviatesHaveThePoissonDistribution) {
+    constexpr int kDraws = 200000;
+    for (double mean : {0.7, 6.5, 27.0}) {
+        std::vector<int> histogram(200, 0);
+        for (int i = 0; i < kDraws; ++i)
+            ++histogram[size_t(PoissonDeviate(mean, scene::HashBits(3, 5, uint64_t(i))))];
+        double pk = std::exp(-mean);
+        for (int k = 0; k < 80; ++k) {
+            if (k > 0) pk *= mean / k;
+            const double expected = kDraws * pk;
+            if (expected < 50.0) continue;
+            // Five binomial standard deviations.
+            EXPECT_NEAR(histogram[size_t(k)], expected, 5.0 * std::sqrt(expected))
+                << "mean " << mean << " k " << k;
+        }
+    }
+    for (double mean : {31.0, 400.0, 1e4}) {
+        double sum = 0.0, sum2 = 0.0;
+        for (int i = 0; i < kDraws; ++i) {
+            const double v = PoissonDeviate(mean, scene::HashBits(4, 6, uint64_t(i)));
+            EXPECT_EQ(v, std::floor(v));
+            sum += v;
+            sum2 += v * v;
+        }
+        const double m = sum / kDraws, var = sum2 / kDraws - m * m;
+        EXPECT_NEAR(m / mean, 1.0, 5.0 * std::sqrt(1.0 / (mean * kDraws))) << mean;
+        EXPECT_NEAR(var / mean, 1.0, 0.02) << mean;
+    }
 }
 
 TEST(Intensifier, FrameIsIndependentOfThreadCount) {
