@@ -27,8 +27,6 @@ constexpr float kPi = std::numbers::pi_v<float>;
 // Albedo of the sea for light reflected up (Payne, J. Atmos. Sci. 29 (1972) 959: ≈ 0.06).
 constexpr float kSeaAlbedo = 0.06f;
 
-constexpr double kGlowMinT_K = 500.0, kGlowMaxT_K = 3000.0, kGlowStep_K = 10.0;
-
 // Interpolation grid: pixels whose surfaces all lie beyond the plumes take their trace from
 // the sky traces at the corners of their kCell × kCell cell, blended bilinearly, when the
 // corners' transmittances differ by at most kInterpolationTolerance and their temperatures by
@@ -116,7 +114,7 @@ BlackbodyGlowTable::BlackbodyGlowTable() {
     const radiometry::Band X = radiometry::CieX(), Y = radiometry::CieY(), Z = radiometry::CieZ();
     // 683 lm/W: the luminous efficacy at 540 THz that defines the candela (SI, 16th CGPM 1979).
     constexpr double kLumensPerWatt = 683.0;
-    for (double T = kGlowMinT_K; T <= kGlowMaxT_K + 1e-9; T += kGlowStep_K) {
+    for (double T = kMinT_K; T <= kMaxT_K + 1e-9; T += kStep_K) {
         const glm::dvec3 xyz = kLumensPerWatt * glm::dvec3(radiometry::BandRadiance(X, T),
                                                            radiometry::BandRadiance(Y, T),
                                                            radiometry::BandRadiance(Z, T));
@@ -126,7 +124,7 @@ BlackbodyGlowTable::BlackbodyGlowTable() {
 }
 
 glm::vec3 BlackbodyGlowTable::operator()(float T_K) const {
-    const double u = (double(T_K) - kGlowMinT_K) / kGlowStep_K;
+    const double u = (double(T_K) - kMinT_K) / kStep_K;
     if (!(u >= 0.0)) return glm::vec3(0.0f);
     if (u >= double(rgb_.size() - 1)) return rgb_.back();
     const size_t i = size_t(u);
