@@ -243,6 +243,17 @@ class SurfWaves {
     std::vector<size_t> incoming_;
     std::vector<DepthSample> depth_;
     std::vector<double> phase_;
+    // The same for Terms two components at a time (SSE2 lanes; sines four at a time): the
+    // incoming count padded to a multiple of 4, lanes_, with silent components (zero amplitude,
+    // zero 1/tanh kh), per component its
+    // constants, per depth sample the interpolated fields (kLaneFields, field-major), per
+    // cross-shore sample the phases.
+    static constexpr size_t kLaneFields = 4;  // amplitude, k, k_s, 1/tanh kh
+    size_t lanes_ = 0;
+    std::vector<double> laneOrigin_, laneKu_, laneOmega_, laneKs0_, laneSpectral_;
+    std::vector<double> laneDepth_;  // [(i · kLaneFields + field) · lanes_ + m]
+    std::vector<double> lanePhase_;  // [i · lanes_ + m]
+    double shelterSeaward_m_ = 0.0;  // with shelters: none seaward of this cross-shore s
     double sBreak_m_ = 0.0;
     std::vector<double> breakTime_s_;  // group travel time from the breaker line, per s sample
 };
