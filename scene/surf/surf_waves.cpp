@@ -139,7 +139,7 @@ SurfWaves::SurfWaves(const Bathymetry& bathymetry, std::vector<SurfComponent> co
         for (int i = 0; i < samples; ++i) phase_[size_t(i) * n + m] = tr.phase[size_t(i)];
     }
     // Two (sines: four) lanes at a time: padded with silent components (zero amplitude and
-    // 1/tanh, k = 1).
+    // 1/tanh, k = 1). 1/k is tabulated rather than k: Terms then divides by nothing.
     lanes_ = (n + 3) / 4 * 4;
     laneOrigin_.assign(lanes_, 0.0);
     laneKu_.assign(lanes_, 0.0);
@@ -152,12 +152,12 @@ SurfWaves::SurfWaves(const Bathymetry& bathymetry, std::vector<SurfComponent> co
         for (int i = 0; i < depthSamples_; ++i) {
             double* d = laneDepth_.data() + size_t(i) * kLaneFields * lanes_ + m;
             if (m >= n) {
-                d[lanes_] = 1.0;
+                d[lanes_] = 1.0;  // 1/k
                 continue;
             }
             const DepthSample& ds = depth_[size_t(i) * n + m];
             d[0] = ds.amplitude;
-            d[lanes_] = ds.k;
+            d[lanes_] = 1.0 / ds.k;
             d[2 * lanes_] = ds.kx;
             d[3 * lanes_] = ds.invTanh;
         }
@@ -348,6 +348,7 @@ double SurfWaves::Swash_m(double s_m, double u_m, double t, double h) const {
     if (!p.active) return 0.0;
     double w = 1.0;
     if (h > 0.0) {
+        if (h >= 2.0 * p.runup2_m) return 0.0;  // beyond the swash (w ≤ 0), without dividing
         w = 1.0 - h / (2.0 * p.runup2_m);
         if (w <= 0.0) return 0.0;
     } else if (s_m < p.shoreline_m - 2.0 * p.runup2_m / p.foreshoreSlope - 10.0) {
@@ -502,7 +503,7 @@ SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* inf
     const __m128d vu = _mm_set1_pd(p.u_m), vt = _mm_set1_pd(t);
     const __m128d vs = _mm_set1_pd(p.s_m), vsRef = _mm_set1_pd(sRef_m_);
     const __m128d vws = _mm_set1_pd(weights.spectralSurf), vwg = _mm_set1_pd(weights.gerstnerSurf);
-    const __m128d zero = _mm_setzero_pd(), one = _mm_set1_pd(1.0);
+    const __m128d zero = _mm_setzero_pd();
     const bool seaward = p.s_m >= sRef_m_;
     const auto lerp = [&](const double* a, const double* b, __m128d f) {
         const __m128d va = _mm_loadu_pd(a);
@@ -551,7 +552,7 @@ SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* inf
         const __m128d spectral = _mm_cmpneq_pd(_mm_loadu_pd(&laneSpectral_[m]), zero);
         const __m128d w = _mm_or_pd(_mm_and_pd(spectral, vws), _mm_andnot_pd(spectral, vwg));
         const __m128d a = _mm_mul_pd(lerp(d0 + m, d1 + m, vdf), w);
-        const __m128d k = lerp(d0 + lanes + m, d1 + lanes + m, vdf);
+        const __m128d invK = lerp(d0 + lanes + m, d1 + lanes + m, vdf);
         const __m128d kx = lerp(d0 + 2 * lanes + m, d1 + 2 * lanes + m, vdf);
         const __m128d invTanh = lerp(d0 + 3 * lanes + m, d1 + 3 * lanes + m, vdf);
         _mm_store_pd(&amplitudes[m], a);
@@ -565,7 +566,6 @@ SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* inf
         const __m128d hor = _mm_mul_pd(a, invTanh);
         orbit = _mm_add_pd(orbit, hor);
         longest = _mm_max_pd(longest, invTanh);
-        const __m128d invK = _mm_div_pd(one, k);
         const __m128d eS = _mm_mul_pd(kx, invK), eU = _mm_mul_pd(ku, invK);
         const __m128d hs = _mm_mul_pd(hor, sn), hc = _mm_mul_pd(hor, cs);
         dispS = _mm_sub_pd(dispS, _mm_mul_pd(eS, hs));
@@ -629,12 +629,10 @@ SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* inf
         size_t best = 0;
         for (size_t m = 1; m < n; ++m)
             if (amplitudes[m] > amplitudes[best]) best = m;
-        const double* e0 = d0 + best;
-        const double* e1 = d1 + best;
-        const double k = e0[lanes] + df * (e1[lanes] - e0[lanes]);
-        const double kx = e0[2 * lanes] + df * (e1[2 * lanes] - e0[2 * lanes]);
         const DepthSample& s0 = depth_[di * n + best];
         const DepthSample& s1 = depth_[(di + 1) * n + best];
+        const double k = s0.k + df * (s1.k - s0.k);
+        const double kx = s0.kx + df * (s1.kx - s0.kx);
         const glm::dvec2 kw = bathy_.Frame().WorldFromShoreDirection({kx, laneKu_[best]});
         local.direction_rad = std::atan2(kw.x, kw.y);
         if (local.direction_rad < 0.0) local.direction_rad += kTwoPi;

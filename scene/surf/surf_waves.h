@@ -248,7 +248,7 @@ class SurfWaves {
     // zero 1/tanh kh), per component its
     // constants, per depth sample the interpolated fields (kLaneFields, field-major), per
     // cross-shore sample the phases.
-    static constexpr size_t kLaneFields = 4;  // amplitude, k, k_s, 1/tanh kh
+    static constexpr size_t kLaneFields = 4;  // amplitude, 1/k, k_s, 1/tanh kh
     size_t lanes_ = 0;
     std::vector<double> laneOrigin_, laneKu_, laneOmega_, laneKs0_, laneSpectral_;
     std::vector<double> laneDepth_;  // [(i · kLaneFields + field) · lanes_ + m]
