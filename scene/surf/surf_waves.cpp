@@ -543,10 +543,11 @@ SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* inf
     __m128d velS = zero, velU = zero, velZ = zero;
     alignas(16) std::array<double, kMaxSurfComponents> amplitudes;
     for (size_t m = 0; m < lanes; m += 2) {
-        const __m128d sn =
-            _mm_cvtps_pd(_mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(&sines[m]))));
-        const __m128d cs =
-            _mm_cvtps_pd(_mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(&cosines[m]))));
+        // Two floats through __m64, which may alias them.
+        const auto load2 = [](const float* f) {
+            return _mm_cvtps_pd(_mm_loadl_pi(_mm_setzero_ps(), reinterpret_cast<const __m64*>(f)));
+        };
+        const __m128d sn = load2(&sines[m]), cs = load2(&cosines[m]);
         const __m128d ku = _mm_loadu_pd(&laneKu_[m]), omega = _mm_loadu_pd(&laneOmega_[m]);
         // Shoaled and refracted, times the weight of the component's part in the fade.
         const __m128d spectral = _mm_cmpneq_pd(_mm_loadu_pd(&laneSpectral_[m]), zero);
