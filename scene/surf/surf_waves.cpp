@@ -118,12 +118,11 @@ SurfWaves::SurfWaves(const Bathymetry& bathymetry, std::vector<SurfComponent> co
         }
     }
 
-    // The incoming components' derived depth samples and phases, interleaved for Terms.
+    // The incoming components' derived depth samples, interleaved by sample.
     for (size_t j = 0; j < components_.size(); ++j)
         if (tracks_[j].incoming) incoming_.push_back(j);
     const size_t n = incoming_.size();
     depth_.resize(size_t(depthSamples_) * n);
-    phase_.resize(size_t(samples) * n);
     for (size_t m = 0; m < n; ++m) {
         const Track& tr = tracks_[incoming_[m]];
         for (int i = 0; i < depthSamples_; ++i) {
@@ -136,7 +135,6 @@ SurfWaves::SurfWaves(const Bathymetry& bathymetry, std::vector<SurfComponent> co
                                              std::sqrt(tr.cg0 / cg) * std::sqrt(tr.cos0 / cosT),
                                          1.0 / std::tanh(k * h), cg};
         }
-        for (int i = 0; i < samples; ++i) phase_[size_t(i) * n + m] = tr.phase[size_t(i)];
     }
     // Two (sines: four) lanes at a time: padded with silent components (zero amplitude and
     // 1/tanh, k = 1). 1/k is tabulated rather than k: Terms then divides by nothing.
@@ -168,8 +166,7 @@ SurfWaves::SurfWaves(const Bathymetry& bathymetry, std::vector<SurfComponent> co
         laneOmega_[m] = components_[incoming_[m]].omega_radps;
         laneKs0_[m] = tr.ks0;
         laneSpectral_[m] = components_[incoming_[m]].spectral ? 1.0 : 0.0;
-        for (int i = 0; i < samples; ++i)
-            lanePhase_[size_t(i) * lanes_ + m] = phase_[size_t(i) * n + m];
+        for (int i = 0; i < samples; ++i) lanePhase_[size_t(i) * lanes_ + m] = tr.phase[size_t(i)];
     }
 
     // Mean breaker line: where H_rms of the unbroken shoaled waves reaches γ h on the plane
@@ -512,7 +509,7 @@ SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* inf
     // The phases in double precision (they grow with time and distance), reduced to [−π, π]
     // by whole turns; their sines and cosines then four at a time in single precision
     // (simd4::SinCos4, ~2e-7): the surface is stored in floats, so nothing visible is lost, and
-    // this is a third of the cost of double-precision sines.
+    // four lanes with shorter polynomials cost far less than double-precision sines.
     alignas(16) std::array<double, kMaxSurfComponents> psis;
     alignas(16) std::array<float, kMaxSurfComponents> reduced, sines, cosines;
     const __m128d kRound = _mm_set1_pd(6755399441055744.0);  // 1.5 · 2⁵²: round to integer
