@@ -153,6 +153,8 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
             if (!surf) {
                 frame.AccumulateFft(x0, y0, filter, s);
                 if (gerstner) local.Accumulate(float(rx), float(ry), fp, s.data());
+            } else if (frame.DryLandSums(x0, y0, s)) {
+                out.surfFoam[v] = 0.0f;  // dry sand, never wet: no foam
             } else {
                 // Each part of the deep sea with its depth weight, then the surf components.
                 SurfPointInfo info;

@@ -37,7 +37,8 @@ struct OceanMesh {
     std::vector<float> jacobian;       // surface folding measure (< 0 folded)
     // With a surf zone, per vertex: the surf's foam coverage (scene/surf/foam.h) at the vertex's
     // rest position where the still water is shallower than the fade depth, else 0; from the
-    // same SurfWaves::Terms evaluation as the vertex. Empty without a surf zone.
+    // same SurfWaves::Terms evaluation as the vertex; 0 on dry land that no water reaches
+    // (OceanSurfaceFrame::DryLandSums). Empty without a surf zone.
     std::vector<float> surfFoam;
     std::vector<uint32_t> indices;  // counter-clockwise seen from above
     // Ring j, column i is vertex j · (segments + !fullCircle) + i. Column i lies at azimuth

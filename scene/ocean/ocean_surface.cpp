@@ -182,6 +182,24 @@ void OceanSurfaceFrame::AddSurf(double x0, double y0, const SurfaceTerms& s,
     }
 }
 
+bool OceanSurfaceFrame::DryLandSums(double x0, double y0, GeometrySums& sums) const {
+    CHECK(surf_);
+    const Bathymetry& bathy = surf_->Bathy();
+    // At depth ≤ 0 every part of the deep sea has faded out (fade weights 0 below half their
+    // fade depths) and SurfWaves::Terms adds only the swash: the water stands at tide + ζ with
+    // no horizontal displacement, ζ ≤ Swash().max_m. Above that (1 mm more for float rounding)
+    // the seabed clamp always applies at the rest position itself.
+    constexpr double kRoundingMargin_m = 1e-3;
+    const double zBed = bathy.SeabedZ_m(x0, y0);
+    if (!(zBed > bathy.Tide_m() + surf_->Swash().max_m + kRoundingMargin_m)) return false;
+    const glm::dvec3 bed = SeabedWithSlope(bathy, x0, y0);
+    sums = GeometrySums{};
+    sums[kTermHeight] = float(bed.x);
+    sums[kTermSlopeX] = float(bed.y);
+    sums[kTermSlopeY] = float(bed.z);
+    return true;
+}
+
 OceanSample OceanSurfaceFrame::SampleAt(double x, double y, glm::dvec2* rest) const {
     return InvertHorizontalDisplacement(
         x, y, [this](double x0, double y0) { return Evaluate(x0, y0); }, rest);

@@ -109,6 +109,11 @@ class OceanSurfaceFrame {
     // and info from Surf()->Terms at the frame time) and the tide, and clamps the height to the
     // seabed under the displaced point.
     void AddSurf(double x0, double y0, const SurfaceTerms& surfTerms, GeometrySums& sums) const;
+    // With a surf zone: whether rest position (x0, y0) is dry land that no water reaches at any
+    // time (seabed above the tide plus the swash maximum), and if so the surface there, sums set
+    // to exactly what the deep sea, the surf terms and AddSurf's seabed clamp give (the seabed
+    // and its slope), without evaluating them.
+    bool DryLandSums(double x0, double y0, GeometrySums& sums) const;
 
     // The surf components (nullptr without environment.ocean.surf).
     const SurfWaves* Surf() const { return surf_.get(); }

@@ -42,6 +42,13 @@ Bathymetry::Bathymetry(const SurfSettings& settings, double oceanDepth_m)
         CHECK(r.width_m > 0.0);
         regionStart_m_.push_back(start);
         start += r.width_m;
+        if (!r.sandbar) continue;
+        // The lift is zero where |s − distance| − width/2 ≥ side slope; 1 mm more for rounding.
+        const double reach = 0.5 * r.sandbar->width_m + r.sandbar->sideSlope_m + 1e-3;
+        const double lo = r.sandbar->distance_m - reach, hi = r.sandbar->distance_m + reach;
+        const bool first = barSMax_m_ < barSMin_m_;
+        barSMin_m_ = first ? lo : std::min(barSMin_m_, lo);
+        barSMax_m_ = first ? hi : std::max(barSMax_m_, hi);
     }
     period_m_ = start;
     CHECK(!s.depthGrid || (s.depthGrid->grid && s.depthGrid->cell_m > 0.0));
@@ -88,6 +95,7 @@ int Bathymetry::RegionAt(double u_m, double* offset_m) const {
 // on the crest rectangle, blended down over the side-slope distance with a smoothstep (zero slope
 // change at both ends, so the bar's flanks join the beach and the crest without kinks).
 double Bathymetry::BarLift(double s_m, double u_m, double profileZ_m) const {
+    if (!(s_m >= barSMin_m_ && s_m <= barSMax_m_)) return 0.0;  // beyond every bar's flanks
     double offset_m = 0.0;
     const int region = RegionAt(u_m, &offset_m);
     if (region < 0) return 0.0;

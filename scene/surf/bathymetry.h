@@ -76,6 +76,9 @@ class Bathymetry {
     double zLand_m_, zOffshore_m_;
     std::vector<double> regionStart_m_;  // cumulative starts of the regions within one period
     double period_m_ = 0.0;
+    // Cross-shore span outside which no sandbar lifts the seabed (empty without sandbars), so
+    // that BarLift skips the region lookup there.
+    double barSMin_m_ = 0.0, barSMax_m_ = -1.0;
 };
 
 }  // namespace seasense::scene

@@ -2,6 +2,8 @@
 // per-point evaluation with shoaling, refraction, the breaker cap and Gerstner steepening.
 #include "scene/surf/surf_waves.h"
 
+#include <emmintrin.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -9,6 +11,7 @@
 #include <numbers>
 
 #include "scene/core/check.h"
+#include "scene/core/simd4.h"
 #include "scene/core/sincos.h"
 #include "scene/ocean/gerstner.h"
 #include "scene/ocean/spectrum.h"
@@ -115,12 +118,11 @@ SurfWaves::SurfWaves(const Bathymetry& bathymetry, std::vector<SurfComponent> co
         }
     }
 
-    // The incoming components' derived depth samples and phases, interleaved for Terms.
+    // The incoming components' derived depth samples, interleaved by sample.
     for (size_t j = 0; j < components_.size(); ++j)
         if (tracks_[j].incoming) incoming_.push_back(j);
     const size_t n = incoming_.size();
     depth_.resize(size_t(depthSamples_) * n);
-    phase_.resize(size_t(samples) * n);
     for (size_t m = 0; m < n; ++m) {
         const Track& tr = tracks_[incoming_[m]];
         for (int i = 0; i < depthSamples_; ++i) {
@@ -133,7 +135,38 @@ SurfWaves::SurfWaves(const Bathymetry& bathymetry, std::vector<SurfComponent> co
                                              std::sqrt(tr.cg0 / cg) * std::sqrt(tr.cos0 / cosT),
                                          1.0 / std::tanh(k * h), cg};
         }
-        for (int i = 0; i < samples; ++i) phase_[size_t(i) * n + m] = tr.phase[size_t(i)];
+    }
+    // Two (sines: four) lanes at a time: padded with silent components (zero amplitude and
+    // 1/tanh, k = 1). 1/k is tabulated rather than k: Terms then divides by nothing.
+    lanes_ = (n + 3) / 4 * 4;
+    laneOrigin_.assign(lanes_, 0.0);
+    laneKu_.assign(lanes_, 0.0);
+    laneOmega_.assign(lanes_, 0.0);
+    laneKs0_.assign(lanes_, 0.0);
+    laneSpectral_.assign(lanes_, 0.0);
+    laneDepth_.assign(size_t(depthSamples_) * kLaneFields * lanes_, 0.0);
+    lanePhase_.assign(size_t(samples) * lanes_, 0.0);
+    for (size_t m = 0; m < lanes_; ++m) {
+        for (int i = 0; i < depthSamples_; ++i) {
+            double* d = laneDepth_.data() + size_t(i) * kLaneFields * lanes_ + m;
+            if (m >= n) {
+                d[lanes_] = 1.0;  // 1/k
+                continue;
+            }
+            const DepthSample& ds = depth_[size_t(i) * n + m];
+            d[0] = ds.amplitude;
+            d[lanes_] = 1.0 / ds.k;
+            d[2 * lanes_] = ds.kx;
+            d[3 * lanes_] = ds.invTanh;
+        }
+        if (m >= n) continue;
+        const Track& tr = tracks_[incoming_[m]];
+        laneOrigin_[m] = tr.phaseOrigin;
+        laneKu_[m] = tr.ku;
+        laneOmega_[m] = components_[incoming_[m]].omega_radps;
+        laneKs0_[m] = tr.ks0;
+        laneSpectral_[m] = components_[incoming_[m]].spectral ? 1.0 : 0.0;
+        for (int i = 0; i < samples; ++i) lanePhase_[size_t(i) * lanes_ + m] = tr.phase[size_t(i)];
     }
 
     // Mean breaker line: where H_rms of the unbroken shoaled waves reaches γ h on the plane
@@ -216,6 +249,7 @@ void SurfWaves::BuildShelters() {
                     sh.fluxMin[size_t(c) * size_t(sh.ns) + size_t(i)] = running;
                 }
             }
+            shelterSeaward_m_ = shelters_.empty() ? sh.s0_m : std::max(shelterSeaward_m_, sh.s0_m);
             shelterOfRegion_[r] = int(shelters_.size());
             shelters_.push_back(std::move(sh));
         }
@@ -224,7 +258,8 @@ void SurfWaves::BuildShelters() {
 }
 
 double SurfWaves::Shelter(double s_m, double u_m, double h) const {
-    if (shelters_.empty() || h <= kMinDepth_m) return 1.0;
+    // Seaward of every bar's foot, or too shallow: no shelter (skips the region lookup).
+    if (shelters_.empty() || h <= kMinDepth_m || s_m > shelterSeaward_m_) return 1.0;
     double offset = 0.0;
     const int region = bathy_.RegionAt(u_m, &offset);
     if (region < 0 || shelterOfRegion_[size_t(region)] < 0) return 1.0;
@@ -310,6 +345,7 @@ double SurfWaves::Swash_m(double s_m, double u_m, double t, double h) const {
     if (!p.active) return 0.0;
     double w = 1.0;
     if (h > 0.0) {
+        if (h >= 2.0 * p.runup2_m) return 0.0;  // beyond the swash (w ≤ 0), without dividing
         w = 1.0 - h / (2.0 * p.runup2_m);
         if (w <= 0.0) return 0.0;
     } else if (s_m < p.shoreline_m - 2.0 * p.runup2_m / p.foreshoreSlope - 10.0) {
@@ -440,57 +476,109 @@ SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* inf
     }
 
     // One interpolation position for every component: the depth samples and the cross-shore
-    // phases are interleaved by sample (see the constructor).
-    const size_t n = incoming_.size();
+    // phases are stored by sample (see the constructor).
+    const size_t n = incoming_.size(), lanes = lanes_;
     const double hh = std::max(h, kMinDepth_m);
     const double dx = std::min(hh / dh_m_, double(depthSamples_ - 1));
     const size_t di = std::min(size_t(dx), size_t(depthSamples_ - 2));
     const double df = dx - double(di);
-    const DepthSample* d0 = depth_.data() + di * n;
-    const DepthSample* d1 = d0 + n;
-    const size_t phaseSamples = phase_.size() / std::max<size_t>(n, 1);
+    const size_t phaseSamples = lanePhase_.size() / lanes;
     const double px = std::clamp(tableIndex, 0.0, double(phaseSamples - 1));
     const size_t pi = std::min(size_t(px), phaseSamples - 2);
     const double pf = px - double(pi);
-    const double* p0 = phase_.data() + pi * n;
-    const double* p1 = p0 + n;
-    struct Local {
-        double a, k, kx, ku, invTanh, omega, cg, cs, sn, psi;
+    const double* d0 = laneDepth_.data() + di * kLaneFields * lanes;
+    const double* d1 = d0 + kLaneFields * lanes;
+    const double* p0 = lanePhase_.data() + pi * lanes;
+    const double* p1 = p0 + lanes;
+
+    // The components two at a time (SSE2 lanes: even components in lane 0, odd in lane 1), each
+    // sum reduced as lane 0 + lane 1 at the end: a fixed order, so the mesh and the queries,
+    // which both come here, get the same bits. Everything is summed before the breaker cap and
+    // the steepness Q, which scale whole sums (below); the tensors and vectors are summed in the
+    // shore frame and turned to the world once.
+    const __m128d vdf = _mm_set1_pd(df), vpf = _mm_set1_pd(pf);
+    const __m128d vu = _mm_set1_pd(p.u_m), vt = _mm_set1_pd(t);
+    const __m128d vs = _mm_set1_pd(p.s_m), vsRef = _mm_set1_pd(sRef_m_);
+    const __m128d vws = _mm_set1_pd(weights.spectralSurf), vwg = _mm_set1_pd(weights.gerstnerSurf);
+    const __m128d zero = _mm_setzero_pd();
+    const bool seaward = p.s_m >= sRef_m_;
+    const auto lerp = [&](const double* a, const double* b, __m128d f) {
+        const __m128d va = _mm_loadu_pd(a);
+        return _mm_add_pd(va, _mm_mul_pd(f, _mm_sub_pd(_mm_loadu_pd(b), va)));
     };
-    std::array<Local, kMaxSurfComponents> waves;
-    std::array<double, kMaxSurfComponents> psis, sines, cosines;
-    for (size_t m = 0; m < n; ++m) {
-        const Track& tr = tracks_[incoming_[m]];
-        const double crossPhase =
-            p.s_m >= sRef_m_ ? tr.ks0 * p.s_m : tr.ks0 * sRef_m_ + p0[m] + pf * (p1[m] - p0[m]);
-        psis[m] =
-            tr.phaseOrigin + tr.ku * p.u_m + crossPhase - components_[incoming_[m]].omega_radps * t;
+    // The phases in double precision (they grow with time and distance), reduced to [−π, π]
+    // by whole turns; their sines and cosines then four at a time in single precision
+    // (simd4::SinCos4, ~2e-7): the surface is stored in floats, so nothing visible is lost, and
+    // four lanes with shorter polynomials cost far less than double-precision sines.
+    alignas(16) std::array<double, kMaxSurfComponents> psis;
+    alignas(16) std::array<float, kMaxSurfComponents> reduced, sines, cosines;
+    const __m128d kRound = _mm_set1_pd(6755399441055744.0);  // 1.5 · 2⁵²: round to integer
+    for (size_t m = 0; m < lanes; m += 2) {
+        const __m128d ks0 = _mm_loadu_pd(&laneKs0_[m]);
+        const __m128d crossPhase =
+            seaward ? _mm_mul_pd(ks0, vs)
+                    : _mm_add_pd(_mm_mul_pd(ks0, vsRef), lerp(p0 + m, p1 + m, vpf));
+        const __m128d psi =
+            _mm_sub_pd(_mm_add_pd(_mm_add_pd(_mm_loadu_pd(&laneOrigin_[m]),
+                                             _mm_mul_pd(_mm_loadu_pd(&laneKu_[m]), vu)),
+                                  crossPhase),
+                       _mm_mul_pd(_mm_loadu_pd(&laneOmega_[m]), vt));
+        _mm_store_pd(&psis[m], psi);
+        const __m128d turns =
+            _mm_sub_pd(_mm_add_pd(_mm_mul_pd(psi, _mm_set1_pd(1.0 / kTwoPi)), kRound), kRound);
+        _mm_storel_pi(reinterpret_cast<__m64*>(&reduced[m]),
+                      _mm_cvtpd_ps(_mm_sub_pd(psi, _mm_mul_pd(turns, _mm_set1_pd(kTwoPi)))));
     }
-    for (size_t m = 0; m < n; ++m) SinCos(psis[m], sines[m], cosines[m]);
-    double envelopeRe = 0.0, envelopeIm = 0.0;
-    for (size_t m = 0; m < n; ++m) {
-        const size_t j = incoming_[m];
-        const Track& tr = tracks_[j];
-        const SurfComponent& c = components_[j];
-        const DepthSample& s0 = d0[m];
-        const DepthSample& s1 = d1[m];
+    for (size_t m = 0; m < lanes; m += 4) {
+        simd4::F4 sn, cs;
+        simd4::SinCos4(_mm_load_ps(&reduced[m]), sn, cs);
+        _mm_store_ps(&sines[m], sn);
+        _mm_store_ps(&cosines[m], cs);
+    }
+    __m128d re = zero, im = zero, slopeS = zero, slopeU = zero, orbit = zero, longest = zero;
+    __m128d dispS = zero, dispU = zero, tSS = zero, tUU = zero, tSU = zero;
+    __m128d velS = zero, velU = zero, velZ = zero;
+    alignas(16) std::array<double, kMaxSurfComponents> amplitudes;
+    for (size_t m = 0; m < lanes; m += 2) {
+        // Two floats through __m64, which may alias them.
+        const auto load2 = [](const float* f) {
+            return _mm_cvtps_pd(_mm_loadl_pi(_mm_setzero_ps(), reinterpret_cast<const __m64*>(f)));
+        };
+        const __m128d sn = load2(&sines[m]), cs = load2(&cosines[m]);
+        const __m128d ku = _mm_loadu_pd(&laneKu_[m]), omega = _mm_loadu_pd(&laneOmega_[m]);
         // Shoaled and refracted, times the weight of the component's part in the fade.
-        const double a = (s0.amplitude + df * (s1.amplitude - s0.amplitude)) *
-                         (c.spectral ? weights.spectralSurf : weights.gerstnerSurf);
-        const double cs = cosines[m], sn = sines[m];
-        waves[m] = {a,
-                    s0.k + df * (s1.k - s0.k),
-                    s0.kx + df * (s1.kx - s0.kx),
-                    tr.ku,
-                    s0.invTanh + df * (s1.invTanh - s0.invTanh),
-                    c.omega_radps,
-                    s0.cg + df * (s1.cg - s0.cg),
-                    cs,
-                    sn,
-                    psis[m]};
-        envelopeRe += a * cs;
-        envelopeIm += a * sn;
+        const __m128d spectral = _mm_cmpneq_pd(_mm_loadu_pd(&laneSpectral_[m]), zero);
+        const __m128d w = _mm_or_pd(_mm_and_pd(spectral, vws), _mm_andnot_pd(spectral, vwg));
+        const __m128d a = _mm_mul_pd(lerp(d0 + m, d1 + m, vdf), w);
+        const __m128d invK = lerp(d0 + lanes + m, d1 + lanes + m, vdf);
+        const __m128d kx = lerp(d0 + 2 * lanes + m, d1 + 2 * lanes + m, vdf);
+        const __m128d invTanh = lerp(d0 + 3 * lanes + m, d1 + 3 * lanes + m, vdf);
+        _mm_store_pd(&amplitudes[m], a);
+        const __m128d asn = _mm_mul_pd(a, sn);
+        re = _mm_add_pd(re, _mm_mul_pd(a, cs));
+        im = _mm_add_pd(im, asn);
+        slopeS = _mm_sub_pd(slopeS, _mm_mul_pd(asn, kx));
+        slopeU = _mm_sub_pd(slopeU, _mm_mul_pd(asn, ku));
+        velZ = _mm_add_pd(velZ, _mm_mul_pd(asn, omega));
+        // The orbit a / tanh kh along the unit direction of travel (k_s, k_u) / k.
+        const __m128d hor = _mm_mul_pd(a, invTanh);
+        orbit = _mm_add_pd(orbit, hor);
+        longest = _mm_max_pd(longest, invTanh);
+        const __m128d eS = _mm_mul_pd(kx, invK), eU = _mm_mul_pd(ku, invK);
+        const __m128d hs = _mm_mul_pd(hor, sn), hc = _mm_mul_pd(hor, cs);
+        dispS = _mm_sub_pd(dispS, _mm_mul_pd(eS, hs));
+        dispU = _mm_sub_pd(dispU, _mm_mul_pd(eU, hs));
+        // ∂D_i/∂x_j = −hor cos ψ e_i k_j: symmetric, three sums.
+        const __m128d hcS = _mm_mul_pd(hc, eS);
+        tSS = _mm_sub_pd(tSS, _mm_mul_pd(hcS, kx));
+        tUU = _mm_sub_pd(tUU, _mm_mul_pd(_mm_mul_pd(hc, eU), ku));
+        tSU = _mm_sub_pd(tSU, _mm_mul_pd(hcS, ku));
+        const __m128d hcw = _mm_mul_pd(hc, omega);
+        velS = _mm_add_pd(velS, _mm_mul_pd(eS, hcw));
+        velU = _mm_add_pd(velU, _mm_mul_pd(eU, hcw));
     }
+    const auto sum = [](__m128d v) { return _mm_cvtsd_f64(_mm_add_sd(v, _mm_unpackhi_pd(v, v))); };
+    const double envelopeRe = sum(re), envelopeIm = sum(im);
     const double A = std::sqrt(envelopeRe * envelopeRe + envelopeIm * envelopeIm);
     // Behind a sandbar only the energy flux the bar let through arrives (Shelter).
     const double shelter = Shelter(p.s_m, p.u_m, h);
@@ -500,38 +588,31 @@ SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* inf
     // approaches the breaker height.
     const double q = settings_.deepSteepness + (1.0 - settings_.deepSteepness) *
                                                    std::min(1.0, 2.0 * A / std::max(gammaH, 1e-9));
-    size_t best = 0;
-    double horizontalSum = 0.0, longest = 0.0;
-    glm::dvec3 horizontal{0.0};  // displacement x, y and the velocity's horizontal part below
-    glm::dvec2 horizontalVelocity{0.0};
-    double dxx = 0.0, dyy = 0.0, dxy = 0.0;
-    for (size_t i = 0; i < n; ++i) {
-        const Local& v = waves[i];
-        const double a = v.a * cap;
-        // World unit direction of travel from the local shore wavevector.
-        const glm::dvec2 kw = bathy_.Frame().WorldFromShoreDirection({v.kx, v.ku});
-        const glm::dvec2 d = kw / v.k;
-        const double hor = q * a * v.invTanh;
-        horizontalSum += a * v.invTanh;
-        longest = std::max(longest, v.invTanh);
-        horizontal += glm::dvec3(-d.x * hor * v.sn, -d.y * hor * v.sn, 0.0);
-        out.displacement.z += a * v.cs;
-        out.sx += -a * v.sn * kw.x;
-        out.sy += -a * v.sn * kw.y;
-        dxx += -d.x * hor * v.cs * kw.x;
-        dyy += -d.y * hor * v.cs * kw.y;
-        dxy += -d.x * hor * v.cs * kw.y;
-        horizontalVelocity += glm::dvec2(d.x, d.y) * (hor * v.omega * v.cs);
-        out.velocity_mps.z += a * v.omega * v.sn;
-        if (v.a > waves[best].a) best = i;
-    }
+    // Shore frame to world: the seaward and alongshore unit vectors.
+    const glm::dvec2 es = bathy_.Frame().WorldFromShoreDirection({1.0, 0.0});
+    const glm::dvec2 eu = bathy_.Frame().WorldFromShoreDirection({0.0, 1.0});
+    out.displacement.z += cap * envelopeRe;
+    const glm::dvec2 slope = cap * (sum(slopeS) * es + sum(slopeU) * eu);
+    out.sx = slope.x;
+    out.sy = slope.y;
+    out.velocity_mps.z = cap * sum(velZ);
+    const double qc = q * cap;
+    const glm::dvec2 horizontal = qc * (sum(dispS) * es + sum(dispU) * eu);
+    const glm::dvec2 horizontalVelocity = qc * (sum(velS) * es + sum(velU) * eu);
+    // The tensor T = R T_shore Rᵀ with R's columns es, eu.
+    const double ss = qc * sum(tSS), uu = qc * sum(tUU), su = qc * sum(tSU);
+    const double dxx = ss * es.x * es.x + 2.0 * su * es.x * eu.x + uu * eu.x * eu.x;
+    const double dyy = ss * es.y * es.y + 2.0 * su * es.y * eu.y + uu * eu.y * eu.y;
+    const double dxy = ss * es.x * es.y + su * (es.x * eu.y + eu.x * es.y) + uu * eu.x * eu.y;
     // The horizontal excursion is held to that of one breaker-height wave (γh/2) of the longest
     // component at this depth, (γh/2)/tanh(kh) — linear theory's orbit ξ = H / (2 tanh kh) at the
     // breaking limit. Without it, components that cancel in height (small envelope, no cap) add
     // their orbits, each ∝ a/(kh), which grow without bound as h → 0. Scaling the horizontal
     // field by one factor keeps its direction; the factor's own gradient is left out of the
     // Jacobian terms.
-    const double limit = std::min(horizontalSum, 0.5 * gammaH * longest);
+    const double longestInvTanh =
+        _mm_cvtsd_f64(_mm_max_sd(longest, _mm_unpackhi_pd(longest, longest)));
+    const double limit = std::min(cap * sum(orbit), 0.5 * gammaH * longestInvTanh);
     const double len = std::sqrt(horizontal.x * horizontal.x + horizontal.y * horizontal.y);
     const double f = len > limit && len > 0.0 ? limit / len : 1.0;
     out.displacement.x = f * horizontal.x;
@@ -541,14 +622,21 @@ SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* inf
     out.dxy = f * dxy;
     out.velocity_mps.x = f * horizontalVelocity.x;
     out.velocity_mps.y = f * horizontalVelocity.y;
-    if (n > 0) {
-        const Local& v = waves[best];
-        const glm::dvec2 kw = bathy_.Frame().WorldFromShoreDirection({v.kx, v.ku});
+    if (n > 0 && info) {
+        // The dominant component: the largest local amplitude (the first of equals).
+        size_t best = 0;
+        for (size_t m = 1; m < n; ++m)
+            if (amplitudes[m] > amplitudes[best]) best = m;
+        const DepthSample& s0 = depth_[di * n + best];
+        const DepthSample& s1 = depth_[(di + 1) * n + best];
+        const double k = s0.k + df * (s1.k - s0.k);
+        const double kx = s0.kx + df * (s1.kx - s0.kx);
+        const glm::dvec2 kw = bathy_.Frame().WorldFromShoreDirection({kx, laneKu_[best]});
         local.direction_rad = std::atan2(kw.x, kw.y);
         if (local.direction_rad < 0.0) local.direction_rad += kTwoPi;
-        local.phaseSpeed_mps = v.omega / v.k;
-        local.groupSpeed_mps = v.cg;
-        local.phase_rad = std::fmod(v.psi, kTwoPi);
+        local.phaseSpeed_mps = laneOmega_[best] / k;
+        local.groupSpeed_mps = s0.cg + df * (s1.cg - s0.cg);
+        local.phase_rad = std::fmod(psis[best], kTwoPi);
         if (local.phase_rad < 0.0) local.phase_rad += kTwoPi;
     }
     local.envelope_m = A * cap;

@@ -238,11 +238,20 @@ class SurfWaves {
     double dh_m_ = 0.02;
     int depthSamples_ = 0;
     std::vector<Track> tracks_;
-    // Incoming components (indices into components_), and their depth samples and cross-shore
-    // phases interleaved by sample: depth_[i · n + j], phase_[i · n + j] for n incoming.
+    // Incoming components (indices into components_), and their depth samples interleaved by
+    // sample: depth_[i · n + j] for n incoming.
     std::vector<size_t> incoming_;
     std::vector<DepthSample> depth_;
-    std::vector<double> phase_;
+    // For Terms, two components at a time (SSE2 lanes; sines four at a time): the incoming
+    // count padded to a multiple of 4, lanes_, with silent components (zero amplitude, zero
+    // 1/tanh kh); per component its constants, per depth sample the interpolated fields
+    // (kLaneFields, field-major), per cross-shore sample the phases ∫ k_s ds.
+    static constexpr size_t kLaneFields = 4;  // amplitude, 1/k, k_s, 1/tanh kh
+    size_t lanes_ = 0;
+    std::vector<double> laneOrigin_, laneKu_, laneOmega_, laneKs0_, laneSpectral_;
+    std::vector<double> laneDepth_;  // [(i · kLaneFields + field) · lanes_ + m]
+    std::vector<double> lanePhase_;  // [i · lanes_ + m]
+    double shelterSeaward_m_ = 0.0;  // with shelters: none seaward of this cross-shore s
     double sBreak_m_ = 0.0;
     std::vector<double> breakTime_s_;  // group travel time from the breaker line, per s sample
 };

@@ -9,10 +9,13 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <filesystem>
 #include <map>
 #include <numbers>
 #include <utility>
 #include <vector>
+
+#include "scene/scenario/scenario_loader.h"
 
 namespace seasense::scene {
 namespace {
@@ -209,6 +212,54 @@ TEST(OceanMesh, SurfVertexHeightsMatchTheQueryAtThatPoint) {
     EXPECT_GT(tested, 1000);
     EXPECT_GT(shallow, 100);  // the surf components alone, not only the fade
     EXPECT_LT(worst, 1e-4);
+}
+
+TEST(OceanMesh, DryLandShortcutIsTheFullEvaluationBitForBit) {
+    // Where OceanSurfaceFrame::DryLandSums claims dry land, the mesh skips the surf terms, the
+    // faded deep sea and the clamp test: its sums must be exactly what that whole path (as
+    // BuildOceanMesh's surf branch evaluates it) gives, across the swash zone and up the beach,
+    // at times with the swash high and low.
+    // configs/surf.yaml: sea state 4 onto a barred beach (land to the west) with swash.
+    const Scenario sc =
+        LoadScenario(std::filesystem::path(SEASENSE_SOURCE_DIR) / "configs/surf.yaml");
+    const OceanSurface sea(sc.environment.ocean);
+    ASSERT_TRUE(sea.Surf()->Swash().active);
+    const Bathymetry& b = sea.Surf()->Bathy();
+    int dry = 0, wet = 0, clampedWet = 0;
+    for (const double t : {3.0, 17.5, 41.0}) {
+        const auto frame = sea.At(t);
+        const glm::dvec2 eye(40.0, 25.0);
+        const GerstnerOcean::LocalFrame local = frame->Gerstner().Local(eye.x, eye.y, t);
+        for (double x = -90.0; x < 40.0; x += 0.37) {
+            for (const double y : {-130.0, 3.0, 71.0, 160.0}) {
+                const float fp = 0.5f;
+                GeometrySums full{};
+                SurfPointInfo info;
+                const SurfaceTerms st = frame->Surf()->Terms(x, y, t, &info);
+                frame->AccumulateFft(x, y, frame->Filter(fp), full, info.weights.cascade.data());
+                GeometrySums g{};
+                local.Accumulate(float(x - eye.x), float(y - eye.y), fp, g.data());
+                for (int k = 0; k < kGeometryTerms; ++k)
+                    full[size_t(k)] += float(info.weights.gerstner) * g[size_t(k)];
+                frame->AddSurf(x, y, st, full);
+                GeometrySums fast{};
+                if (!frame->DryLandSums(x, y, fast)) {
+                    ++wet;
+                    if (full[kTermHeight] == float(b.SeabedZ_m(x, y))) ++clampedWet;
+                    continue;
+                }
+                ++dry;
+                EXPECT_GT(b.SeabedZ_m(x, y), b.Tide_m() + sea.Surf()->Swash().max_m);
+                for (int k = 0; k < kGeometryTerms; ++k)
+                    ASSERT_EQ(std::bit_cast<uint32_t>(fast[size_t(k)]),
+                              std::bit_cast<uint32_t>(full[size_t(k)]))
+                        << "x " << x << " y " << y << " t " << t << " term " << k;
+            }
+        }
+    }
+    EXPECT_GT(dry, 1000);
+    EXPECT_GT(wet, 1000);
+    EXPECT_GT(clampedWet, 10);  // the swash zone's own clamp stays on the full path
 }
 
 TEST(OceanMesh, SurfMeshAndFrameBitIdenticalForAnyThreadCount) {
