@@ -1,0 +1,72 @@
+// The five-channel run's work per frame, channel by channel, in one process: what each renderer
+// of `seasense run` does with a published state (render, sensor model, mosaic preview), and
+// what the host does (advance the world, encode the state), so that their sum is the CPU the
+// run needs per frame without the processes, the barrier and start-up.
+#include <benchmark/benchmark.h>
+#include <tbb/task_arena.h>
+
+#include <memory>
+#include <vector>
+
+#include "channels/pipeline/channel_pipeline.h"
+#include "channels/sync/mosaic.h"
+#include "channels/sync/state_codec.h"
+#include "scene/scenario/scenario_loader.h"
+
+namespace seasense::channels {
+namespace {
+
+const scene::Scenario& FiveChannel() {
+    static const scene::Scenario s = scene::LoadScenario(
+        std::filesystem::path(SEASENSE_SOURCE_DIR) / "configs/five-channel.yaml");
+    return s;
+}
+
+// Channel range(0) of configs/five-channel.yaml with range(1) threads: frames 1, 2, … in order
+// as in a run (frame 0, which builds tables and scratch, outside the timing).
+void BM_FiveChannelRenderer(benchmark::State& state) {
+    const scene::Scenario& sc = FiveChannel();
+    const scene::ChannelSettings& ch = sc.channels.at(size_t(state.range(0)));
+    state.SetLabel(ch.name);
+    tbb::task_arena arena(int(state.range(1)));
+    const scene::World world(sc);
+    std::unique_ptr<ChannelPipeline> pipeline;
+    arena.execute([&] {
+        pipeline =
+            std::make_unique<ChannelPipeline>(world, ch, "unused", ch.formats, DefaultOcioConfig());
+        pipeline->Render(world.Advance(0));
+    });
+    int previewW = 0, previewH = 0;
+    sync::MosaicPreviewSize(ch.width, ch.height, previewW, previewH);
+    int64_t frame = 1;
+    for (auto _ : state) {
+        state.PauseTiming();
+        const scene::FrameState fs = world.Advance(frame++);
+        state.ResumeTiming();
+        arena.execute([&] {
+            pipeline->Render(fs);
+            std::vector<uint8_t> rgb = pipeline->PreviewRgb8(previewW, previewH);
+            benchmark::DoNotOptimize(rgb.data());
+        });
+    }
+}
+BENCHMARK(BM_FiveChannelRenderer)
+    ->ArgNames({"channel", "threads"})
+    ->ArgsProduct({{0, 1, 2, 3, 4}, {1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// The host's work per frame: World::Advance and the state's encoding into a slot.
+void BM_FiveChannelHost(benchmark::State& state) {
+    const scene::World world(FiveChannel());
+    std::vector<uint8_t> slot(1 << 20);
+    int64_t frame = 0;
+    for (auto _ : state) {
+        const scene::FrameState fs = world.Advance(frame++);
+        benchmark::DoNotOptimize(sync::EncodeFrameState(fs, slot.data(), slot.size()));
+    }
+}
+BENCHMARK(BM_FiveChannelHost)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace seasense::channels
