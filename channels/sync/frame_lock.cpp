@@ -25,7 +25,28 @@ constexpr int64_t kPollNs = 50'000'000;
 // 2-core machine), while the other side of a barrier usually arrives within microseconds.
 constexpr int64_t kSpinNs = 40'000;
 
-uint32_t* Raw(FutexWord& w) { return reinterpret_cast<uint32_t*>(&w); }
+// The 32-bit value of the word (its std::atomic base, at the same address).
+uint32_t* Raw(FutexWord& w) {
+    return reinterpret_cast<uint32_t*>(static_cast<std::atomic<uint32_t>*>(&w));
+}
+
+// Counts the caller among the word's sleepers for its lifetime. The fence after the increment
+// pairs with the one in WakeAll (Dekker's pattern): either the waker's load of `sleepers` sees
+// this increment and it wakes, or every read of the word, status and counters this waiter
+// makes after the fence sees the waker's change, so a skipped wake-up is never needed.
+class SleeperGuard {
+  public:
+    explicit SleeperGuard(FutexWord& w) : w_(w) {
+        w_.sleepers.fetch_add(1, std::memory_order_relaxed);
+        std::atomic_thread_fence(std::memory_order_seq_cst);
+    }
+    ~SleeperGuard() { w_.sleepers.fetch_sub(1, std::memory_order_relaxed); }
+    SleeperGuard(const SleeperGuard&) = delete;
+    SleeperGuard& operator=(const SleeperGuard&) = delete;
+
+  private:
+    FutexWord& w_;
+};
 
 void FutexWait(FutexWord& w, uint32_t expected, int64_t timeout_ns) {
     timespec ts{};
@@ -68,6 +89,10 @@ const char* ToString(WaitResult r) {
 }
 
 void WakeAll(FutexWord& word) {
+    // Orders the caller's change of the word (or of the status) before the read of the
+    // sleeper count; see SleeperGuard.
+    std::atomic_thread_fence(std::memory_order_seq_cst);
+    if (word.sleepers.load(std::memory_order_relaxed) == 0) return;
     ::syscall(SYS_futex, Raw(word), FUTEX_WAKE, INT_MAX, nullptr, nullptr, 0);
 }
 
@@ -81,6 +106,7 @@ WaitResult WaitFor(FutexWord& word, const std::function<bool()>& pred,
         if (pred()) return WaitResult::Ready;
         std::this_thread::yield();
     }
+    const SleeperGuard sleeping(word);
     for (;;) {
         // Read the word before the predicate: a change after this read makes FutexWait
         // return at once, so no wake-up is lost.

@@ -25,12 +25,13 @@ const char* ToString(WaitResult r);
 using LivenessCheck = std::function<bool()>;
 
 // Sleeps on word until pred() holds, status says stop (see WaitResult), alive() fails, or
-// timeout_s elapses. Every change to a futex word is followed by a wake of all its waiters.
+// timeout_s elapses. Every change to a futex word (or to the run status) is followed by
+// WakeAll. Spins (yielding) for up to 40 µs before it counts itself a sleeper and sleeps.
 WaitResult WaitFor(FutexWord& word, const std::function<bool()>& pred,
                    const std::function<bool()>& stopped, const LivenessCheck& alive,
                    double timeout_s);
 
-// Wakes every process sleeping on word.
+// Wakes every process sleeping on word; no system call when none is (FutexWord::sleepers).
 void WakeAll(FutexWord& word);
 
 // Host side. Frame index i is frame number firstFrame + i.

@@ -13,7 +13,7 @@ namespace seasense::channels::sync {
 // "SEASHM01" read as a little-endian 64-bit word.
 inline constexpr uint64_t kSegmentMagic = 0x31304d4853414553ull;
 // Bumped whenever the layout below changes; a segment of another version is refused.
-inline constexpr uint32_t kLayoutVersion = 2;
+inline constexpr uint32_t kLayoutVersion = 3;
 inline constexpr int kMaxChannels = 16;
 // State slots: the host publishes frame n+1 while channels may still present frame n, and
 // never writes the slot of frame n+2 before every channel has presented frame n.
@@ -22,9 +22,13 @@ inline constexpr size_t kNameBytes = 64;
 inline constexpr size_t kPathBytes = 1024;
 
 // A futex word: a 32-bit atomic in the mapping (lock-free, same size as uint32_t, so that the
-// kernel's futex(2) can wait on its address from any process).
-using FutexWord = std::atomic<uint32_t>;
-static_assert(sizeof(FutexWord) == 4 && FutexWord::is_always_lock_free);
+// kernel's futex(2) can wait on its address from any process), with the number of processes
+// about to sleep or asleep on it, so that a change nobody sleeps on costs no wake-up system
+// call (frame_lock.cpp pairs the two with sequentially consistent fences).
+struct alignas(64) FutexWord : std::atomic<uint32_t> {
+    std::atomic<uint32_t> sleepers{0};
+};
+static_assert(sizeof(std::atomic<uint32_t>) == 4 && std::atomic<uint32_t>::is_always_lock_free);
 
 enum class RunStatus : uint32_t {
     Starting = 0,  // header written, channels attaching
