@@ -100,7 +100,8 @@ int main(int argc, char** argv) {
                        "(repeatable)");
     runCmd
         ->add_option("--threads", run.threadsPerChannel,
-                     "Worker threads per renderer process (0 = all cores)")
+                     "Worker threads per renderer process (0 = the hardware threads divided "
+                     "among the channels, at least 1)")
         ->capture_default_str();
     runCmd
         ->add_option("--attach-timeout", run.attachTimeout_s,

@@ -19,7 +19,7 @@ struct RunOptions {
     bool images = true;
     std::string runId;                  // default: the host's pid
     std::vector<std::string> external;  // channels started by hand (`seasense channel`)
-    int threadsPerChannel = 0;          // 0: all cores
+    int threadsPerChannel = 0;          // 0: hardware threads / channels, at least 1
     double attachTimeout_s = 60.0;      // for every renderer to attach
     double frameTimeout_s = 120.0;      // for one frame to be presented by all channels
 };

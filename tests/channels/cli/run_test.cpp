@@ -274,8 +274,9 @@ TEST(Run, KilledHostMakesRenderersExitAndRemoveTheSegment) {
 TEST(Run, SigintShutsDownCleanly) {
     const fs::path out = TempDir("sigint");
     const std::string runId = RunId("int");
+    // Without --threads: the renderers share the machine's hardware threads.
     const pid_t host = Start(kBinary + " run --config " + kScenario + " --frames 100000 --out " +
-                             out.string() + " --run-id " + runId + " --threads 1 2>/dev/null");
+                             out.string() + " --run-id " + runId + " 2>/dev/null");
     const std::vector<int> pids = WaitRunning(runId, 4);
     ASSERT_EQ(::kill(host, SIGINT), 0);
     EXPECT_EQ(WaitExit(host, 30.0), 128 + SIGINT);
@@ -283,6 +284,13 @@ TEST(Run, SigintShutsDownCleanly) {
     EXPECT_FALSE(SegmentExists(runId));
     const nlohmann::json summary = nlohmann::json::parse(ReadFile(out / "summary.json"));
     EXPECT_EQ(summary["status"], "interrupted");
+    // No more worker threads than hardware threads, unless there are more channels than that,
+    // and at least one each.
+    const int threadsPerChannel = summary["threads_per_channel"];
+    const int hardware = summary["hardware_threads"];
+    EXPECT_GE(threadsPerChannel, 1);
+    EXPECT_LE(threadsPerChannel * int(kChannels.size()),
+              std::max(std::max(hardware, 1), int(kChannels.size())));
     const int64_t frames = summary["frames"];
     EXPECT_GE(frames, 4);
     // Every written file is complete: one sync row per channel per frame, a readable video
