@@ -835,7 +835,7 @@ OtwChannel::OtwChannel(const scene::World& world, const scene::ChannelSettings& 
     const glm::dvec3 foam = reflectance("foam", {0.50, 0.53, 0.55});
     for (int c = 0; c < 3; ++c)
         shore_[c] = {kSeaRrs[c], kCoastalK_perm[c], float(wet[c]), float(dry[c]), float(foam[c])};
-    stars_ = scene::LoadStarCatalog(scene::DefaultStarCatalogPath());
+    stars_ = scene::StarSky(scene::LoadStarCatalog(scene::DefaultStarCatalogPath()));
 }
 
 OtwChannel::OtwChannel(const scene::World& world, const scene::ChannelSettings& settings,
@@ -1077,13 +1077,12 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
             basis_->moon);
         overlay(
             [&](Image& img) {
-                AddMoonAndStars(cam, vis, MoonDisc{},
-                                scene::VisibleStars(stars_, state.utc, observer), img);
+                AddMoonAndStars(cam, vis, MoonDisc{}, stars_.Visible(state.utc, observer), img);
             },
             basis_->stars);
     } else {
         AddMoonAndStars(cam, vis, MakeMoonDisc(moonAboveClouds, state.sun),
-                        scene::VisibleStars(stars_, state.utc, observer), radiance);
+                        stars_.Visible(state.utc, observer), radiance);
     }
     // --- Cloud layers (channels/otw/cloud_layer) over the sky, sun, moon and stars. ---
     if (world_.Clouds()) {

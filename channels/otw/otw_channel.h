@@ -81,7 +81,7 @@ class OtwChannel {
     std::unique_ptr<radiometry::AnalyticSky> sky_;
     glm::dvec3 skySun_{0.0};
     glm::dvec3 skyMoon_{0.0};
-    std::vector<scene::CatalogStar> stars_;  // the bright-star list (configs/stars)
+    scene::StarSky stars_;  // the bright-star list (configs/stars), places cached per hour
     std::unique_ptr<ShadeScratch> scratch_;
     std::unique_ptr<ChannelPlumes> plumes_;  // scenario plumes (channels/plume)
     std::unique_ptr<CloudSky> clouds_;       // cloud pass scratch (environment.clouds)
