@@ -360,6 +360,23 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                         corner[k] = &nodes[n];
                         cornerT[k] = nodeT[n];
                     }
+                    // A depth beyond which a sample's surface is nearer than dNear anywhere in
+                    // the cell, so that its pixel is skipped without its direction: range
+                    // r = near / (cos θ · depth), θ the angle from the optical axis, and
+                    // cos θ = 1 / |(a, 1, b)| ≥ cosMin over the cell's pixels, so depth ≥
+                    // near / (cosMin · dNear) gives r ≤ dNear. The 1e-4 margin covers the
+                    // float rounding of the per-pixel range (a few ulp), so a pixel skipped
+                    // here is one the test rMax ≤ dNear below skips: the image is unchanged.
+                    float depthInFront = std::numeric_limits<float>::infinity();
+                    if (dNear > 0.0f) {
+                        double a2 = 0.0, b2 = 0.0;
+                        for (int px = cx * kCell; px < std::min(W, (cx + 1) * kCell); ++px)
+                            a2 = std::max(a2, double(colA[size_t(px)]) * colA[size_t(px)]);
+                        for (int py = cy * kCell; py < std::min(H, (cy + 1) * kCell); ++py)
+                            b2 = std::max(b2, double(rowB[size_t(py)]) * rowB[size_t(py)]);
+                        const double cosMin = 1.0 / std::sqrt(1.0 + a2 + b2);
+                        depthInFront = float(double(nearM) / (cosMin * double(dNear)) * 1.0001);
+                    }
                     bool clearSky = false;
                     const bool smooth =
                         Smooth(corner, cornerT, list.smallOpticalDepth > kInterpolationTolerance,
@@ -406,12 +423,17 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                             ++rowCovered[size_t(cy)];
                             // Samples that see the sky first (no direction needed for them).
                             bool allSky = true;
+                            float minDepth = std::numeric_limits<float>::infinity();
                             for (int j = 0; j < N; ++j)
                                 for (int i = 0; i < N; ++i) {
-                                    const bool sky = DepthAt(px * N + i, py * N + j) < 0.0f;
+                                    const float d = DepthAt(px * N + i, py * N + j);
+                                    const bool sky = d < 0.0f;
                                     range[size_t(j * N + i)] = sky ? kPlumeSkyRange_m : -1.0f;
                                     allSky &= sky;
+                                    minDepth = std::min(minDepth, d);
                                 }
+                            // Every surface surely in front of the plumes (skipped below too).
+                            if (minDepth >= depthInFront) continue;
                             if (allSky && clearSky) continue;
                             const glm::vec3 dir = PixelDirection(px, py);
                             float rMin = kPlumeSkyRange_m, rMax = 0.0f;
