@@ -262,6 +262,34 @@ void PlumeScreenBins::Gather(const List& from, int x0, int y0, int x1, int y1, f
     Finish(copy, out);
 }
 
+void PlumeScreenBins::GatherRow(const List& from, int x0, int y0, int y1, int step, int width,
+                                int cells, float smallPixels, std::span<List> out) const {
+    CHECK(step > 0 && width > 0 && cells >= 0 && out.size() >= size_t(cells));
+    for (int c = 0; c < cells; ++c) {
+        CHECK(&from != &out[size_t(c)]);
+        Begin(out[size_t(c)]);
+    }
+    y1 = std::min(y1, height_);
+    // Rectangle c clipped to the bin area as Gather clips it; empty ones get no puffs.
+    const auto Right = [&](int c) { return std::min(x0 + c * step + width, width_); };
+    if (y0 < y1 && cells > 0) {
+        for (size_t j = 0; j < from.count; ++j) {
+            const uint32_t k = from.index[j];
+            const Rect& r = rect_[k];
+            if (r.y1 <= y0 || r.y0 >= y1) continue;
+            // The rectangles c with x0 + c·step < r.x1 and x0 + c·step + width > r.x0, widened
+            // by one on each side (Take decides exactly).
+            const int lo = std::max((r.x0 - x0 - width) / step - 1, 0);
+            const int hi = std::min((r.x1 - x0) / step + 1, cells - 1);
+            for (int c = lo; c <= hi; ++c) {
+                const int cx0 = x0 + c * step, cx1 = Right(c);
+                if (cx0 < cx1) Take(k, cx0, y0, cx1, y1, smallPixels, out[size_t(c)]);
+            }
+        }
+    }
+    for (int c = 0; c < cells; ++c) Finish(false, out[size_t(c)]);
+}
+
 void PlumeScreenBins::Copy(List& list) const {
     static_assert(std::size(decltype(List::data){}) == kFields);
     if (list.copied) return;

@@ -223,6 +223,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     // before it is read).
     struct Scratch {
         PlumeScreenBins::List strip, list;
+        std::vector<PlumeScreenBins::List> cellLists{PlumeScreenBins::kTile / kCell};
         std::vector<float> range, depthRows;
     };
     tbb::enumerable_thread_specific<Scratch> scratch;
@@ -232,7 +233,8 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
         tbb::blocked_range<int>(0, cellsY, 1),
         [&](const tbb::blocked_range<int>& r) {
             Scratch& local = scratch.local();
-            PlumeScreenBins::List &strip = local.strip, &list = local.list;
+            PlumeScreenBins::List& strip = local.strip;
+            std::span<PlumeScreenBins::List> cellLists(local.cellLists);
             for (int cy = r.begin(); cy != r.end(); ++cy) {
                 CellRow& row = cellRows[size_t(cy)];
                 row.start.assign(size_t(cellsX) + 1, 0);
@@ -247,11 +249,14 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                     // puffs looked at than in the tiles' whole lists.
                     constexpr int kCellsPerTile = PlumeScreenBins::kTile / kCell;
                     static_assert(PlumeScreenBins::kTile % kCell == 0);
-                    if (cx % kCellsPerTile == 0)
+                    if (cx % kCellsPerTile == 0) {
                         bins.Gather(cx * kCell, cy * kCell, cx * kCell + PlumeScreenBins::kTile + 1,
                                     cy * kCell + kCell + 1, float(kCell), false, strip);
-                    bins.Gather(strip, cx * kCell, cy * kCell, cx * kCell + kCell + 1,
-                                cy * kCell + kCell + 1, float(kCell), false, list);
+                        bins.GatherRow(strip, cx * kCell, cy * kCell, cy * kCell + kCell + 1, kCell,
+                                       kCell + 1, std::min(kCellsPerTile, cellsX - cx),
+                                       float(kCell), cellLists);
+                    }
+                    const PlumeScreenBins::List& list = cellLists[size_t(cx % kCellsPerTile)];
                     row.start[size_t(cx)] = uint32_t(row.index.size());
                     if (list.size() == 0) continue;
                     row.index.insert(row.index.end(), list.index.begin(), list.index.end());
