@@ -236,6 +236,8 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             PlumeScreenBins::List& strip = local.strip;
             std::span<PlumeScreenBins::List> cellLists(local.cellLists);
             for (int cy = r.begin(); cy != r.end(); ++cy) {
+                // The row's counts, kept in registers (the rows' slots share cache lines).
+                uint64_t traces = 0, tests = 0;
                 CellRow& row = cellRows[size_t(cy)];
                 row.start.assign(size_t(cellsX) + 1, 0);
                 row.count.assign(size_t(cellsX), 0);
@@ -272,11 +274,12 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                         nodes[n] = bins.Trace(list, PixelDirection(nx * kCell, ny * kCell),
                                               kPlumeSkyRange_m);
                         nodeT[n] = std::exp(-nodes[n].opticalDepth);
-                        ++rowTraces[size_t(cy)];
-                        rowTests[size_t(cy)] += list.size();
+                        ++traces;
+                        tests += list.size();
                     }
                 }
                 row.start[size_t(cellsX)] = uint32_t(row.index.size());
+                rowTraces[size_t(cy)] = traces, rowTests[size_t(cy)] = tests;
             }
         },
         tbb::simple_partitioner());
@@ -340,6 +343,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             std::vector<float>& depthRows = local.depthRows;
             depthRows.resize(size_t(rowSamples) * size_t(vis.width));
             for (int cy = rows.begin(); cy != rows.end(); ++cy) {
+                uint64_t covered = 0, traces = 0, tests = 0;
                 const CellRow& row = cellRows[size_t(cy)];
                 const int sy0 = cy * rowSamples;
                 ReadDepths(cy, row, depthRows.data());
@@ -410,8 +414,8 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                                 sub[b][a] =
                                     bins.Trace(list, PixelDirection(nx, ny), kPlumeSkyRange_m);
                                 subT[b][a] = std::exp(-sub[b][a].opticalDepth);
-                                ++rowTraces[size_t(cy)];
-                                rowTests[size_t(cy)] += list.size();
+                                ++traces;
+                                tests += list.size();
                             }
                         const bool subFine = list.halfSmallOpticalDepth > kInterpolationTolerance;
                         for (int sb = 0; sb < 2; ++sb)
@@ -425,7 +429,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                     };
                     for (int py = cy * kCell; py < std::min(H, (cy + 1) * kCell); ++py) {
                         for (int px = cx * kCell; px < std::min(W, (cx + 1) * kCell); ++px) {
-                            ++rowCovered[size_t(cy)];
+                            ++covered;
                             // Samples that see the sky first (no direction needed for them).
                             bool allSky = true;
                             float minDepth = std::numeric_limits<float>::infinity();
@@ -486,8 +490,8 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                                     Apply(Bilinear(c, float(ix) / kHalf, float(iy) / kHalf), dir,
                                           px, py, range.data(), rMin, rMax, nullptr);
                                 } else {
-                                    ++rowTraces[size_t(cy)];
-                                    rowTests[size_t(cy)] += list.size();
+                                    ++traces;
+                                    tests += list.size();
                                     Apply(bins.Trace(list, dir, kPlumeSkyRange_m), dir, px, py,
                                           range.data(), rMin, rMax, nullptr);
                                 }
@@ -500,18 +504,20 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                             if (rMax > rMin * kDepthEdgeRatio) {
                                 BandTrace nearTrace, farTrace;
                                 bins.Trace2(list, dir, rMin, rMax, nearTrace, farTrace);
-                                rowTraces[size_t(cy)] += 2;
-                                rowTests[size_t(cy)] += list.size();
+                                traces += 2;
+                                tests += list.size();
                                 Apply(nearTrace, dir, px, py, range.data(), rMin, rMax, &farTrace);
                             } else {
-                                ++rowTraces[size_t(cy)];
-                                rowTests[size_t(cy)] += list.size();
+                                ++traces;
+                                tests += list.size();
                                 Apply(bins.Trace(list, dir, rMin), dir, px, py, range.data(), rMin,
                                       rMax, nullptr);
                             }
                         }
                     }
                 }
+                rowCovered[size_t(cy)] = covered;
+                rowTraces[size_t(cy)] += traces, rowTests[size_t(cy)] += tests;
             }
         },
         tbb::simple_partitioner());
