@@ -1,6 +1,9 @@
 // Screen-space puff bins: per-puff tolerance footprints, tile lists and the per-ray trace.
 #include "channels/plume/plume_bins.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <iterator>
@@ -33,14 +36,23 @@ PlumeScreenBins::PlumeScreenBins(const scene::PlumeField& field, const ChannelCa
     const size_t b = size_t(band);
     const double sqrt2Pi = std::sqrt(2.0 * std::numbers::pi);
     const double halfSqrtPi = 0.5 * std::sqrt(std::numbers::pi);
-    for (size_t i = 0; i < n; ++i) {
+    // Each puff is projected on its own (in parallel, into its own slot), then the kept ones
+    // are compacted in field order, so the bins are the same for any thread count.
+    struct Projected {
+        bool kept = false;
+        Rect rect{};
+        float values[kFields];
+        float far, sigmaPixels, tauMax;
+    };
+    std::vector<Projected> projected(n);
+    const auto Project = [&](size_t i, Projected& out) {
         const scene::ObscurantOptics& optics = field.Optics(puffs.plume[i]);
         const double alpha = optics.massExtinction_m2pkg[b];
         const double sh = 1.0 / std::sqrt(double(puffs.invVarH[i]));
         const double sz = 1.0 / std::sqrt(double(puffs.invVarZ[i]));
         // Line integral through the centre: peak √(2π/A), largest for A = 1/max(σ)².
         const double tauMax = alpha * double(puffs.peak_kgpm3[i]) * sqrt2Pi * std::max(sh, sz);
-        if (!(tauMax > eps)) continue;
+        if (!(tauMax > eps)) return;
         const double r2 = 2.0 * std::log(tauMax / eps);
         const double r = std::sqrt(r2);
         const glm::dvec3 c{puffs.x[i], puffs.y[i], puffs.z[i]};
@@ -62,7 +74,7 @@ PlumeScreenBins::PlumeScreenBins(const scene::PlumeField& field, const ChannelCa
             xMin = std::min(xMin, x), xMax = std::max(xMax, x);
             yMin = std::min(yMin, y), yMax = std::max(yMax, y);
         }
-        if (behind == 8) continue;
+        if (behind == 8) return;
         Rect rect{0, 0, width_, height_};
         if (behind == 0) {
             // The ellipsoid itself projects inside the box's rectangle; when it lies wholly in
@@ -102,7 +114,7 @@ PlumeScreenBins::PlumeScreenBins(const scene::PlumeField& field, const ChannelCa
             rect = {clampX(std::floor(xMin) - 1.0), clampY(std::floor(yMin) - 1.0),
                     clampX(std::ceil(xMax) + 1.0), clampY(std::ceil(yMax) + 1.0)};
         }
-        if (rect.x0 >= rect.x1 || rect.y0 >= rect.y1) continue;
+        if (rect.x0 >= rect.x1 || rect.y0 >= rect.y1) return;
         const double nearest = glm::length(glm::clamp(eye, lo, hi) - eye);
         const glm::dvec3 qc = cameraFromWorld * (c - eye);
         const double sigmaPixels = qc.y > camera.near_m ? std::min(sh, sz) / (qc.y * pixelAngle)
@@ -111,18 +123,38 @@ PlumeScreenBins::PlumeScreenBins(const scene::PlumeField& field, const ChannelCa
         const double omega = optics.albedo[b];
         const double T = puffs.temperature_K[i];
         const double hot = T >= double(scene::kHotPuff_K) ? 1.0 - omega : 0.0;
-        kept_.push_back(uint32_t(i));
-        rect_.push_back(rect);
+        out.kept = true;
+        out.rect = rect;
         const float values[kFields] = {
             float(eye.x - c.x), float(eye.y - c.y), float(eye.z - c.z), puffs.invVarH[i],
             puffs.invVarZ[i], float(r2), float(alpha * double(puffs.peak_kgpm3[i]) * halfSqrtPi),
             // Float margins: a little nearer and farther than the box.
             float(nearest * 0.999), float(omega), float((1.0 - omega) * T), float(hot),
             float(hot * T), float(omega * optics.asymmetry)};
-        for (int f = 0; f < kFields; ++f) data_[f].push_back(values[f]);
-        far_.push_back(float(far * 1.001 + 1.0));
-        sigmaPixels_.push_back(float(sigmaPixels));
-        tauMax_.push_back(float(tauMax));
+        std::copy(std::begin(values), std::end(values), out.values);
+        out.far = float(far * 1.001 + 1.0);
+        out.sigmaPixels = float(sigmaPixels);
+        out.tauMax = float(tauMax);
+    };
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 64),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                          for (size_t i = r.begin(); i != r.end(); ++i) Project(i, projected[i]);
+                      });
+    size_t keptCount = 0;
+    for (const Projected& p : projected) keptCount += p.kept;
+    kept_.reserve(keptCount);
+    rect_.reserve(keptCount);
+    far_.reserve(keptCount), sigmaPixels_.reserve(keptCount), tauMax_.reserve(keptCount);
+    for (int f = 0; f < kFields; ++f) data_[f].reserve(keptCount + 1);
+    for (size_t i = 0; i < n; ++i) {
+        const Projected& p = projected[i];
+        if (!p.kept) continue;
+        kept_.push_back(uint32_t(i));
+        rect_.push_back(p.rect);
+        for (int f = 0; f < kFields; ++f) data_[f].push_back(p.values[f]);
+        far_.push_back(p.far);
+        sigmaPixels_.push_back(p.sigmaPixels);
+        tauMax_.push_back(p.tauMax);
     }
 
     // The inert puff: a unit sphere at the eye with a negative cutoff, beyond every range.
@@ -228,6 +260,34 @@ void PlumeScreenBins::Gather(const List& from, int x0, int y0, int x1, int y1, f
         for (size_t j = 0; j < from.count; ++j)
             Take(from.index[j], x0, y0, x1, y1, smallPixels, out);
     Finish(copy, out);
+}
+
+void PlumeScreenBins::GatherRow(const List& from, int x0, int y0, int y1, int step, int width,
+                                int cells, float smallPixels, std::span<List> out) const {
+    CHECK(step > 0 && width > 0 && cells >= 0 && out.size() >= size_t(cells));
+    for (int c = 0; c < cells; ++c) {
+        CHECK(&from != &out[size_t(c)]);
+        Begin(out[size_t(c)]);
+    }
+    y1 = std::min(y1, height_);
+    // Rectangle c clipped to the bin area as Gather clips it; empty ones get no puffs.
+    const auto Right = [&](int c) { return std::min(x0 + c * step + width, width_); };
+    if (y0 < y1 && cells > 0) {
+        for (size_t j = 0; j < from.count; ++j) {
+            const uint32_t k = from.index[j];
+            const Rect& r = rect_[k];
+            if (r.y1 <= y0 || r.y0 >= y1) continue;
+            // The rectangles c with x0 + c·step < r.x1 and x0 + c·step + width > r.x0, widened
+            // by one on each side (Take decides exactly).
+            const int lo = std::max((r.x0 - x0 - width) / step - 1, 0);
+            const int hi = std::min((r.x1 - x0) / step + 1, cells - 1);
+            for (int c = lo; c <= hi; ++c) {
+                const int cx0 = x0 + c * step, cx1 = Right(c);
+                if (cx0 < cx1) Take(k, cx0, y0, cx1, y1, smallPixels, out[size_t(c)]);
+            }
+        }
+    }
+    for (int c = 0; c < cells; ++c) Finish(false, out[size_t(c)]);
 }
 
 void PlumeScreenBins::Copy(List& list) const {

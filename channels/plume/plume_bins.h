@@ -79,6 +79,12 @@ class PlumeScreenBins {
     // small rectangles share one larger one.
     void Gather(const List& from, int x0, int y0, int x1, int y1, float smallPixels, bool copy,
                 List& out) const;
+    // Gather(from, …) for a row of `cells` rectangles [x0 + c·step, x0 + c·step + width) ×
+    // [y0, y1), c = 0 … cells − 1, into out[c]: the same lists bit for bit, with one pass over
+    // from's puffs (each puff visits only the rectangles its own rectangle can reach) instead
+    // of one pass per rectangle.
+    void GatherRow(const List& from, int x0, int y0, int y1, int step, int width, int cells,
+                   float smallPixels, std::span<List> out) const;
     // Copies a gathered list's data (no-op when copied already).
     void Copy(List& list) const;
     // Tile of pixel (px, py).

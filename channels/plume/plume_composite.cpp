@@ -3,6 +3,7 @@
 #include "channels/plume/plume_composite.h"
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -217,49 +218,71 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
         rowTests(size_t(cellsY), 0);
     // The nodes' transmittances e^(−τ), for the smoothness test of the four cells around each.
     std::vector<float> nodeT(nodes.size(), 1.0f);
-    tbb::parallel_for(tbb::blocked_range<int>(0, cellsY, 1), [&](const tbb::blocked_range<int>& r) {
+    // Scratch space per worker thread, made once per frame rather than once per task (the
+    // results never depend on which thread's scratch a row used: every value is written
+    // before it is read).
+    struct Scratch {
         PlumeScreenBins::List strip, list;
-        for (int cy = r.begin(); cy != r.end(); ++cy) {
-            CellRow& row = cellRows[size_t(cy)];
-            row.start.assign(size_t(cellsX) + 1, 0);
-            row.count.assign(size_t(cellsX), 0);
-            row.near_m.assign(size_t(cellsX), 0.0f);
-            row.far_m.assign(size_t(cellsX), 0.0f);
-            row.smallOpticalDepth.assign(size_t(cellsX), 0.0f);
-            row.halfSmallOpticalDepth.assign(size_t(cellsX), 0.0f);
-            for (int cx = 0; cx < cellsX; ++cx) {
-                // The cells of one tile column take their puffs from the list of the strip of
-                // the tile that the row crosses (a cell reaches one pixel beyond itself): fewer
-                // puffs looked at than in the tiles' whole lists.
-                constexpr int kCellsPerTile = PlumeScreenBins::kTile / kCell;
-                static_assert(PlumeScreenBins::kTile % kCell == 0);
-                if (cx % kCellsPerTile == 0)
-                    bins.Gather(cx * kCell, cy * kCell, cx * kCell + PlumeScreenBins::kTile + 1,
-                                cy * kCell + kCell + 1, float(kCell), false, strip);
-                bins.Gather(strip, cx * kCell, cy * kCell, cx * kCell + kCell + 1,
-                            cy * kCell + kCell + 1, float(kCell), false, list);
-                row.start[size_t(cx)] = uint32_t(row.index.size());
-                if (list.size() == 0) continue;
-                row.index.insert(row.index.end(), list.index.begin(), list.index.end());
-                row.count[size_t(cx)] = uint32_t(list.count);
-                row.near_m[size_t(cx)] = list.near_m;
-                row.far_m[size_t(cx)] = list.far_m;
-                row.smallOpticalDepth[size_t(cx)] = list.smallOpticalDepth;
-                row.halfSmallOpticalDepth[size_t(cx)] = list.halfSmallOpticalDepth;
-                for (int k = 0; k < 4; ++k) {
-                    const int nx = cx + k % 2, ny = cy + k / 2;
-                    if ((nx > cx && nx < cellsX) || (ny > cy && ny < cellsY)) continue;
-                    const size_t n = size_t(ny) * size_t(nodesX) + size_t(nx);
-                    nodes[n] =
-                        bins.Trace(list, PixelDirection(nx * kCell, ny * kCell), kPlumeSkyRange_m);
-                    nodeT[n] = std::exp(-nodes[n].opticalDepth);
-                    ++rowTraces[size_t(cy)];
-                    rowTests[size_t(cy)] += list.size();
+        std::vector<PlumeScreenBins::List> cellLists{PlumeScreenBins::kTile / kCell};
+        std::vector<float> range, depthRows;
+    };
+    tbb::enumerable_thread_specific<Scratch> scratch;
+    // One task per row of cells (simple_partitioner): the rows' costs differ by orders of
+    // magnitude (most have no plume), so coarser chunks leave one thread idle at the end.
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, cellsY, 1),
+        [&](const tbb::blocked_range<int>& r) {
+            Scratch& local = scratch.local();
+            PlumeScreenBins::List& strip = local.strip;
+            std::span<PlumeScreenBins::List> cellLists(local.cellLists);
+            for (int cy = r.begin(); cy != r.end(); ++cy) {
+                // The row's counts, kept in registers (the rows' slots share cache lines).
+                uint64_t traces = 0, tests = 0;
+                CellRow& row = cellRows[size_t(cy)];
+                row.start.assign(size_t(cellsX) + 1, 0);
+                row.count.assign(size_t(cellsX), 0);
+                row.near_m.assign(size_t(cellsX), 0.0f);
+                row.far_m.assign(size_t(cellsX), 0.0f);
+                row.smallOpticalDepth.assign(size_t(cellsX), 0.0f);
+                row.halfSmallOpticalDepth.assign(size_t(cellsX), 0.0f);
+                for (int cx = 0; cx < cellsX; ++cx) {
+                    // The cells of one tile column take their puffs from the list of the strip of
+                    // the tile that the row crosses (a cell reaches one pixel beyond itself): fewer
+                    // puffs looked at than in the tiles' whole lists.
+                    constexpr int kCellsPerTile = PlumeScreenBins::kTile / kCell;
+                    static_assert(PlumeScreenBins::kTile % kCell == 0);
+                    if (cx % kCellsPerTile == 0) {
+                        bins.Gather(cx * kCell, cy * kCell, cx * kCell + PlumeScreenBins::kTile + 1,
+                                    cy * kCell + kCell + 1, float(kCell), false, strip);
+                        bins.GatherRow(strip, cx * kCell, cy * kCell, cy * kCell + kCell + 1, kCell,
+                                       kCell + 1, std::min(kCellsPerTile, cellsX - cx),
+                                       float(kCell), cellLists);
+                    }
+                    const PlumeScreenBins::List& list = cellLists[size_t(cx % kCellsPerTile)];
+                    row.start[size_t(cx)] = uint32_t(row.index.size());
+                    if (list.size() == 0) continue;
+                    row.index.insert(row.index.end(), list.index.begin(), list.index.end());
+                    row.count[size_t(cx)] = uint32_t(list.count);
+                    row.near_m[size_t(cx)] = list.near_m;
+                    row.far_m[size_t(cx)] = list.far_m;
+                    row.smallOpticalDepth[size_t(cx)] = list.smallOpticalDepth;
+                    row.halfSmallOpticalDepth[size_t(cx)] = list.halfSmallOpticalDepth;
+                    for (int k = 0; k < 4; ++k) {
+                        const int nx = cx + k % 2, ny = cy + k / 2;
+                        if ((nx > cx && nx < cellsX) || (ny > cy && ny < cellsY)) continue;
+                        const size_t n = size_t(ny) * size_t(nodesX) + size_t(nx);
+                        nodes[n] = bins.Trace(list, PixelDirection(nx * kCell, ny * kCell),
+                                              kPlumeSkyRange_m);
+                        nodeT[n] = std::exp(-nodes[n].opticalDepth);
+                        ++traces;
+                        tests += list.size();
+                    }
                 }
+                row.start[size_t(cellsX)] = uint32_t(row.index.size());
+                rowTraces[size_t(cy)] = traces, rowTests[size_t(cy)] = tests;
             }
-            row.start[size_t(cellsX)] = uint32_t(row.index.size());
-        }
-    });
+        },
+        tbb::simple_partitioner());
 
     // Whether the sky traces at the four corners of a cell (00, 10, 01, 11) may be blended:
     // their transmittances agree within kInterpolationTolerance, their temperatures (of the
@@ -309,160 +332,195 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
 
     // Pass 2, cells in parallel (a row of cells each); each pixel depends only on its own rays
     // and the cell's corner nodes.
-    tbb::parallel_for(tbb::blocked_range<int>(0, cellsY, 1), [&](const tbb::blocked_range<int>&
-                                                                     rows) {
-        std::vector<float> range(samples);
-        PlumeScreenBins::List list;
-        const int rowSamples = kCell * N;
-        std::vector<float> depthRows(size_t(rowSamples) * size_t(vis.width));
-        for (int cy = rows.begin(); cy != rows.end(); ++cy) {
-            const CellRow& row = cellRows[size_t(cy)];
-            const int sy0 = cy * rowSamples;
-            ReadDepths(cy, row, depthRows.data());
-            const auto DepthAt = [&](int sx, int sy) {
-                return depthRows[size_t(sy - sy0) * size_t(vis.width) + size_t(sx)];
-            };
-            for (int cx = 0; cx < cellsX; ++cx) {
-                if (row.count[size_t(cx)] == 0) continue;
-                list.count = row.count[size_t(cx)];
-                list.index.assign(row.index.begin() + row.start[size_t(cx)],
-                                  row.index.begin() + row.start[size_t(cx) + 1]);
-                list.near_m = row.near_m[size_t(cx)];
-                list.far_m = row.far_m[size_t(cx)];
-                list.smallOpticalDepth = row.smallOpticalDepth[size_t(cx)];
-                list.halfSmallOpticalDepth = row.halfSmallOpticalDepth[size_t(cx)];
-                list.copied = false;
-                // The ranges where the cell's puffs can matter.
-                const float dNear = list.near_m, dFar = list.far_m;
-                const BandTrace* corner[4];
-                float cornerT[4];
-                for (int k = 0; k < 4; ++k) {
-                    const size_t n = size_t(cy + k / 2) * size_t(nodesX) + size_t(cx + k % 2);
-                    corner[k] = &nodes[n];
-                    cornerT[k] = nodeT[n];
-                }
-                bool clearSky = false;
-                const bool smooth = Smooth(
-                    corner, cornerT, list.smallOpticalDepth > kInterpolationTolerance, clearSky);
-                // Where the cell is not smooth, its sky pixels are refined on 2 × 2-pixel
-                // sub-cells: sky traces at the 3 × 3 nodes every 2 pixels (made when
-                // the first sky pixel needs them), the same criteria with the puffs
-                // smaller than a sub-cell, and the pixels of a sub-cell that is not smooth
-                // traced one by one (the nodes' pixels take their node's trace).
-                bool refined = false;
-                BandTrace sub[3][3];
-                float subT[3][3];
-                bool subSmooth[2][2], subClear[2][2];
-                const auto Refine = [&] {
-                    refined = true;
-                    bins.Copy(list);
-                    for (int b = 0; b < 3; ++b)
-                        for (int a = 0; a < 3; ++a) {
-                            if (a % 2 == 0 && b % 2 == 0) {
-                                sub[b][a] = *corner[(b / 2) * 2 + a / 2];
-                                subT[b][a] = cornerT[(b / 2) * 2 + a / 2];
-                                continue;
-                            }
-                            const int nx = cx * kCell + a * (kCell / 2),
-                                      ny = cy * kCell + b * (kCell / 2);
-                            sub[b][a] = bins.Trace(list, PixelDirection(nx, ny), kPlumeSkyRange_m);
-                            subT[b][a] = std::exp(-sub[b][a].opticalDepth);
-                            ++rowTraces[size_t(cy)];
-                            rowTests[size_t(cy)] += list.size();
-                        }
-                    const bool subFine = list.halfSmallOpticalDepth > kInterpolationTolerance;
-                    for (int sb = 0; sb < 2; ++sb)
-                        for (int sa = 0; sa < 2; ++sa) {
-                            const BandTrace* c[4] = {&sub[sb][sa], &sub[sb][sa + 1],
-                                                     &sub[sb + 1][sa], &sub[sb + 1][sa + 1]};
-                            const float cT[4] = {subT[sb][sa], subT[sb][sa + 1], subT[sb + 1][sa],
-                                                 subT[sb + 1][sa + 1]};
-                            subSmooth[sb][sa] = Smooth(c, cT, subFine, subClear[sb][sa]);
-                        }
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, cellsY, 1),
+        [&](const tbb::blocked_range<int>& rows) {
+            Scratch& local = scratch.local();
+            std::vector<float>& range = local.range;
+            range.resize(samples);
+            PlumeScreenBins::List& list = local.list;
+            const int rowSamples = kCell * N;
+            std::vector<float>& depthRows = local.depthRows;
+            depthRows.resize(size_t(rowSamples) * size_t(vis.width));
+            for (int cy = rows.begin(); cy != rows.end(); ++cy) {
+                uint64_t covered = 0, traces = 0, tests = 0;
+                const CellRow& row = cellRows[size_t(cy)];
+                const int sy0 = cy * rowSamples;
+                ReadDepths(cy, row, depthRows.data());
+                const auto DepthAt = [&](int sx, int sy) {
+                    return depthRows[size_t(sy - sy0) * size_t(vis.width) + size_t(sx)];
                 };
-                for (int py = cy * kCell; py < std::min(H, (cy + 1) * kCell); ++py) {
-                    for (int px = cx * kCell; px < std::min(W, (cx + 1) * kCell); ++px) {
-                        ++rowCovered[size_t(cy)];
-                        // Samples that see the sky first (no direction needed for them).
-                        bool allSky = true;
-                        for (int j = 0; j < N; ++j)
-                            for (int i = 0; i < N; ++i) {
-                                const bool sky = DepthAt(px * N + i, py * N + j) < 0.0f;
-                                range[size_t(j * N + i)] = sky ? kPlumeSkyRange_m : -1.0f;
-                                allSky &= sky;
-                            }
-                        if (allSky && clearSky) continue;
-                        const glm::vec3 dir = PixelDirection(px, py);
-                        float rMin = kPlumeSkyRange_m, rMax = 0.0f;
-                        if (allSky) {
-                            rMax = kPlumeSkyRange_m;
-                        } else {
-                            // depth = near / w, w the distance along the optical axis.
-                            const float rangeScale =
-                                nearM / std::max(glm::dot(dir, forward), 1e-6f);
-                            for (int j = 0; j < N; ++j)
-                                for (int i = 0; i < N; ++i) {
-                                    float& r = range[size_t(j * N + i)];
-                                    if (r < 0.0f)
-                                        r = std::min(rangeScale / DepthAt(px * N + i, py * N + j),
-                                                     kPlumeSkyRange_m);
-                                    rMin = std::min(rMin, r), rMax = std::max(rMax, r);
+                for (int cx = 0; cx < cellsX; ++cx) {
+                    if (row.count[size_t(cx)] == 0) continue;
+                    list.count = row.count[size_t(cx)];
+                    list.index.assign(row.index.begin() + row.start[size_t(cx)],
+                                      row.index.begin() + row.start[size_t(cx) + 1]);
+                    list.near_m = row.near_m[size_t(cx)];
+                    list.far_m = row.far_m[size_t(cx)];
+                    list.smallOpticalDepth = row.smallOpticalDepth[size_t(cx)];
+                    list.halfSmallOpticalDepth = row.halfSmallOpticalDepth[size_t(cx)];
+                    list.copied = false;
+                    // The ranges where the cell's puffs can matter.
+                    const float dNear = list.near_m, dFar = list.far_m;
+                    const BandTrace* corner[4];
+                    float cornerT[4];
+                    for (int k = 0; k < 4; ++k) {
+                        const size_t n = size_t(cy + k / 2) * size_t(nodesX) + size_t(cx + k % 2);
+                        corner[k] = &nodes[n];
+                        cornerT[k] = nodeT[n];
+                    }
+                    // A depth beyond which a sample's surface is nearer than dNear anywhere in
+                    // the cell, so that its pixel is skipped without its direction: range
+                    // r = near / (cos θ · depth), θ the angle from the optical axis, and
+                    // cos θ = 1 / |(a, 1, b)| ≥ cosMin over the cell's pixels, so depth ≥
+                    // near / (cosMin · dNear) gives r ≤ dNear. The 1e-4 margin covers the
+                    // float rounding of the per-pixel range (a few ulp), so a pixel skipped
+                    // here is one the test rMax ≤ dNear below skips: the image is unchanged.
+                    float depthInFront = std::numeric_limits<float>::infinity();
+                    if (dNear > 0.0f) {
+                        double a2 = 0.0, b2 = 0.0;
+                        for (int px = cx * kCell; px < std::min(W, (cx + 1) * kCell); ++px)
+                            a2 = std::max(a2, double(colA[size_t(px)]) * colA[size_t(px)]);
+                        for (int py = cy * kCell; py < std::min(H, (cy + 1) * kCell); ++py)
+                            b2 = std::max(b2, double(rowB[size_t(py)]) * rowB[size_t(py)]);
+                        const double cosMin = 1.0 / std::sqrt(1.0 + a2 + b2);
+                        depthInFront = float(double(nearM) / (cosMin * double(dNear)) * 1.0001);
+                    }
+                    bool clearSky = false;
+                    const bool smooth =
+                        Smooth(corner, cornerT, list.smallOpticalDepth > kInterpolationTolerance,
+                               clearSky);
+                    // Where the cell is not smooth, its sky pixels are refined on 2 × 2-pixel
+                    // sub-cells: sky traces at the 3 × 3 nodes every 2 pixels (made when
+                    // the first sky pixel needs them), the same criteria with the puffs
+                    // smaller than a sub-cell, and the pixels of a sub-cell that is not smooth
+                    // traced one by one (the nodes' pixels take their node's trace).
+                    bool refined = false;
+                    BandTrace sub[3][3];
+                    float subT[3][3];
+                    bool subSmooth[2][2], subClear[2][2];
+                    const auto Refine = [&] {
+                        refined = true;
+                        bins.Copy(list);
+                        for (int b = 0; b < 3; ++b)
+                            for (int a = 0; a < 3; ++a) {
+                                if (a % 2 == 0 && b % 2 == 0) {
+                                    sub[b][a] = *corner[(b / 2) * 2 + a / 2];
+                                    subT[b][a] = cornerT[(b / 2) * 2 + a / 2];
+                                    continue;
                                 }
-                        }
-                        // Every surface in front of the plumes: nothing to add.
-                        if (rMax <= dNear) continue;
-                        if (rMin >= dFar) {
-                            // Every surface behind the plumes: the sky trace is the trace.
-                            if (clearSky) continue;
-                            if (smooth) {
-                                const float fx = float(px - cx * kCell) / kCell;
-                                const float fy = float(py - cy * kCell) / kCell;
-                                Apply(Bilinear(corner, fx, fy), dir, px, py, range.data(), rMin,
-                                      rMax, nullptr);
-                                continue;
+                                const int nx = cx * kCell + a * (kCell / 2),
+                                          ny = cy * kCell + b * (kCell / 2);
+                                sub[b][a] =
+                                    bins.Trace(list, PixelDirection(nx, ny), kPlumeSkyRange_m);
+                                subT[b][a] = std::exp(-sub[b][a].opticalDepth);
+                                ++traces;
+                                tests += list.size();
                             }
-                            if (!refined) Refine();
-                            const int lx = px - cx * kCell, ly = py - cy * kCell;
-                            constexpr int kHalf = kCell / 2;
-                            const int sa = lx / kHalf, sb = ly / kHalf;
-                            const int ix = lx - sa * kHalf, iy = ly - sb * kHalf;
-                            if (ix == 0 && iy == 0) {
-                                Apply(sub[sb][sa], dir, px, py, range.data(), rMin, rMax, nullptr);
-                            } else if (subSmooth[sb][sa]) {
-                                if (subClear[sb][sa]) continue;
+                        const bool subFine = list.halfSmallOpticalDepth > kInterpolationTolerance;
+                        for (int sb = 0; sb < 2; ++sb)
+                            for (int sa = 0; sa < 2; ++sa) {
                                 const BandTrace* c[4] = {&sub[sb][sa], &sub[sb][sa + 1],
                                                          &sub[sb + 1][sa], &sub[sb + 1][sa + 1]};
-                                Apply(Bilinear(c, float(ix) / kHalf, float(iy) / kHalf), dir, px,
-                                      py, range.data(), rMin, rMax, nullptr);
-                            } else {
-                                ++rowTraces[size_t(cy)];
-                                rowTests[size_t(cy)] += list.size();
-                                Apply(bins.Trace(list, dir, kPlumeSkyRange_m), dir, px, py,
-                                      range.data(), rMin, rMax, nullptr);
+                                const float cT[4] = {subT[sb][sa], subT[sb][sa + 1],
+                                                     subT[sb + 1][sa], subT[sb + 1][sa + 1]};
+                                subSmooth[sb][sa] = Smooth(c, cT, subFine, subClear[sb][sa]);
                             }
-                            continue;
-                        }
-                        // One ray to the nearest surface and, at a depth edge, one to the
-                        // farthest (the far samples see what lies beyond the near surface),
-                        // in one pass over the puffs.
-                        bins.Copy(list);
-                        if (rMax > rMin * kDepthEdgeRatio) {
-                            BandTrace nearTrace, farTrace;
-                            bins.Trace2(list, dir, rMin, rMax, nearTrace, farTrace);
-                            rowTraces[size_t(cy)] += 2;
-                            rowTests[size_t(cy)] += list.size();
-                            Apply(nearTrace, dir, px, py, range.data(), rMin, rMax, &farTrace);
-                        } else {
-                            ++rowTraces[size_t(cy)];
-                            rowTests[size_t(cy)] += list.size();
-                            Apply(bins.Trace(list, dir, rMin), dir, px, py, range.data(), rMin,
-                                  rMax, nullptr);
+                    };
+                    for (int py = cy * kCell; py < std::min(H, (cy + 1) * kCell); ++py) {
+                        for (int px = cx * kCell; px < std::min(W, (cx + 1) * kCell); ++px) {
+                            ++covered;
+                            // Samples that see the sky first (no direction needed for them).
+                            bool allSky = true;
+                            float minDepth = std::numeric_limits<float>::infinity();
+                            for (int j = 0; j < N; ++j)
+                                for (int i = 0; i < N; ++i) {
+                                    const float d = DepthAt(px * N + i, py * N + j);
+                                    const bool sky = d < 0.0f;
+                                    range[size_t(j * N + i)] = sky ? kPlumeSkyRange_m : -1.0f;
+                                    allSky &= sky;
+                                    minDepth = std::min(minDepth, d);
+                                }
+                            // Every surface surely in front of the plumes (skipped below too).
+                            if (minDepth >= depthInFront) continue;
+                            if (allSky && clearSky) continue;
+                            const glm::vec3 dir = PixelDirection(px, py);
+                            float rMin = kPlumeSkyRange_m, rMax = 0.0f;
+                            if (allSky) {
+                                rMax = kPlumeSkyRange_m;
+                            } else {
+                                // depth = near / w, w the distance along the optical axis.
+                                const float rangeScale =
+                                    nearM / std::max(glm::dot(dir, forward), 1e-6f);
+                                for (int j = 0; j < N; ++j)
+                                    for (int i = 0; i < N; ++i) {
+                                        float& r = range[size_t(j * N + i)];
+                                        if (r < 0.0f)
+                                            r = std::min(
+                                                rangeScale / DepthAt(px * N + i, py * N + j),
+                                                kPlumeSkyRange_m);
+                                        rMin = std::min(rMin, r), rMax = std::max(rMax, r);
+                                    }
+                            }
+                            // Every surface in front of the plumes: nothing to add.
+                            if (rMax <= dNear) continue;
+                            if (rMin >= dFar) {
+                                // Every surface behind the plumes: the sky trace is the trace.
+                                if (clearSky) continue;
+                                if (smooth) {
+                                    const float fx = float(px - cx * kCell) / kCell;
+                                    const float fy = float(py - cy * kCell) / kCell;
+                                    Apply(Bilinear(corner, fx, fy), dir, px, py, range.data(), rMin,
+                                          rMax, nullptr);
+                                    continue;
+                                }
+                                if (!refined) Refine();
+                                const int lx = px - cx * kCell, ly = py - cy * kCell;
+                                constexpr int kHalf = kCell / 2;
+                                const int sa = lx / kHalf, sb = ly / kHalf;
+                                const int ix = lx - sa * kHalf, iy = ly - sb * kHalf;
+                                if (ix == 0 && iy == 0) {
+                                    Apply(sub[sb][sa], dir, px, py, range.data(), rMin, rMax,
+                                          nullptr);
+                                } else if (subSmooth[sb][sa]) {
+                                    if (subClear[sb][sa]) continue;
+                                    const BandTrace* c[4] = {&sub[sb][sa], &sub[sb][sa + 1],
+                                                             &sub[sb + 1][sa],
+                                                             &sub[sb + 1][sa + 1]};
+                                    Apply(Bilinear(c, float(ix) / kHalf, float(iy) / kHalf), dir,
+                                          px, py, range.data(), rMin, rMax, nullptr);
+                                } else {
+                                    ++traces;
+                                    tests += list.size();
+                                    Apply(bins.Trace(list, dir, kPlumeSkyRange_m), dir, px, py,
+                                          range.data(), rMin, rMax, nullptr);
+                                }
+                                continue;
+                            }
+                            // One ray to the nearest surface and, at a depth edge, one to the
+                            // farthest (the far samples see what lies beyond the near surface),
+                            // in one pass over the puffs.
+                            bins.Copy(list);
+                            if (rMax > rMin * kDepthEdgeRatio) {
+                                BandTrace nearTrace, farTrace;
+                                bins.Trace2(list, dir, rMin, rMax, nearTrace, farTrace);
+                                traces += 2;
+                                tests += list.size();
+                                Apply(nearTrace, dir, px, py, range.data(), rMin, rMax, &farTrace);
+                            } else {
+                                ++traces;
+                                tests += list.size();
+                                Apply(bins.Trace(list, dir, rMin), dir, px, py, range.data(), rMin,
+                                      rMax, nullptr);
+                            }
                         }
                     }
                 }
+                rowCovered[size_t(cy)] = covered;
+                rowTraces[size_t(cy)] += traces, rowTests[size_t(cy)] += tests;
             }
-        }
-    });
+        },
+        tbb::simple_partitioner());
     for (int y = 0; y < cellsY; ++y) {
         stats.pixelsCovered += rowCovered[size_t(y)];
         stats.traces += rowTraces[size_t(y)];

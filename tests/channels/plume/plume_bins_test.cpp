@@ -1,12 +1,14 @@
 // Tests of the screen-space puff bins: traces within the stated transmittance tolerance of the
 // exact sum over every puff (no cutoff, double-precision erf) for committed plumes and for a
-// thick flame puff, lists taken from larger lists equal to lists from the tiles, eight-lane
-// traces equal to four-lane ones, and the dropping of puffs too thin to matter.
+// thick flame puff, lists taken from larger lists (one rectangle or a row of them) equal to
+// lists from the tiles, eight-lane traces equal to four-lane ones, and the dropping of puffs
+// too thin to matter.
 #include "channels/plume/plume_bins.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <numbers>
@@ -146,6 +148,44 @@ TEST(PlumeScreenBins, GatherFromALargerListEqualsGatherFromTheTiles) {
         }
     }
     EXPECT_GT(nonEmpty, 100u);
+}
+
+// A row of rectangles gathered in one pass (GatherRow) gets the lists that Gather makes for
+// each rectangle on its own: the same puffs in the same order, ranges and small-puff sums bit
+// for bit, for CompositePlumes' 4 × 4 cells (step 4, width 5) and for other steps and widths,
+// the rows running past the bin area's right and bottom edges.
+TEST(PlumeScreenBins, GatherRowEqualsGatherPerRectangle) {
+    const scene::PlumeField field = CommittedPlumes();
+    const ChannelCamera cam = NorthCamera({0.0, 0.0, 20.0}, 200, 150, 40.0, 3.0);
+    const PlumeScreenBins bins(field, cam, ObscurantBand::Visible);
+    PlumeScreenBins::List strip, single;
+    std::vector<PlumeScreenBins::List> row(12);
+    size_t nonEmpty = 0, compared = 0;
+    for (const auto [step, width, cells] : {std::array{4, 5, 8}, {3, 7, 11}, {5, 2, 7}}) {
+        const int stripWidth = (cells - 1) * step + width;
+        for (int y0 = 0; y0 < cam.height + PlumeScreenBins::kMargin; y0 += 4) {
+            for (int x0 = 0; x0 < cam.width + PlumeScreenBins::kMargin; x0 += stripWidth) {
+                bins.Gather(x0, y0, x0 + stripWidth, y0 + 5, 4.0f, false, strip);
+                bins.GatherRow(strip, x0, y0, y0 + 5, step, width, cells, 4.0f, row);
+                for (int c = 0; c < cells; ++c) {
+                    const int x = x0 + c * step;
+                    bins.Gather(x, y0, x + width, y0 + 5, 4.0f, false, single);
+                    const PlumeScreenBins::List& l = row[size_t(c)];
+                    ASSERT_EQ(l.count, single.count) << x << ", " << y0;
+                    EXPECT_EQ(l.index, single.index);
+                    EXPECT_EQ(std::memcmp(&l.near_m, &single.near_m, 4), 0);
+                    EXPECT_EQ(std::memcmp(&l.far_m, &single.far_m, 4), 0);
+                    EXPECT_EQ(std::memcmp(&l.smallOpticalDepth, &single.smallOpticalDepth, 4), 0);
+                    EXPECT_EQ(
+                        std::memcmp(&l.halfSmallOpticalDepth, &single.halfSmallOpticalDepth, 4), 0);
+                    nonEmpty += single.count > 0;
+                    ++compared;
+                }
+            }
+        }
+    }
+    EXPECT_GT(nonEmpty, 300u);
+    EXPECT_GT(nonEmpty * 10, compared);  // the plumes fill a good part of the view
 }
 
 // Eight puffs at a time (AVX2) or four (SSE2): the same traces bit for bit, gathered and
