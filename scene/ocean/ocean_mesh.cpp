@@ -157,8 +157,10 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
                 out.surfFoam[v] = 0.0f;  // dry sand, never wet: no foam
             } else {
                 // Each part of the deep sea with its depth weight, then the surf components.
+                // The foam reads the dominant component only where the water has broken.
                 SurfPointInfo info;
-                const SurfaceTerms st = frame.Surf()->Terms(x0, y0, frame.Time_s(), &info);
+                const SurfaceTerms st = frame.Surf()->Terms(x0, y0, frame.Time_s(), &info,
+                                                            SurfWaves::Dominant::kWhereBroken);
                 frame.AccumulateFft(x0, y0, filter, s, info.weights.cascade.data());
                 const double wg = info.weights.gerstner;
                 if (gerstner && wg == 1.0) {

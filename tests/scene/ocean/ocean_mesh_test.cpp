@@ -9,6 +9,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <numbers>
@@ -16,6 +17,7 @@
 #include <vector>
 
 #include "scene/scenario/scenario_loader.h"
+#include "scene/surf/foam.h"
 
 namespace seasense::scene {
 namespace {
@@ -260,6 +262,56 @@ TEST(OceanMesh, DryLandShortcutIsTheFullEvaluationBitForBit) {
     EXPECT_GT(dry, 1000);
     EXPECT_GT(wet, 1000);
     EXPECT_GT(clampedWet, 10);  // the swash zone's own clamp stays on the full path
+}
+
+TEST(OceanMesh, SurfDominantOnlyWhereBrokenChangesNothingTheMeshUses) {
+    // The mesh asks SurfWaves::Terms for the dominant component only where the water has broken
+    // (Dominant::kWhereBroken). Against the full description (kEverywhere), across the barred
+    // beach of configs/surf.yaml from beyond the fade to the dry sand at three times: the terms
+    // and everything else in the point's information are the same bits, the dominant component
+    // is the same where broken, and the surf foam coverage is the same everywhere.
+    const Scenario sc =
+        LoadScenario(std::filesystem::path(SEASENSE_SOURCE_DIR) / "configs/surf.yaml");
+    const OceanSurface sea(sc.environment.ocean);
+    const SurfWaves& w = *sea.Surf();
+    const FoamSettings& foamSettings = w.Bathy().Settings().foam;
+    const auto same = [](double a, double b) {
+        return std::bit_cast<uint64_t>(a) == std::bit_cast<uint64_t>(b);
+    };
+    int broken = 0, unbroken = 0, foamy = 0;
+    for (const double t : {3.0, 17.5, 41.0}) {
+        for (double x = -40.0; x < 700.0; x += 0.83) {
+            for (const double y : {-130.0, 3.0, 71.0, 160.0}) {
+                SurfPointInfo all, lazy;
+                const SurfaceTerms a = w.Terms(x, y, t, &all, SurfWaves::Dominant::kEverywhere);
+                const SurfaceTerms b = w.Terms(x, y, t, &lazy, SurfWaves::Dominant::kWhereBroken);
+                ASSERT_EQ(std::memcmp(&a, &b, sizeof(a)), 0) << x << " " << y << " " << t;
+                ASSERT_TRUE(
+                    same(all.depth_m, lazy.depth_m) && same(all.envelope_m, lazy.envelope_m) &&
+                    same(all.unbrokenHeight_m, lazy.unbrokenHeight_m) &&
+                    same(all.breaking.intensity, lazy.breaking.intensity) &&
+                    all.breaking.broken == lazy.breaking.broken &&
+                    same(all.breaking.timeSinceBreaking_s, lazy.breaking.timeSinceBreaking_s) &&
+                    all.weights.cascade == lazy.weights.cascade &&
+                    same(all.surfWeight, lazy.surfWeight));
+                if (all.breaking.broken) {
+                    ++broken;
+                    ASSERT_TRUE(same(all.direction_rad, lazy.direction_rad) &&
+                                same(all.groupSpeed_mps, lazy.groupSpeed_mps) &&
+                                same(all.phaseSpeed_mps, lazy.phaseSpeed_mps) &&
+                                same(all.phase_rad, lazy.phase_rad));
+                } else {
+                    ++unbroken;
+                }
+                const double fa = SurfFoamCoverage(all, x, y, t, foamSettings);
+                ASSERT_TRUE(same(fa, SurfFoamCoverage(lazy, x, y, t, foamSettings)));
+                if (fa > 0.0) ++foamy;
+            }
+        }
+    }
+    EXPECT_GT(broken, 1000);
+    EXPECT_GT(unbroken, 1000);
+    EXPECT_GT(foamy, 500);
 }
 
 TEST(OceanMesh, SurfMeshAndFrameBitIdenticalForAnyThreadCount) {
