@@ -182,7 +182,8 @@ void OceanSurfaceFrame::AddSurf(double x0, double y0, const SurfaceTerms& s,
     }
 }
 
-bool OceanSurfaceFrame::DryLandSums(double x0, double y0, GeometrySums& sums) const {
+bool OceanSurfaceFrame::DryLandSums(double x0, double y0, GeometrySums& sums,
+                                    double* seabedZ_m) const {
     CHECK(surf_);
     const Bathymetry& bathy = surf_->Bathy();
     // At depth ≤ 0 every part of the deep sea has faded out (fade weights 0 below half their
@@ -190,8 +191,15 @@ bool OceanSurfaceFrame::DryLandSums(double x0, double y0, GeometrySums& sums) co
     // no horizontal displacement, ζ ≤ Swash().max_m. Above that (1 mm more for float rounding)
     // the seabed clamp always applies at the rest position itself.
     constexpr double kRoundingMargin_m = 1e-3;
-    const double zBed = bathy.SeabedZ_m(x0, y0);
-    if (!(zBed > bathy.Tide_m() + surf_->Swash().max_m + kRoundingMargin_m)) return false;
+    // The seabed as SurfWaves::Terms finds it (through the shore frame: the same bits as
+    // SeabedZ_m but on a depth grid, where the two differ by the round trip's rounding, far
+    // below the margin).
+    const ShorePoint p = bathy.Frame().ShoreFromWorld(x0, y0);
+    const double zBed = bathy.SeabedZAtShore_m(p.s_m, p.u_m);
+    if (!(zBed > bathy.Tide_m() + surf_->Swash().max_m + kRoundingMargin_m)) {
+        if (seabedZ_m) *seabedZ_m = zBed;
+        return false;
+    }
     const glm::dvec3 bed = SeabedWithSlope(bathy, x0, y0);
     sums = GeometrySums{};
     sums[kTermHeight] = float(bed.x);

@@ -449,10 +449,18 @@ SurfWaves::Bound SurfWaves::BoundAtDepths(double minDepth_m, const std::vector<B
 }
 
 SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* info,
-                              Dominant dominant) const {
+                              const TermsOptions& options) const {
+    return options.velocity ? TermsImpl<true>(x0, y0, t, info, options)
+                            : TermsImpl<false>(x0, y0, t, info, options);
+}
+
+template <bool kVelocity>
+SurfaceTerms SurfWaves::TermsImpl(double x0, double y0, double t, SurfPointInfo* info,
+                                  const TermsOptions& options) const {
     SurfaceTerms out;
     const ShorePoint p = bathy_.Frame().ShoreFromWorld(x0, y0);
-    const double zBed = bathy_.SeabedZAtShore_m(p.s_m, p.u_m);
+    const double zBed =
+        std::isnan(options.seabedZ_m) ? bathy_.SeabedZAtShore_m(p.s_m, p.u_m) : options.seabedZ_m;
     const double h = bathy_.Tide_m() - zBed;
     const SurfWeights weights = Weights(h);
     SurfPointInfo local;
@@ -544,7 +552,7 @@ SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* inf
     };
     F4 re = zero, im = zero, slopeS = zero, slopeU = zero, orbit = zero, longest = zero;
     F4 dispS = zero, dispU = zero, tSS = zero, tUU = zero, tSU = zero;
-    F4 velS = zero, velU = zero, velZ = zero;
+    [[maybe_unused]] F4 velS = zero, velU = zero, velZ = zero;
     alignas(16) std::array<float, kMaxSurfComponents> amplitudes;
     for (size_t m = 0; m < lanes; m += 4) {
         F4 sn, cs;
@@ -562,7 +570,7 @@ SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* inf
         im = _mm_add_ps(im, asn);
         slopeS = _mm_sub_ps(slopeS, _mm_mul_ps(asn, kx));
         slopeU = _mm_sub_ps(slopeU, _mm_mul_ps(asn, ku));
-        velZ = _mm_add_ps(velZ, _mm_mul_ps(asn, omega));
+        if constexpr (kVelocity) velZ = _mm_add_ps(velZ, _mm_mul_ps(asn, omega));
         // The orbit a / tanh kh along the unit direction of travel (k_s, k_u) / k.
         const F4 hor = _mm_mul_ps(a, invTanh);
         orbit = _mm_add_ps(orbit, hor);
@@ -576,9 +584,11 @@ SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* inf
         tSS = _mm_sub_ps(tSS, _mm_mul_ps(hcS, kx));
         tUU = _mm_sub_ps(tUU, _mm_mul_ps(_mm_mul_ps(hc, eU), ku));
         tSU = _mm_sub_ps(tSU, _mm_mul_ps(hcS, ku));
-        const F4 hcw = _mm_mul_ps(hc, omega);
-        velS = _mm_add_ps(velS, _mm_mul_ps(eS, hcw));
-        velU = _mm_add_ps(velU, _mm_mul_ps(eU, hcw));
+        if constexpr (kVelocity) {
+            const F4 hcw = _mm_mul_ps(hc, omega);
+            velS = _mm_add_ps(velS, _mm_mul_ps(eS, hcw));
+            velU = _mm_add_ps(velU, _mm_mul_ps(eU, hcw));
+        }
     }
     // (lane 0 + lane 2) + (lane 1 + lane 3), in double.
     const auto sum = [](F4 v) {
@@ -602,10 +612,9 @@ SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* inf
     const glm::dvec2 slope = cap * (sum(slopeS) * es + sum(slopeU) * eu);
     out.sx = slope.x;
     out.sy = slope.y;
-    out.velocity_mps.z = cap * sum(velZ);
+    if constexpr (kVelocity) out.velocity_mps.z = cap * sum(velZ);
     const double qc = q * cap;
     const glm::dvec2 horizontal = qc * (sum(dispS) * es + sum(dispU) * eu);
-    const glm::dvec2 horizontalVelocity = qc * (sum(velS) * es + sum(velU) * eu);
     // The tensor T = R T_shore Rᵀ with R's columns es, eu.
     const double ss = qc * sum(tSS), uu = qc * sum(tUU), su = qc * sum(tSU);
     const double dxx = ss * es.x * es.x + 2.0 * su * es.x * eu.x + uu * eu.x * eu.x;
@@ -629,9 +638,12 @@ SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* inf
     out.dxx = f * dxx;
     out.dyy = f * dyy;
     out.dxy = f * dxy;
-    out.velocity_mps.x = f * horizontalVelocity.x;
-    out.velocity_mps.y = f * horizontalVelocity.y;
-    if (n > 0 && info && (dominant == Dominant::kEverywhere || local.breaking.broken)) {
+    if constexpr (kVelocity) {
+        const glm::dvec2 horizontalVelocity = qc * (sum(velS) * es + sum(velU) * eu);
+        out.velocity_mps.x = f * horizontalVelocity.x;
+        out.velocity_mps.y = f * horizontalVelocity.y;
+    }
+    if (n > 0 && info && (options.dominant == Dominant::kEverywhere || local.breaking.broken)) {
         // The dominant component: the largest local amplitude (the first of equals).
         size_t best = 0;
         for (size_t m = 1; m < n; ++m)

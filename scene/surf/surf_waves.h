@@ -32,6 +32,7 @@
 #include <array>
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <limits>
 #include <vector>
 
 #include "scene/ocean/surface_terms.h"
@@ -135,11 +136,23 @@ class SurfWaves {
     // line (breaking.broken), the one place the surf foam reads them (SurfFoamCoverage's streaks
     // follow the broken water); elsewhere they are left 0, saving an atan2 and an fmod per point.
     enum class Dominant { kEverywhere, kWhereBroken };
+    // What a caller that needs less than everything (the mesh) can leave out or hand in. None of
+    // it changes a bit of what is computed.
+    struct TermsOptions {
+        bool velocity = true;  // false: velocity_mps left 0 (three sums fewer per component)
+        Dominant dominant = Dominant::kEverywhere;
+        // Bathy().SeabedZAtShore_m at the point's shore coordinates when the caller has it
+        // (OceanSurfaceFrame::DryLandSums), else NaN and Terms looks it up.
+        double seabedZ_m = std::numeric_limits<double>::quiet_NaN();
+    };
 
     // The surf components' terms at rest position (x0, y0), time t (already weighted by the surf
-    // weight), and the point's information. Velocity is included.
-    SurfaceTerms Terms(double x0, double y0, double t_s, SurfPointInfo* info = nullptr,
-                       Dominant dominant = Dominant::kEverywhere) const;
+    // weight), and the point's information. Velocity is included unless options say otherwise.
+    SurfaceTerms Terms(double x0, double y0, double t_s, SurfPointInfo* info = nullptr) const {
+        return Terms(x0, y0, t_s, info, TermsOptions{});
+    }
+    SurfaceTerms Terms(double x0, double y0, double t_s, SurfPointInfo* info,
+                       const TermsOptions& options) const;
 
     // Upper bounds of the sea at still-water depths ≥ minDepth_m: its height above the tide and
     // its horizontal displacement (m). The deep parts enter with their own bounds (each FFT
@@ -191,6 +204,9 @@ class SurfWaves {
     // --- end swash
 
   private:
+    template <bool kVelocity>
+    SurfaceTerms TermsImpl(double x0, double y0, double t_s, SurfPointInfo* info,
+                           const TermsOptions& options) const;
     void BuildSwash();
     SwashParameters swash_;
     std::vector<double> swashAmplitude_, swashPhase_;  // per component at the breaker line

@@ -264,12 +264,14 @@ TEST(OceanMesh, DryLandShortcutIsTheFullEvaluationBitForBit) {
     EXPECT_GT(clampedWet, 10);  // the swash zone's own clamp stays on the full path
 }
 
-TEST(OceanMesh, SurfDominantOnlyWhereBrokenChangesNothingTheMeshUses) {
-    // The mesh asks SurfWaves::Terms for the dominant component only where the water has broken
-    // (Dominant::kWhereBroken). Against the full description (kEverywhere), across the barred
-    // beach of configs/surf.yaml from beyond the fade to the dry sand at three times: the terms
-    // and everything else in the point's information are the same bits, the dominant component
-    // is the same where broken, and the surf foam coverage is the same everywhere.
+TEST(OceanMesh, SurfTermsOptionsOfTheMeshChangeNothingItUses) {
+    // The mesh asks SurfWaves::Terms for less (TermsOptions: no velocity, the dominant component
+    // only where the water has broken) and hands in the seabed that DryLandSums looked up.
+    // Against the full evaluation, across the barred beach of configs/surf.yaml from beyond the
+    // fade onto the dry sand at three times: DryLandSums' seabed is the point's seabedZ_m, the
+    // terms other than the velocity and everything else in the point's information are the same
+    // bits, the dominant component is the same where broken, and the surf foam coverage is the
+    // same everywhere.
     const Scenario sc =
         LoadScenario(std::filesystem::path(SEASENSE_SOURCE_DIR) / "configs/surf.yaml");
     const OceanSurface sea(sc.environment.ocean);
@@ -280,11 +282,20 @@ TEST(OceanMesh, SurfDominantOnlyWhereBrokenChangesNothingTheMeshUses) {
     };
     int broken = 0, unbroken = 0, foamy = 0;
     for (const double t : {3.0, 17.5, 41.0}) {
+        const auto frame = sea.At(t);
         for (double x = -40.0; x < 700.0; x += 0.83) {
             for (const double y : {-130.0, 3.0, 71.0, 160.0}) {
+                SurfWaves::TermsOptions options;
+                options.velocity = false;
+                options.dominant = SurfWaves::Dominant::kWhereBroken;
+                GeometrySums dry{};
+                if (frame->DryLandSums(x, y, dry, &options.seabedZ_m)) continue;
                 SurfPointInfo all, lazy;
-                const SurfaceTerms a = w.Terms(x, y, t, &all, SurfWaves::Dominant::kEverywhere);
-                const SurfaceTerms b = w.Terms(x, y, t, &lazy, SurfWaves::Dominant::kWhereBroken);
+                const SurfaceTerms a = w.Terms(x, y, t, &all);
+                SurfaceTerms b = w.Terms(x, y, t, &lazy, options);
+                ASSERT_TRUE(same(options.seabedZ_m, all.seabedZ_m));
+                ASSERT_EQ(b.velocity_mps, glm::dvec3(0.0));
+                b.velocity_mps = a.velocity_mps;
                 ASSERT_EQ(std::memcmp(&a, &b, sizeof(a)), 0) << x << " " << y << " " << t;
                 ASSERT_TRUE(
                     same(all.depth_m, lazy.depth_m) && same(all.envelope_m, lazy.envelope_m) &&
