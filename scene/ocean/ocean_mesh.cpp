@@ -150,15 +150,20 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
             const size_t v = size_t(j) * size_t(columns) + size_t(i);
             GeometrySums s{};
             const double x0 = req.eye_m.x + rx, y0 = req.eye_m.y + ry;
+            // The surf path: the seabed DryLandSums looked up, no velocity, the dominant
+            // component only where the foam reads it (none of it changes the surface's bits).
+            SurfWaves::TermsOptions options;
+            options.velocity = false;
+            options.dominant = SurfWaves::Dominant::kWhereBroken;
             if (!surf) {
                 frame.AccumulateFft(x0, y0, filter, s);
                 if (gerstner) local.Accumulate(float(rx), float(ry), fp, s.data());
-            } else if (frame.DryLandSums(x0, y0, s)) {
+            } else if (frame.DryLandSums(x0, y0, s, &options.seabedZ_m)) {
                 out.surfFoam[v] = 0.0f;  // dry sand, never wet: no foam
             } else {
                 // Each part of the deep sea with its depth weight, then the surf components.
                 SurfPointInfo info;
-                const SurfaceTerms st = frame.Surf()->Terms(x0, y0, frame.Time_s(), &info);
+                const SurfaceTerms st = frame.Surf()->Terms(x0, y0, frame.Time_s(), &info, options);
                 frame.AccumulateFft(x0, y0, filter, s, info.weights.cascade.data());
                 const double wg = info.weights.gerstner;
                 if (gerstner && wg == 1.0) {

@@ -4,6 +4,7 @@
 
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
+#include <xmmintrin.h>
 
 #include <algorithm>
 #include <bit>
@@ -51,9 +52,18 @@ void AddBilinear(const Texture& c, int level, double x0, double y0, float weight
     const GeometrySums& e = t[size_t(i1) * size_t(n) + size_t(j1)].v;
     const float w00 = weight * (1.0f - wx) * (1.0f - wy), w10 = weight * wx * (1.0f - wy);
     const float w01 = weight * (1.0f - wx) * wy, w11 = weight * wx * wy;
-    for (int k = 0; k < kGeometryTerms; ++k)
-        sums[size_t(k)] +=
-            w00 * a[size_t(k)] + w10 * b[size_t(k)] + w01 * d[size_t(k)] + w11 * e[size_t(k)];
+    // sums[k] += ((w00 a + w10 b) + w01 d) + w11 e, four terms at a time (SSE): the same
+    // single-precision operations in the same order as one term at a time, so the same bits.
+    static_assert(kGeometryTerms == 8);
+    const __m128 v00 = _mm_set1_ps(w00), v10 = _mm_set1_ps(w10);
+    const __m128 v01 = _mm_set1_ps(w01), v11 = _mm_set1_ps(w11);
+    for (size_t k = 0; k < size_t(kGeometryTerms); k += 4) {
+        const __m128 term = _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(v00, _mm_loadu_ps(&a[k])),
+                                                             _mm_mul_ps(v10, _mm_loadu_ps(&b[k]))),
+                                                  _mm_mul_ps(v01, _mm_loadu_ps(&d[k]))),
+                                       _mm_mul_ps(v11, _mm_loadu_ps(&e[k])));
+        _mm_storeu_ps(&sums[k], _mm_add_ps(_mm_loadu_ps(&sums[k]), term));
+    }
 }
 
 }  // namespace
@@ -182,7 +192,8 @@ void OceanSurfaceFrame::AddSurf(double x0, double y0, const SurfaceTerms& s,
     }
 }
 
-bool OceanSurfaceFrame::DryLandSums(double x0, double y0, GeometrySums& sums) const {
+bool OceanSurfaceFrame::DryLandSums(double x0, double y0, GeometrySums& sums,
+                                    double* seabedZ_m) const {
     CHECK(surf_);
     const Bathymetry& bathy = surf_->Bathy();
     // At depth ≤ 0 every part of the deep sea has faded out (fade weights 0 below half their
@@ -190,8 +201,15 @@ bool OceanSurfaceFrame::DryLandSums(double x0, double y0, GeometrySums& sums) co
     // no horizontal displacement, ζ ≤ Swash().max_m. Above that (1 mm more for float rounding)
     // the seabed clamp always applies at the rest position itself.
     constexpr double kRoundingMargin_m = 1e-3;
-    const double zBed = bathy.SeabedZ_m(x0, y0);
-    if (!(zBed > bathy.Tide_m() + surf_->Swash().max_m + kRoundingMargin_m)) return false;
+    // The seabed as SurfWaves::Terms finds it (through the shore frame: the same bits as
+    // SeabedZ_m but on a depth grid, where the two differ by the round trip's rounding, far
+    // below the margin).
+    const ShorePoint p = bathy.Frame().ShoreFromWorld(x0, y0);
+    const double zBed = bathy.SeabedZAtShore_m(p.s_m, p.u_m);
+    if (!(zBed > bathy.Tide_m() + surf_->Swash().max_m + kRoundingMargin_m)) {
+        if (seabedZ_m) *seabedZ_m = zBed;
+        return false;
+    }
     const glm::dvec3 bed = SeabedWithSlope(bathy, x0, y0);
     sums = GeometrySums{};
     sums[kTermHeight] = float(bed.x);

@@ -112,8 +112,10 @@ class OceanSurfaceFrame {
     // With a surf zone: whether rest position (x0, y0) is dry land that no water reaches at any
     // time (seabed above the tide plus the swash maximum), and if so the surface there, sums set
     // to exactly what the deep sea, the surf terms and AddSurf's seabed clamp give (the seabed
-    // and its slope), without evaluating them.
-    bool DryLandSums(double x0, double y0, GeometrySums& sums) const;
+    // and its slope), without evaluating them. Where it is not, the seabed it looked up there
+    // (as SurfWaves::Terms looks it up) is written to seabedZ_m if given, for
+    // SurfWaves::TermsOptions::seabedZ_m.
+    bool DryLandSums(double x0, double y0, GeometrySums& sums, double* seabedZ_m = nullptr) const;
 
     // The surf components (nullptr without environment.ocean.surf).
     const SurfWaves* Surf() const { return surf_.get(); }

@@ -136,28 +136,30 @@ SurfWaves::SurfWaves(const Bathymetry& bathymetry, std::vector<SurfComponent> co
                                          1.0 / std::tanh(k * h), cg};
         }
     }
-    // Two (sines: four) lanes at a time: padded with silent components (zero amplitude and
-    // 1/tanh, k = 1). 1/k is tabulated rather than k: Terms then divides by nothing.
+    // Four lanes at a time: padded with silent components (zero amplitude and 1/tanh, k = 1).
+    // 1/k is tabulated rather than k: Terms then divides by nothing.
     lanes_ = (n + 3) / 4 * 4;
     laneOrigin_.assign(lanes_, 0.0);
     laneKu_.assign(lanes_, 0.0);
     laneOmega_.assign(lanes_, 0.0);
     laneKs0_.assign(lanes_, 0.0);
-    laneSpectral_.assign(lanes_, 0.0);
-    laneDepth_.assign(size_t(depthSamples_) * kLaneFields * lanes_, 0.0);
+    laneKuF_.assign(lanes_, 0.0f);
+    laneOmegaF_.assign(lanes_, 0.0f);
+    laneSpectral_.assign(lanes_, 0.0f);
+    laneDepth_.assign(size_t(depthSamples_) * kLaneFields * lanes_, 0.0f);
     lanePhase_.assign(size_t(samples) * lanes_, 0.0);
     for (size_t m = 0; m < lanes_; ++m) {
         for (int i = 0; i < depthSamples_; ++i) {
-            double* d = laneDepth_.data() + size_t(i) * kLaneFields * lanes_ + m;
+            float* d = laneDepth_.data() + size_t(i) * kLaneFields * lanes_ + m;
             if (m >= n) {
-                d[lanes_] = 1.0;  // 1/k
+                d[lanes_] = 1.0f;  // 1/k
                 continue;
             }
             const DepthSample& ds = depth_[size_t(i) * n + m];
-            d[0] = ds.amplitude;
-            d[lanes_] = 1.0 / ds.k;
-            d[2 * lanes_] = ds.kx;
-            d[3 * lanes_] = ds.invTanh;
+            d[0] = float(ds.amplitude);
+            d[lanes_] = float(1.0 / ds.k);
+            d[2 * lanes_] = float(ds.kx);
+            d[3 * lanes_] = float(ds.invTanh);
         }
         if (m >= n) continue;
         const Track& tr = tracks_[incoming_[m]];
@@ -165,7 +167,9 @@ SurfWaves::SurfWaves(const Bathymetry& bathymetry, std::vector<SurfComponent> co
         laneKu_[m] = tr.ku;
         laneOmega_[m] = components_[incoming_[m]].omega_radps;
         laneKs0_[m] = tr.ks0;
-        laneSpectral_[m] = components_[incoming_[m]].spectral ? 1.0 : 0.0;
+        laneKuF_[m] = float(tr.ku);
+        laneOmegaF_[m] = float(laneOmega_[m]);
+        laneSpectral_[m] = components_[incoming_[m]].spectral ? 1.0f : 0.0f;
         for (int i = 0; i < samples; ++i) lanePhase_[size_t(i) * lanes_ + m] = tr.phase[size_t(i)];
     }
 
@@ -444,10 +448,19 @@ SurfWaves::Bound SurfWaves::BoundAtDepths(double minDepth_m, const std::vector<B
     return out;
 }
 
-SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* info) const {
+SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* info,
+                              const TermsOptions& options) const {
+    return options.velocity ? TermsImpl<true>(x0, y0, t, info, options)
+                            : TermsImpl<false>(x0, y0, t, info, options);
+}
+
+template <bool kVelocity>
+SurfaceTerms SurfWaves::TermsImpl(double x0, double y0, double t, SurfPointInfo* info,
+                                  const TermsOptions& options) const {
     SurfaceTerms out;
     const ShorePoint p = bathy_.Frame().ShoreFromWorld(x0, y0);
-    const double zBed = bathy_.SeabedZAtShore_m(p.s_m, p.u_m);
+    const double zBed =
+        std::isnan(options.seabedZ_m) ? bathy_.SeabedZAtShore_m(p.s_m, p.u_m) : options.seabedZ_m;
     const double h = bathy_.Tide_m() - zBed;
     const SurfWeights weights = Weights(h);
     SurfPointInfo local;
@@ -486,32 +499,31 @@ SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* inf
     const double px = std::clamp(tableIndex, 0.0, double(phaseSamples - 1));
     const size_t pi = std::min(size_t(px), phaseSamples - 2);
     const double pf = px - double(pi);
-    const double* d0 = laneDepth_.data() + di * kLaneFields * lanes;
-    const double* d1 = d0 + kLaneFields * lanes;
+    const float* d0 = laneDepth_.data() + di * kLaneFields * lanes;
+    const float* d1 = d0 + kLaneFields * lanes;
     const double* p0 = lanePhase_.data() + pi * lanes;
     const double* p1 = p0 + lanes;
 
-    // The components two at a time (SSE2 lanes: even components in lane 0, odd in lane 1), each
-    // sum reduced as lane 0 + lane 1 at the end: a fixed order, so the mesh and the queries,
-    // which both come here, get the same bits. Everything is summed before the breaker cap and
-    // the steepness Q, which scale whole sums (below); the tensors and vectors are summed in the
-    // shore frame and turned to the world once.
-    const __m128d vdf = _mm_set1_pd(df), vpf = _mm_set1_pd(pf);
+    // The phases two at a time in double precision (they grow with time and distance), reduced
+    // to [−π, π] by whole turns; their sines and cosines then four at a time in single precision
+    // (simd4::SinCos4, ~2e-7), and the components' terms summed four at a time in single
+    // precision too (lane m mod 4 holds components m, m + 4, ...; the lanes reduced in double as
+    // (0 + 2) + (1 + 3) at the end): a fixed order, so the mesh and the queries, which both come
+    // here, get the same bits. The surface is stored in floats and a sum of ≤ 20 float terms of
+    // ≤ a few metres is good to ~1e-6 m, so nothing visible is lost, and four lanes cost half of
+    // two. Everything is summed before the breaker cap and the steepness Q, which scale whole
+    // sums (below); the tensors and vectors are summed in the shore frame and turned to the world
+    // once.
+    const __m128d vpf = _mm_set1_pd(pf);
     const __m128d vu = _mm_set1_pd(p.u_m), vt = _mm_set1_pd(t);
     const __m128d vs = _mm_set1_pd(p.s_m), vsRef = _mm_set1_pd(sRef_m_);
-    const __m128d vws = _mm_set1_pd(weights.spectralSurf), vwg = _mm_set1_pd(weights.gerstnerSurf);
-    const __m128d zero = _mm_setzero_pd();
     const bool seaward = p.s_m >= sRef_m_;
     const auto lerp = [&](const double* a, const double* b, __m128d f) {
         const __m128d va = _mm_loadu_pd(a);
         return _mm_add_pd(va, _mm_mul_pd(f, _mm_sub_pd(_mm_loadu_pd(b), va)));
     };
-    // The phases in double precision (they grow with time and distance), reduced to [−π, π]
-    // by whole turns; their sines and cosines then four at a time in single precision
-    // (simd4::SinCos4, ~2e-7): the surface is stored in floats, so nothing visible is lost, and
-    // four lanes with shorter polynomials cost far less than double-precision sines.
     alignas(16) std::array<double, kMaxSurfComponents> psis;
-    alignas(16) std::array<float, kMaxSurfComponents> reduced, sines, cosines;
+    alignas(16) std::array<float, kMaxSurfComponents> reduced;
     const __m128d kRound = _mm_set1_pd(6755399441055744.0);  // 1.5 · 2⁵²: round to integer
     for (size_t m = 0; m < lanes; m += 2) {
         const __m128d ks0 = _mm_loadu_pd(&laneKs0_[m]);
@@ -529,55 +541,60 @@ SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* inf
         _mm_storel_pi(reinterpret_cast<__m64*>(&reduced[m]),
                       _mm_cvtpd_ps(_mm_sub_pd(psi, _mm_mul_pd(turns, _mm_set1_pd(kTwoPi)))));
     }
+    using simd4::F4;
+    const F4 vdf = _mm_set1_ps(float(df));
+    const F4 vws = _mm_set1_ps(float(weights.spectralSurf));
+    const F4 vwg = _mm_set1_ps(float(weights.gerstnerSurf));
+    const F4 zero = _mm_setzero_ps();
+    const auto lerp4 = [&](const float* a, const float* b) {
+        const F4 va = _mm_load_ps(a);
+        return _mm_add_ps(va, _mm_mul_ps(vdf, _mm_sub_ps(_mm_load_ps(b), va)));
+    };
+    F4 re = zero, im = zero, slopeS = zero, slopeU = zero, orbit = zero, longest = zero;
+    F4 dispS = zero, dispU = zero, tSS = zero, tUU = zero, tSU = zero;
+    [[maybe_unused]] F4 velS = zero, velU = zero, velZ = zero;
+    alignas(16) std::array<float, kMaxSurfComponents> amplitudes;
     for (size_t m = 0; m < lanes; m += 4) {
-        simd4::F4 sn, cs;
+        F4 sn, cs;
         simd4::SinCos4(_mm_load_ps(&reduced[m]), sn, cs);
-        _mm_store_ps(&sines[m], sn);
-        _mm_store_ps(&cosines[m], cs);
-    }
-    __m128d re = zero, im = zero, slopeS = zero, slopeU = zero, orbit = zero, longest = zero;
-    __m128d dispS = zero, dispU = zero, tSS = zero, tUU = zero, tSU = zero;
-    __m128d velS = zero, velU = zero, velZ = zero;
-    alignas(16) std::array<double, kMaxSurfComponents> amplitudes;
-    for (size_t m = 0; m < lanes; m += 2) {
-        // Two floats through __m64, which may alias them.
-        const auto load2 = [](const float* f) {
-            return _mm_cvtps_pd(_mm_loadl_pi(_mm_setzero_ps(), reinterpret_cast<const __m64*>(f)));
-        };
-        const __m128d sn = load2(&sines[m]), cs = load2(&cosines[m]);
-        const __m128d ku = _mm_loadu_pd(&laneKu_[m]), omega = _mm_loadu_pd(&laneOmega_[m]);
+        const F4 ku = _mm_load_ps(&laneKuF_[m]), omega = _mm_load_ps(&laneOmegaF_[m]);
         // Shoaled and refracted, times the weight of the component's part in the fade.
-        const __m128d spectral = _mm_cmpneq_pd(_mm_loadu_pd(&laneSpectral_[m]), zero);
-        const __m128d w = _mm_or_pd(_mm_and_pd(spectral, vws), _mm_andnot_pd(spectral, vwg));
-        const __m128d a = _mm_mul_pd(lerp(d0 + m, d1 + m, vdf), w);
-        const __m128d invK = lerp(d0 + lanes + m, d1 + lanes + m, vdf);
-        const __m128d kx = lerp(d0 + 2 * lanes + m, d1 + 2 * lanes + m, vdf);
-        const __m128d invTanh = lerp(d0 + 3 * lanes + m, d1 + 3 * lanes + m, vdf);
-        _mm_store_pd(&amplitudes[m], a);
-        const __m128d asn = _mm_mul_pd(a, sn);
-        re = _mm_add_pd(re, _mm_mul_pd(a, cs));
-        im = _mm_add_pd(im, asn);
-        slopeS = _mm_sub_pd(slopeS, _mm_mul_pd(asn, kx));
-        slopeU = _mm_sub_pd(slopeU, _mm_mul_pd(asn, ku));
-        velZ = _mm_add_pd(velZ, _mm_mul_pd(asn, omega));
+        const F4 w = simd4::Select4(_mm_cmpneq_ps(_mm_load_ps(&laneSpectral_[m]), zero), vws, vwg);
+        const F4 a = _mm_mul_ps(lerp4(d0 + m, d1 + m), w);
+        const F4 invK = lerp4(d0 + lanes + m, d1 + lanes + m);
+        const F4 kx = lerp4(d0 + 2 * lanes + m, d1 + 2 * lanes + m);
+        const F4 invTanh = lerp4(d0 + 3 * lanes + m, d1 + 3 * lanes + m);
+        _mm_store_ps(&amplitudes[m], a);
+        const F4 asn = _mm_mul_ps(a, sn);
+        re = _mm_add_ps(re, _mm_mul_ps(a, cs));
+        im = _mm_add_ps(im, asn);
+        slopeS = _mm_sub_ps(slopeS, _mm_mul_ps(asn, kx));
+        slopeU = _mm_sub_ps(slopeU, _mm_mul_ps(asn, ku));
+        if constexpr (kVelocity) velZ = _mm_add_ps(velZ, _mm_mul_ps(asn, omega));
         // The orbit a / tanh kh along the unit direction of travel (k_s, k_u) / k.
-        const __m128d hor = _mm_mul_pd(a, invTanh);
-        orbit = _mm_add_pd(orbit, hor);
-        longest = _mm_max_pd(longest, invTanh);
-        const __m128d eS = _mm_mul_pd(kx, invK), eU = _mm_mul_pd(ku, invK);
-        const __m128d hs = _mm_mul_pd(hor, sn), hc = _mm_mul_pd(hor, cs);
-        dispS = _mm_sub_pd(dispS, _mm_mul_pd(eS, hs));
-        dispU = _mm_sub_pd(dispU, _mm_mul_pd(eU, hs));
+        const F4 hor = _mm_mul_ps(a, invTanh);
+        orbit = _mm_add_ps(orbit, hor);
+        longest = _mm_max_ps(longest, invTanh);
+        const F4 eS = _mm_mul_ps(kx, invK), eU = _mm_mul_ps(ku, invK);
+        const F4 hs = _mm_mul_ps(hor, sn), hc = _mm_mul_ps(hor, cs);
+        dispS = _mm_sub_ps(dispS, _mm_mul_ps(eS, hs));
+        dispU = _mm_sub_ps(dispU, _mm_mul_ps(eU, hs));
         // ∂D_i/∂x_j = −hor cos ψ e_i k_j: symmetric, three sums.
-        const __m128d hcS = _mm_mul_pd(hc, eS);
-        tSS = _mm_sub_pd(tSS, _mm_mul_pd(hcS, kx));
-        tUU = _mm_sub_pd(tUU, _mm_mul_pd(_mm_mul_pd(hc, eU), ku));
-        tSU = _mm_sub_pd(tSU, _mm_mul_pd(hcS, ku));
-        const __m128d hcw = _mm_mul_pd(hc, omega);
-        velS = _mm_add_pd(velS, _mm_mul_pd(eS, hcw));
-        velU = _mm_add_pd(velU, _mm_mul_pd(eU, hcw));
+        const F4 hcS = _mm_mul_ps(hc, eS);
+        tSS = _mm_sub_ps(tSS, _mm_mul_ps(hcS, kx));
+        tUU = _mm_sub_ps(tUU, _mm_mul_ps(_mm_mul_ps(hc, eU), ku));
+        tSU = _mm_sub_ps(tSU, _mm_mul_ps(hcS, ku));
+        if constexpr (kVelocity) {
+            const F4 hcw = _mm_mul_ps(hc, omega);
+            velS = _mm_add_ps(velS, _mm_mul_ps(eS, hcw));
+            velU = _mm_add_ps(velU, _mm_mul_ps(eU, hcw));
+        }
     }
-    const auto sum = [](__m128d v) { return _mm_cvtsd_f64(_mm_add_sd(v, _mm_unpackhi_pd(v, v))); };
+    // (lane 0 + lane 2) + (lane 1 + lane 3), in double.
+    const auto sum = [](F4 v) {
+        const __m128d pairs = _mm_add_pd(_mm_cvtps_pd(v), _mm_cvtps_pd(_mm_movehl_ps(v, v)));
+        return _mm_cvtsd_f64(_mm_add_sd(pairs, _mm_unpackhi_pd(pairs, pairs)));
+    };
     const double envelopeRe = sum(re), envelopeIm = sum(im);
     const double A = std::sqrt(envelopeRe * envelopeRe + envelopeIm * envelopeIm);
     // Behind a sandbar only the energy flux the bar let through arrives (Shelter).
@@ -595,10 +612,9 @@ SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* inf
     const glm::dvec2 slope = cap * (sum(slopeS) * es + sum(slopeU) * eu);
     out.sx = slope.x;
     out.sy = slope.y;
-    out.velocity_mps.z = cap * sum(velZ);
+    if constexpr (kVelocity) out.velocity_mps.z = cap * sum(velZ);
     const double qc = q * cap;
     const glm::dvec2 horizontal = qc * (sum(dispS) * es + sum(dispU) * eu);
-    const glm::dvec2 horizontalVelocity = qc * (sum(velS) * es + sum(velU) * eu);
     // The tensor T = R T_shore Rᵀ with R's columns es, eu.
     const double ss = qc * sum(tSS), uu = qc * sum(tUU), su = qc * sum(tSU);
     const double dxx = ss * es.x * es.x + 2.0 * su * es.x * eu.x + uu * eu.x * eu.x;
@@ -610,8 +626,10 @@ SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* inf
     // their orbits, each ∝ a/(kh), which grow without bound as h → 0. Scaling the horizontal
     // field by one factor keeps its direction; the factor's own gradient is left out of the
     // Jacobian terms.
+    alignas(16) std::array<float, 4> longestLanes;
+    _mm_store_ps(longestLanes.data(), longest);
     const double longestInvTanh =
-        _mm_cvtsd_f64(_mm_max_sd(longest, _mm_unpackhi_pd(longest, longest)));
+        double(std::max({longestLanes[0], longestLanes[1], longestLanes[2], longestLanes[3]}));
     const double limit = std::min(cap * sum(orbit), 0.5 * gammaH * longestInvTanh);
     const double len = std::sqrt(horizontal.x * horizontal.x + horizontal.y * horizontal.y);
     const double f = len > limit && len > 0.0 ? limit / len : 1.0;
@@ -620,9 +638,12 @@ SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* inf
     out.dxx = f * dxx;
     out.dyy = f * dyy;
     out.dxy = f * dxy;
-    out.velocity_mps.x = f * horizontalVelocity.x;
-    out.velocity_mps.y = f * horizontalVelocity.y;
-    if (n > 0 && info) {
+    if constexpr (kVelocity) {
+        const glm::dvec2 horizontalVelocity = qc * (sum(velS) * es + sum(velU) * eu);
+        out.velocity_mps.x = f * horizontalVelocity.x;
+        out.velocity_mps.y = f * horizontalVelocity.y;
+    }
+    if (n > 0 && info && (options.dominant == Dominant::kEverywhere || local.breaking.broken)) {
         // The dominant component: the largest local amplitude (the first of equals).
         size_t best = 0;
         for (size_t m = 1; m < n; ++m)

@@ -32,6 +32,7 @@
 #include <array>
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <limits>
 #include <vector>
 
 #include "scene/ocean/surface_terms.h"
@@ -130,9 +131,28 @@ class SurfWaves {
     // Weights of the sea's parts at a still-water depth h (m).
     SurfWeights Weights(double depth_m) const;
 
+    // Which points Terms describes the dominant component at (SurfPointInfo::direction_rad,
+    // phaseSpeed_mps, groupSpeed_mps, phase_rad): everywhere, or only shoreward of the breaker
+    // line (breaking.broken), the one place the surf foam reads them (SurfFoamCoverage's streaks
+    // follow the broken water); elsewhere they are left 0, saving an atan2 and an fmod per point.
+    enum class Dominant { kEverywhere, kWhereBroken };
+    // What a caller that needs less than everything (the mesh) can leave out or hand in. None of
+    // it changes a bit of what is computed.
+    struct TermsOptions {
+        bool velocity = true;  // false: velocity_mps left 0 (three sums fewer per component)
+        Dominant dominant = Dominant::kEverywhere;
+        // Bathy().SeabedZAtShore_m at the point's shore coordinates when the caller has it
+        // (OceanSurfaceFrame::DryLandSums), else NaN and Terms looks it up.
+        double seabedZ_m = std::numeric_limits<double>::quiet_NaN();
+    };
+
     // The surf components' terms at rest position (x0, y0), time t (already weighted by the surf
-    // weight), and the point's information. Velocity is included.
-    SurfaceTerms Terms(double x0, double y0, double t_s, SurfPointInfo* info = nullptr) const;
+    // weight), and the point's information. Velocity is included unless options say otherwise.
+    SurfaceTerms Terms(double x0, double y0, double t_s, SurfPointInfo* info = nullptr) const {
+        return Terms(x0, y0, t_s, info, TermsOptions{});
+    }
+    SurfaceTerms Terms(double x0, double y0, double t_s, SurfPointInfo* info,
+                       const TermsOptions& options) const;
 
     // Upper bounds of the sea at still-water depths ≥ minDepth_m: its height above the tide and
     // its horizontal displacement (m). The deep parts enter with their own bounds (each FFT
@@ -184,6 +204,9 @@ class SurfWaves {
     // --- end swash
 
   private:
+    template <bool kVelocity>
+    SurfaceTerms TermsImpl(double x0, double y0, double t_s, SurfPointInfo* info,
+                           const TermsOptions& options) const;
     void BuildSwash();
     SwashParameters swash_;
     std::vector<double> swashAmplitude_, swashPhase_;  // per component at the breaker line
@@ -242,14 +265,16 @@ class SurfWaves {
     // sample: depth_[i · n + j] for n incoming.
     std::vector<size_t> incoming_;
     std::vector<DepthSample> depth_;
-    // For Terms, two components at a time (SSE2 lanes; sines four at a time): the incoming
-    // count padded to a multiple of 4, lanes_, with silent components (zero amplitude, zero
-    // 1/tanh kh); per component its constants, per depth sample the interpolated fields
-    // (kLaneFields, field-major), per cross-shore sample the phases ∫ k_s ds.
+    // For Terms, the phases two components at a time in double (SSE2 lanes), the rest four at
+    // a time in float: the incoming count padded to a multiple of 4, lanes_, with silent
+    // components (zero amplitude, zero 1/tanh kh); per component its constants (the phase's in
+    // double, the sums' in float), per depth sample the interpolated fields (kLaneFields,
+    // field-major, float), per cross-shore sample the phases ∫ k_s ds.
     static constexpr size_t kLaneFields = 4;  // amplitude, 1/k, k_s, 1/tanh kh
     size_t lanes_ = 0;
-    std::vector<double> laneOrigin_, laneKu_, laneOmega_, laneKs0_, laneSpectral_;
-    std::vector<double> laneDepth_;  // [(i · kLaneFields + field) · lanes_ + m]
+    std::vector<double> laneOrigin_, laneKu_, laneOmega_, laneKs0_;
+    std::vector<float> laneKuF_, laneOmegaF_, laneSpectral_;
+    std::vector<float> laneDepth_;   // [(i · kLaneFields + field) · lanes_ + m]
     std::vector<double> lanePhase_;  // [i · lanes_ + m]
     double shelterSeaward_m_ = 0.0;  // with shelters: none seaward of this cross-shore s
     double sBreak_m_ = 0.0;

@@ -9,6 +9,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <numbers>
@@ -16,6 +17,7 @@
 #include <vector>
 
 #include "scene/scenario/scenario_loader.h"
+#include "scene/surf/foam.h"
 
 namespace seasense::scene {
 namespace {
@@ -260,6 +262,67 @@ TEST(OceanMesh, DryLandShortcutIsTheFullEvaluationBitForBit) {
     EXPECT_GT(dry, 1000);
     EXPECT_GT(wet, 1000);
     EXPECT_GT(clampedWet, 10);  // the swash zone's own clamp stays on the full path
+}
+
+TEST(OceanMesh, SurfTermsOptionsOfTheMeshChangeNothingItUses) {
+    // The mesh asks SurfWaves::Terms for less (TermsOptions: no velocity, the dominant component
+    // only where the water has broken) and hands in the seabed that DryLandSums looked up.
+    // Against the full evaluation, across the barred beach of configs/surf.yaml from beyond the
+    // fade onto the dry sand at three times: DryLandSums' seabed is the point's seabedZ_m, the
+    // terms other than the velocity and everything else in the point's information are the same
+    // bits, the dominant component is the same where broken, and the surf foam coverage is the
+    // same everywhere.
+    const Scenario sc =
+        LoadScenario(std::filesystem::path(SEASENSE_SOURCE_DIR) / "configs/surf.yaml");
+    const OceanSurface sea(sc.environment.ocean);
+    const SurfWaves& w = *sea.Surf();
+    const FoamSettings& foamSettings = w.Bathy().Settings().foam;
+    const auto same = [](double a, double b) {
+        return std::bit_cast<uint64_t>(a) == std::bit_cast<uint64_t>(b);
+    };
+    int broken = 0, unbroken = 0, foamy = 0;
+    for (const double t : {3.0, 17.5, 41.0}) {
+        const auto frame = sea.At(t);
+        for (double x = -40.0; x < 700.0; x += 0.83) {
+            for (const double y : {-130.0, 3.0, 71.0, 160.0}) {
+                SurfWaves::TermsOptions options;
+                options.velocity = false;
+                options.dominant = SurfWaves::Dominant::kWhereBroken;
+                GeometrySums dry{};
+                if (frame->DryLandSums(x, y, dry, &options.seabedZ_m)) continue;
+                SurfPointInfo all, lazy;
+                const SurfaceTerms a = w.Terms(x, y, t, &all);
+                SurfaceTerms b = w.Terms(x, y, t, &lazy, options);
+                ASSERT_TRUE(same(options.seabedZ_m, all.seabedZ_m));
+                ASSERT_EQ(b.velocity_mps, glm::dvec3(0.0));
+                b.velocity_mps = a.velocity_mps;
+                ASSERT_EQ(std::memcmp(&a, &b, sizeof(a)), 0) << x << " " << y << " " << t;
+                ASSERT_TRUE(
+                    same(all.depth_m, lazy.depth_m) && same(all.envelope_m, lazy.envelope_m) &&
+                    same(all.unbrokenHeight_m, lazy.unbrokenHeight_m) &&
+                    same(all.breaking.intensity, lazy.breaking.intensity) &&
+                    all.breaking.broken == lazy.breaking.broken &&
+                    same(all.breaking.timeSinceBreaking_s, lazy.breaking.timeSinceBreaking_s) &&
+                    all.weights.cascade == lazy.weights.cascade &&
+                    same(all.surfWeight, lazy.surfWeight));
+                if (all.breaking.broken) {
+                    ++broken;
+                    ASSERT_TRUE(same(all.direction_rad, lazy.direction_rad) &&
+                                same(all.groupSpeed_mps, lazy.groupSpeed_mps) &&
+                                same(all.phaseSpeed_mps, lazy.phaseSpeed_mps) &&
+                                same(all.phase_rad, lazy.phase_rad));
+                } else {
+                    ++unbroken;
+                }
+                const double fa = SurfFoamCoverage(all, x, y, t, foamSettings);
+                ASSERT_TRUE(same(fa, SurfFoamCoverage(lazy, x, y, t, foamSettings)));
+                if (fa > 0.0) ++foamy;
+            }
+        }
+    }
+    EXPECT_GT(broken, 1000);
+    EXPECT_GT(unbroken, 1000);
+    EXPECT_GT(foamy, 500);
 }
 
 TEST(OceanMesh, SurfMeshAndFrameBitIdenticalForAnyThreadCount) {
