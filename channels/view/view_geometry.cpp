@@ -150,14 +150,13 @@ void ViewGeometry::UpdateOceanAttributes() {
     const double threshold = world_.GetScenario().environment.ocean.foamThreshold;
     oceanAttributes_.resize(ocean_.positions.size());
     const int rings = ocean_.rings;
-    const int columns = ocean_.fullCircle ? ocean_.segments : ocean_.segments + 1;
     if (rings == 0) return;
-    CHECK(size_t(rings) * size_t(columns) == ocean_.positions.size());
+    CHECK(ocean_.ringStart.size() == size_t(rings) + 1 &&
+          ocean_.ringStart.back() == ocean_.positions.size());
     tbb::parallel_for(0, rings, [&](int j) {
         const double radius = ocean_.radii_m[size_t(j)];
         const double drop = scene::CurvatureDrop_m(radius);
-        for (int i = 0; i < columns; ++i) {
-            const size_t v = size_t(j) * size_t(columns) + size_t(i);
+        for (size_t v = ocean_.ringStart[size_t(j)]; v < ocean_.ringStart[size_t(j) + 1]; ++v) {
             // Without a surf zone the column is optically deep: 1e4 m, where the seabed's share
             // e^(−K·depth) is 0 in float for any water. Finite, because the rasterizer
             // interpolates attributes with barycentric weights that can be exactly 0, and
@@ -201,7 +200,9 @@ void ViewGeometry::Update(const scene::SceneState& state) {
     scene::OceanMeshRequest req;
     req.eye_m = cam.worldFromCamera.position_m;
     req.angularStep_rad = kOceanVertexSpacing_px * cam.hfov_rad / double(cam.width);
-    FrustumAzimuthSector(cam, 20.0 * M_PI / 180.0, req.azimuthMin_rad, req.azimuthMax_rad);
+    // The view's own sector; the mesh widens each band by what the waves can carry sideways.
+    FrustumAzimuthSector(cam, 0.0, req.azimuthMin_rad, req.azimuthMax_rad);
+    req.widenByReach = true;
     req.minRange_m = NearestVisibleSeaRange_m(cam, sea, req.eye_m);
     scene::BuildOceanMesh(sea, req, ocean_);
     UpdateOceanAttributes();

@@ -29,6 +29,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 
 #include "scene/core/check.h"
 #include "scene/surf/foam.h"
@@ -81,19 +83,8 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
     // World-fixed azimuths: a whole number of segments around the circle.
     const int circle = std::max(8, int(std::ceil(2.0 * M_PI / req.angularStep_rad)));
     const double dphi = 2.0 * M_PI / circle;
-    int first = 0, segments = circle;
-    bool full = req.azimuthMax_rad - req.azimuthMin_rad >= 2.0 * M_PI - 1e-9;
-    if (!full) {
-        CHECK(req.azimuthMax_rad > req.azimuthMin_rad);
-        first = int(std::floor(req.azimuthMin_rad / dphi));
-        segments = std::max(1, int(std::ceil(req.azimuthMax_rad / dphi)) - first);
-        if (segments >= circle) {
-            full = true;
-            first = 0;
-            segments = circle;
-        }
-    }
-    const int columns = full ? segments : segments + 1;  // the full circle wraps its last column
+    const bool sectorFull = req.azimuthMax_rad - req.azimuthMin_rad >= 2.0 * M_PI - 1e-9;
+    if (!sectorFull) CHECK(req.azimuthMax_rad > req.azimuthMin_rad);
 
     // Rings: the fixed sequence, from the last ring at or inside the nearest visible range.
     std::vector<double> all =
@@ -113,23 +104,87 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
         footprint[j] = float(std::max({all[a] * dphi, inner, outer}));
     }
 
+    // Each band's columns [lo, hi) (world column indices; hi − lo ≥ circle: the whole circle),
+    // then each ring's: the union of the two bands it bounds (they share the sector's centre).
+    const auto sectorColumns = [&](double margin_rad, int64_t& lo, int64_t& hi) {
+        if (sectorFull ||
+            req.azimuthMax_rad - req.azimuthMin_rad + 2.0 * margin_rad >= 2.0 * M_PI - 1e-9) {
+            lo = 0, hi = circle;
+            return;
+        }
+        lo = int64_t(std::floor((req.azimuthMin_rad - margin_rad) / dphi));
+        hi = int64_t(std::ceil((req.azimuthMax_rad + margin_rad) / dphi));
+        if (hi - lo >= circle) lo = 0, hi = circle;
+    };
+    std::vector<int64_t> bandLo(size_t(rings - 1)), bandHi(size_t(rings - 1));
+    if (req.widenByReach) {
+        // Displacement bounds over discs of radius 4^k m around the eye (k = 0 … 6, then the
+        // whole sea): a band uses the smallest disc holding its outer ring.
+        std::vector<double> discR, discReach;
+        for (double R = 1.0; R < 5000.0; R *= 4.0) {
+            discR.push_back(R);
+            discReach.push_back(frame.BoundsNear(req.eye_m.x, req.eye_m.y, R).horizontal_m);
+        }
+        discR.push_back(std::numeric_limits<double>::infinity());
+        discReach.push_back(frame.MaxHorizontal_m());
+        size_t k = 0;
+        for (int j = 0; j + 1 < rings; ++j) {
+            while (discR[k] < radii[size_t(j) + 1]) ++k;
+            const double reach = discReach[k], r = radii[size_t(j)];
+            // One column more on each side for the chords between columns; never more than
+            // kMaxReachMargin_rad (see OceanMeshRequest::widenByReach).
+            const double margin = r > reach
+                                      ? std::min(std::asin(reach / r) + dphi, kMaxReachMargin_rad)
+                                      : kMaxReachMargin_rad;
+            sectorColumns(margin, bandLo[size_t(j)], bandHi[size_t(j)]);
+        }
+    } else {
+        int64_t lo = 0, hi = 0;
+        sectorColumns(0.0, lo, hi);
+        std::fill(bandLo.begin(), bandLo.end(), lo);
+        std::fill(bandHi.begin(), bandHi.end(), hi);
+    }
+    std::vector<uint32_t> ringStart(size_t(rings) + 1, 0);
+    std::vector<int> ringFirst(size_t(rings), 0);
+    int widest = 0;
+    for (int j = 0; j < rings; ++j) {
+        const size_t a = size_t(std::max(j - 1, 0)), b = size_t(std::min(j, rings - 2));
+        const int64_t lo = std::min(bandLo[a], bandLo[b]), hi = std::max(bandHi[a], bandHi[b]);
+        const bool whole = hi - lo >= circle;
+        const int count = whole ? circle : int(hi - lo) + 1;
+        ringFirst[size_t(j)] = whole ? 0 : int(lo);
+        ringStart[size_t(j) + 1] = ringStart[size_t(j)] + uint32_t(count);
+        if (count > widest) {
+            widest = count;
+            out.fullCircle = whole;
+            out.segments = whole ? circle : count - 1;
+            out.firstColumn = ringFirst[size_t(j)];
+        }
+    }
     // The index buffer depends only on the grid's shape: rebuilt when that changes.
-    const bool sameShape = out.rings == rings && out.segments == segments &&
-                           out.fullCircle == full && !out.indices.empty();
+    const bool sameShape = out.rings == rings && out.circleSegments == circle &&
+                           out.ringStart == ringStart && out.ringFirstColumn == ringFirst &&
+                           !out.indices.empty();
     out.rings = rings;
-    out.segments = segments;
-    out.fullCircle = full;
     out.circleSegments = circle;
-    out.firstColumn = first;
+    out.ringStart = ringStart;
+    out.ringFirstColumn = ringFirst;
     out.radii_m = radii;
     out.footprint_m = footprint;
-    std::vector<double> sinAz(static_cast<size_t>(columns)), cosAz(static_cast<size_t>(columns));
-    for (int i = 0; i < columns; ++i) {
-        const double az = dphi * double(first + i);
-        sinAz[size_t(i)] = std::sin(az);
-        cosAz[size_t(i)] = std::cos(az);
+    // Sine and cosine of every column any ring uses, from the leftmost.
+    int64_t colLo = INT64_MAX, colHi = INT64_MIN;
+    for (int j = 0; j < rings; ++j) {
+        colLo = std::min<int64_t>(colLo, ringFirst[size_t(j)]);
+        colHi = std::max<int64_t>(colHi, int64_t(ringFirst[size_t(j)]) +
+                                             (ringStart[size_t(j) + 1] - ringStart[size_t(j)]));
     }
-    out.positions.resize(size_t(rings) * size_t(columns));
+    std::vector<double> sinAz(size_t(colHi - colLo)), cosAz(size_t(colHi - colLo));
+    for (int64_t c = colLo; c < colHi; ++c) {
+        const double az = dphi * double(c);
+        sinAz[size_t(c - colLo)] = std::sin(az);
+        cosAz[size_t(c - colLo)] = std::cos(az);
+    }
+    out.positions.resize(ringStart.back());
     out.normals.resize(out.positions.size());
     out.jacobian.resize(out.positions.size());
     const GerstnerOcean::LocalFrame local =
@@ -145,9 +200,11 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
         const double drop = CurvatureDrop_m(radius);
         const float fp = footprint[size_t(j)];
         const FftFilter filter = frame.Filter(fp);
+        const int columns = int(ringStart[size_t(j) + 1] - ringStart[size_t(j)]);
+        const size_t c0 = size_t(ringFirst[size_t(j)] - colLo);
         for (int i = 0; i < columns; ++i) {
-            const double rx = radius * sinAz[size_t(i)], ry = radius * cosAz[size_t(i)];
-            const size_t v = size_t(j) * size_t(columns) + size_t(i);
+            const double rx = radius * sinAz[c0 + size_t(i)], ry = radius * cosAz[c0 + size_t(i)];
+            const size_t v = size_t(ringStart[size_t(j)]) + size_t(i);
             GeometrySums s{};
             const double x0 = req.eye_m.x + rx, y0 = req.eye_m.y + ry;
             // The surf path: the seabed DryLandSums looked up, no velocity, the dominant
@@ -190,17 +247,28 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
     });
 
     if (sameShape) return;
+    // Vertex of world column c on ring j.
+    const auto vertex = [&](int j, int64_t c) {
+        const uint32_t n = ringStart[size_t(j) + 1] - ringStart[size_t(j)];
+        const int64_t i =
+            n == uint32_t(circle) ? ((c % circle) + circle) % circle : c - ringFirst[size_t(j)];
+        CHECK(i >= 0 && i < int64_t(n));
+        return ringStart[size_t(j)] + uint32_t(i);
+    };
     out.indices.clear();
-    out.indices.reserve(size_t(rings - 1) * size_t(segments) * 6);
+    size_t quads = 0;
+    for (int j = 0; j + 1 < rings; ++j)
+        quads += size_t(std::min<int64_t>(bandHi[size_t(j)] - bandLo[size_t(j)], circle));
+    out.indices.reserve(quads * 6);
     for (int j = 0; j + 1 < rings; ++j) {
-        for (int i = 0; i < segments; ++i) {
-            const int i1 = full ? (i + 1) % segments : i + 1;
-            const uint32_t a = uint32_t(j * columns + i), b = uint32_t(j * columns + i1);
-            const uint32_t c = uint32_t((j + 1) * columns + i),
-                           d = uint32_t((j + 1) * columns + i1);
+        const bool whole = bandHi[size_t(j)] - bandLo[size_t(j)] >= circle;
+        const int64_t lo = whole ? 0 : bandLo[size_t(j)], hi = whole ? circle : bandHi[size_t(j)];
+        for (int64_t c = lo; c < hi; ++c) {
+            const uint32_t a = vertex(j, c), b = vertex(j, c + 1);
+            const uint32_t cc = vertex(j + 1, c), d = vertex(j + 1, c + 1);
             // Azimuth increases clockwise seen from above and radius outward, so (a, b, c)
             // and (b, d, c) are counter-clockwise seen from above.
-            out.indices.insert(out.indices.end(), {a, b, c, b, d, c});
+            out.indices.insert(out.indices.end(), {a, b, cc, b, d, cc});
         }
     }
 }

@@ -29,7 +29,23 @@ struct OceanMeshRequest {
     // No sea nearer than this can be seen (e.g. below the view): the grid starts here rather
     // than under the eye. +∞ means no sea is visible at all (an empty mesh).
     double minRange_m = 0.0;
+    // False: every ring covers [azimuthMin, azimuthMax] (which must then include any margin).
+    // True: that sector is the view's own, and the band between rings j and j + 1 is widened on
+    // both sides by asin(D / r_j) (and one column), D bounding the horizontal displacement of
+    // the sea within r_{j+1} of the eye (OceanSurfaceFrame::BoundsNear): a point drawn in the
+    // sector at rest radius r ≥ r_j lies at most D from its rest position, which the eye sees at
+    // most asin(D / r) off its azimuth. Far rings, where D / r is small, then hold only the
+    // view's columns. The widening is capped at kMaxReachMargin_rad (20°), the fixed margin used
+    // before: within D / sin 20° of the eye (~9 m for D = 3 m) the bound would ask for up to the
+    // whole circle, which costs more vertices than the rest of the mesh, while the displacement
+    // actually synthesized near the eye stays far below D (0.4–0.8 m within 6 m of a 2 m eye in
+    // configs/surf.yaml, against D ≈ 3 m), which 20° covers beyond ~2.3 m. So near the eye this
+    // is the old margin, not a proof.
+    bool widenByReach = false;
 };
+
+// The largest sideways widening of a band with OceanMeshRequest::widenByReach: 20°.
+inline constexpr double kMaxReachMargin_rad = 20.0 * 3.14159265358979323846 / 180.0;
 
 struct OceanMesh {
     std::vector<glm::vec3> positions;  // world ENU, curvature drop applied relative to the eye
@@ -41,14 +57,21 @@ struct OceanMesh {
     // (OceanSurfaceFrame::DryLandSums). Empty without a surf zone.
     std::vector<float> surfFoam;
     std::vector<uint32_t> indices;  // counter-clockwise seen from above
-    // Ring j, column i is vertex j · (segments + !fullCircle) + i. Column i lies at azimuth
-    // (firstColumn + i) · 2π / circleSegments: azimuths are fixed in the world.
+    // Ring j's vertices are ringStart[j] … ringStart[j + 1] − 1, its columns ringFirstColumn[j],
+    // ringFirstColumn[j] + 1, …: column c lies at azimuth c · 2π / circleSegments, fixed in the
+    // world; a ring with ringStart[j + 1] − ringStart[j] == circleSegments is a whole circle
+    // (column c is vertex ringStart[j] + c mod circleSegments). Without widenByReach every ring
+    // has the same columns: ring j, column i is vertex j · (segments + !fullCircle) + i, column
+    // i at azimuth (firstColumn + i) · 2π / circleSegments. With it, segments, fullCircle and
+    // firstColumn describe the widest ring.
     int rings = 0;
     int segments = 0;
     bool fullCircle = false;
     int circleSegments = 0;
     int firstColumn = 0;
-    std::vector<double> radii_m;     // rest-position radius of each ring
+    std::vector<uint32_t> ringStart;   // rings + 1 entries
+    std::vector<int> ringFirstColumn;  // per ring (0 for whole circles)
+    std::vector<double> radii_m;       // rest-position radius of each ring
     std::vector<float> footprint_m;  // per ring: the sampling footprint the surface is filtered to
 };
 

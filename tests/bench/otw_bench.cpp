@@ -138,7 +138,9 @@ void BM_OceanMesh(benchmark::State& state) {
     scene::OceanMeshRequest req;
     req.eye_m = cam.worldFromCamera.position_m;
     req.angularStep_rad = 6.0 * cam.hfov_rad / double(cam.width);
-    FrustumAzimuthSector(cam, 20.0 * M_PI / 180.0, req.azimuthMin_rad, req.azimuthMax_rad);
+    // As ViewGeometry asks: the view's own sector, widened per band by the waves' reach.
+    FrustumAzimuthSector(cam, 0.0, req.azimuthMin_rad, req.azimuthMax_rad);
+    req.widenByReach = true;
     double t = 0.0;
     const auto sea0 = world.Ocean().At(t);
     req.minRange_m = NearestVisibleSeaRange_m(cam, *sea0, req.eye_m);

@@ -12,7 +12,9 @@
 #include <cstring>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <numbers>
+#include <set>
 #include <utility>
 #include <vector>
 
@@ -153,6 +155,82 @@ TEST(OceanMesh, GridIsWatertight) {
         }
         EXPECT_GT(uses.size(), 10000u);
         EXPECT_LT(border, uses.size() / 20);
+    }
+}
+
+// With widenByReach each band is widened by asin(D / r) (at most 20°): a sea point drawn in
+// the view's sector comes from a rest position inside the band's columns. Checked against the
+// surface's actual displacement (OceanSurfaceFrame::Terms, unfiltered) at rest positions where
+// the bound is below 20°, over a sea with a surf zone (larger sideways orbits); the mesh stays
+// free of cracks (no edge of more than two triangles, every vertex used), no ring wider than
+// with the fixed 20° margin and the far rings much narrower.
+TEST(OceanMesh, ReachWidenedBandsCoverEverySeaPointDrawnInTheSector) {
+    for (bool surf : {false, true}) {
+        const OceanSurface sea(surf ? WithSurf(Beaufort5()) : Beaufort5());
+        const std::shared_ptr<const OceanSurfaceFrame> frame = sea.At(2.0);
+        const glm::dvec3 eye(surf ? 250.0 : 0.0, 0.0, 2.0);
+        const double centre = surf ? -1.3 : 0.3, half = 0.45;
+        OceanMeshRequest req = View(eye, centre, half);
+        req.widenByReach = true;
+        OceanMesh m;
+        BuildOceanMesh(*frame, req, m);
+        ASSERT_EQ(m.ringStart.size(), size_t(m.rings) + 1);
+        const int circle = m.circleSegments;
+        const double dphi = 2.0 * kPi / circle;
+        // Quads present, keyed by (band, column mod circle), from the triangles' vertices.
+        std::vector<int> ringOf(m.positions.size()), columnOf(m.positions.size());
+        for (int j = 0; j < m.rings; ++j)
+            for (uint32_t v = m.ringStart[size_t(j)]; v < m.ringStart[size_t(j) + 1]; ++v) {
+                ringOf[v] = j;
+                columnOf[v] =
+                    ((m.ringFirstColumn[size_t(j)] + int(v - m.ringStart[size_t(j)])) % circle +
+                     circle) %
+                    circle;
+            }
+        std::set<std::pair<int, int>> quads;
+        std::map<std::pair<uint32_t, uint32_t>, int> edgeUses;
+        std::vector<bool> used(m.positions.size(), false);
+        for (size_t t = 0; t < m.indices.size(); t += 3) {
+            const uint32_t a = m.indices[t], b = m.indices[t + 1], c = m.indices[t + 2];
+            if (ringOf[c] == ringOf[a] + 1 && ringOf[b] == ringOf[a])  // (a, b, c): a quad's first
+                quads.insert({ringOf[a], columnOf[a]});
+            for (uint32_t v : {a, b, c}) used[v] = true;
+            for (auto [p, q] : {std::pair{a, b}, std::pair{b, c}, std::pair{c, a}})
+                ++edgeUses[std::minmax(p, q)];
+        }
+        for (const auto& [edge, n] : edgeUses) ASSERT_LE(n, 2);
+        for (bool u : used) ASSERT_TRUE(u);
+        // No ring wider than with the fixed 20° margin, and far rings narrower.
+        OceanMeshRequest fixed = View(eye, centre, half + kMaxReachMargin_rad);
+        OceanMesh m20;
+        BuildOceanMesh(*frame, fixed, m20);
+        ASSERT_EQ(m20.rings, m.rings);
+        const uint32_t columns20 = uint32_t(m20.segments + 1);
+        for (int j = 0; j < m.rings; ++j)
+            EXPECT_LE(m.ringStart[size_t(j) + 1] - m.ringStart[size_t(j)], columns20) << j;
+        // The horizon ring: the view's own columns, a column of rounding and one of margin
+        // on each side.
+        EXPECT_LE(m.ringStart.back() - m.ringStart[size_t(m.rings) - 1],
+                  uint32_t(std::ceil(2.0 * half / dphi)) + 5);
+        // Rest positions around the sector, where asin(D / r) < 20°.
+        const double reach = frame->MaxHorizontal_m();
+        int checked = 0;
+        for (size_t j = 0; j + 1 < m.radii_m.size(); j += 3) {
+            const double r = 0.5 * (m.radii_m[j] + m.radii_m[j + 1]);
+            if (reach / m.radii_m[j] >= std::sin(kMaxReachMargin_rad)) continue;
+            for (double off = -0.6; off <= 0.6; off += 0.0007) {
+                const double az = centre + off;
+                const double x0 = eye.x + r * std::sin(az), y0 = eye.y + r * std::cos(az);
+                const glm::dvec3 d = frame->Terms(x0, y0).displacement;
+                const double drawnAz = std::atan2(x0 + d.x - eye.x, y0 + d.y - eye.y);
+                if (std::abs(std::remainder(drawnAz - centre, 2.0 * kPi)) > half) continue;
+                const int column = ((int(std::floor(az / dphi)) % circle) + circle) % circle;
+                ASSERT_TRUE(quads.count({int(j), column}))
+                    << "band " << j << " r " << r << " azimuth " << az;
+                ++checked;
+            }
+        }
+        EXPECT_GT(checked, 10000);
     }
 }
 
