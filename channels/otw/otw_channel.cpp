@@ -300,6 +300,17 @@ constexpr float kMaxSeaPixelCosSpread = 0.005f;
 constexpr float kMaxSeaPixelRelativeCosSpread = 0.1f;
 constexpr float kMaxSeaPixelDepthRatio = 1.1f;
 
+// Vertex positions and normals of a triangle as SSE (x, y, z, 0), gathered once for the many
+// samples that see it.
+struct CachedTriangle {
+    uint32_t prim = kNoPrimitive;
+    int mesh = 0;
+    uint64_t frame = 0;  // OtwChannel's frame count when gathered (0: never)
+    F4 p0 = _mm_setzero_ps(), p1 = p0, p2 = p0, n0 = p0, n1 = p0, n2 = p0;
+    F4 a0 = p0, a1 = p0, a2 = p0;  // sea vertex attributes (ViewGeometry::OceanAttributes)
+    bool shadowable = false;       // a shadow ray from some point of it may meet a caster
+};
+
 // Per-thread scratch of the shading pass. The pixels of a row block are sorted into sky, sea
 // and model entries so that each kind is shaded in a tight loop: sky and sea four lanes at a
 // time in structure-of-arrays chunks (the bulk of the frame), the few model samples one by
@@ -321,6 +332,14 @@ struct BlockScratch {
     std::vector<uint8_t> vis;
     size_t skyCount = 0, seaCount = 0;
     SeaChunk chunk{};  // zeroed: lanes past a chunk's end are computed, then dropped
+    // Triangles met, direct-mapped by primitive id and tagged with the frame: neighbouring
+    // samples mostly see the same few triangles (a strip's ids are consecutive), and the next
+    // pixel rows the same ones again (sea vertices are ~6 pixels apart), so each is gathered
+    // about once per block. Entries of another frame or primitive are gathered anew; the
+    // gathered values depend only on the frame and the primitive, so whatever the cache holds
+    // the shading is the same.
+    static constexpr uint32_t kTriangleCacheSize = 1024;
+    std::vector<CachedTriangle> triangles = std::vector<CachedTriangle>(kTriangleCacheSize);
 
     // Empties the lists and makes the sky and sea lists hold at least n entries.
     void Reset(size_t n) {
@@ -335,16 +354,6 @@ struct BlockScratch {
         modelLit.clear();
         origins.clear(), originOwner.clear();
     }
-};
-
-// Vertex positions and normals of a triangle as SSE (x, y, z, 0), gathered once for the many
-// samples that see it.
-struct CachedTriangle {
-    uint32_t prim = kNoPrimitive;
-    int mesh = 0;
-    F4 p0 = _mm_setzero_ps(), p1 = p0, p2 = p0, n0 = p0, n1 = p0, n2 = p0;
-    F4 a0 = p0, a1 = p0, a2 = p0;  // sea vertex attributes (ViewGeometry::OceanAttributes)
-    bool shadowable = false;       // a shadow ray from some point of it may meet a caster
 };
 
 F4 Load3(const glm::vec3& v) { return _mm_setr_ps(v.x, v.y, v.z, 0.0f); }
@@ -386,6 +395,7 @@ struct FrameGeometry {
     glm::dvec3 forward;
     double tanH, tanV;
     glm::vec3 colStep;
+    uint64_t frame = 0;  // OtwChannel's frame count, from 1 (CachedTriangle::frame)
 
     glm::vec3 RowBase(double ndcY) const {
         return glm::vec3(forward + R * glm::dvec3(-tanH, 0.0, ndcY * tanV));
@@ -506,9 +516,10 @@ class BlockClassifier {
 
     // The cached triangle prim.
     const CachedTriangle& Triangle(uint32_t prim) {
-        CachedTriangle& tri = tri_[prim % kTriangleCacheSize];
-        if (tri.prim == prim) return tri;
+        CachedTriangle& tri = sc_.triangles[prim % BlockScratch::kTriangleCacheSize];
+        if (tri.prim == prim && tri.frame == g_.frame) return tri;
         g_.Fetch(prim, tri);
+        tri.frame = g_.frame;
         tri.shadowable = false;
         if (f_.shadows) {
             // Every shadow-ray origin on the triangle lies in its bounding box grown by the
@@ -706,10 +717,6 @@ class BlockClassifier {
     const int y0_;                            // first sample row of the block
     glm::vec3 sampleRow_[kMaxSupersampling];  // RowBase of the pixel row's sample rows
     size_t rowIndex_[kMaxSupersampling];      // visibility index of their first sample
-    // Triangles last met, direct-mapped by primitive id: neighbouring samples mostly see the
-    // same few triangles (a strip's ids are consecutive), so each is gathered about once.
-    static constexpr uint32_t kTriangleCacheSize = 16;
-    CachedTriangle tri_[kTriangleCacheSize];
 };
 
 // Traces the block's shadow rays and stores the sun visibility of its sea and model entries;
@@ -987,6 +994,7 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
                     cam.TanHalfV(),
                     glm::vec3(0.0f)};
     g.colStep = glm::vec3(g.R * glm::dvec3(2.0 * g.tanH / sw, 0.0, 0.0));
+    g.frame = ++frames_;
     CHECK(geometry_.OceanAttributes().size() == ocean.positions.size());
     g.meshes.push_back({ocean.positions.data(), ocean.normals.data(), ocean.indices.data(),
                         geometry_.OceanAttributes().data()});
