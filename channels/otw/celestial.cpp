@@ -69,10 +69,11 @@ std::vector<scene::VisibleStar> StarsNearView::Visible(const ChannelCamera& cam,
     // of the axis.
     const double cone = std::atan(std::hypot(cam.TanHalfH(), cam.TanHalfV()));
     // Refraction lifts a star by at most its value at the horizon (largest at −1°, where
-    // scene::ApparentAltitude_rad's formula peaks), taken 1.5 times.
+    // scene::ApparentAltitude_rad's formula peaks), so the apparent directions at the survey
+    // and now are each within that of the true ones: twice it.
     const double h = -M_PI / 180.0;
     const double refraction =
-        1.5 * (scene::ApparentAltitude_rad(h, observer.pressure_hPa, observer.temperature_C) - h);
+        2.0 * (scene::ApparentAltitude_rad(h, observer.pressure_hPa, observer.temperature_C) - h);
     // Earth's rotation rate (7.292e-5 rad/s, sidereal) with 5 % for precession, nutation and
     // aberration, whose rates are below 1e-6 of it.
     constexpr double kSkyRate_radPerS = 7.3e-5 * 1.05;

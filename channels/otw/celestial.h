@@ -54,8 +54,8 @@ void AddMoonAndStars(const ChannelCamera& camera, const VisibilityBuffer& vis, c
 // nutation and aberration per star were ~3 % of an OTW frame). A star is kept when, at the last
 // survey (all stars carried to their place), it lay within the view's corner angle plus
 // kMarginRad of the camera axis; the survey holds while the sky's rotation since it (at most
-// Earth's rate, 7.3e-5 rad/s), the camera axis's turn and a change of refraction (at most its
-// value at the horizon) add up to less than that margin, and is redone otherwise.
+// Earth's rate, 7.3e-5 rad/s), the camera axis's turn and refraction (at most its value at the
+// horizon, at the survey and now) add up to less than that margin, and is redone otherwise.
 class StarsNearView {
   public:
     explicit StarsNearView(std::vector<scene::CatalogStar> catalog);
