@@ -145,9 +145,9 @@ void Intensifier::Process(const Image& samples, double time_s, int64_t frame) {
                     const float* b = a + 6;
                     const __m128 a03 = _mm_loadu_ps(a), b03 = _mm_loadu_ps(b);
                     const __m128 a45 =
-                        _mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(a + 4)));
+                        _mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(a + 4)));
                     const __m128 b45 =
-                        _mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(b + 4)));
+                        _mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(b + 4)));
                     const __m128 lo = _mm_unpacklo_ps(a03, b03);   // a0 b0 a1 b1
                     const __m128 hi = _mm_unpackhi_ps(a03, b03);   // a2 b2 a3 b3
                     const __m128 top = _mm_unpacklo_ps(a45, b45);  // a4 b4 a5 b5
