@@ -81,7 +81,9 @@ std::vector<scene::VisibleStar> StarsNearView::Visible(const ChannelCamera& cam,
         return std::acos(std::clamp(glm::dot(a, b), -1.0, 1.0));
     };
     bool valid = valid_ && observer.latitude_deg == observer0_.latitude_deg &&
-                 observer.longitude_deg == observer0_.longitude_deg && cone <= cone0_rad_;
+                 observer.longitude_deg == observer0_.longitude_deg &&
+                 observer.pressure_hPa == observer0_.pressure_hPa &&
+                 observer.temperature_C == observer0_.temperature_C && cone <= cone0_rad_;
     if (valid) {
         const double dt_s = std::abs(double(t.unixNs - t0_.unixNs)) * 1e-9;
         valid = kSkyRate_radPerS * dt_s + angle(axis, axis0_) + refraction + (cone - cone0_rad_) <
