@@ -59,6 +59,56 @@ double MoonLuminance(const MoonDisc& moon, const glm::dvec3& d) {
     return glm::dot(normal, moon.towardSun) > 0.0 ? moon.luminance_cdm2 : 0.0;
 }
 
+StarsNearView::StarsNearView(std::vector<scene::CatalogStar> catalog)
+    : catalog_(std::move(catalog)) {}
+
+std::vector<scene::VisibleStar> StarsNearView::Visible(const ChannelCamera& cam, scene::UtcTime t,
+                                                       const scene::Observer& observer) {
+    const glm::dvec3 axis = cam.worldFromCamera.worldFromBody * glm::dvec3(0.0, 1.0, 0.0);
+    // Every direction in view (the frustum's corners are its farthest) lies within this angle
+    // of the axis.
+    const double cone = std::atan(std::hypot(cam.TanHalfH(), cam.TanHalfV()));
+    // Refraction lifts a star by at most its value at the horizon (largest at −1°, where
+    // scene::ApparentAltitude_rad's formula peaks), so the apparent directions at the survey
+    // and now are each within that of the true ones: twice it.
+    const double h = -M_PI / 180.0;
+    const double refraction =
+        2.0 * (scene::ApparentAltitude_rad(h, observer.pressure_hPa, observer.temperature_C) - h);
+    // Earth's rotation rate (7.292e-5 rad/s, sidereal) with 5 % for precession, nutation and
+    // aberration, whose rates are below 1e-6 of it.
+    constexpr double kSkyRate_radPerS = 7.3e-5 * 1.05;
+    const auto angle = [](const glm::dvec3& a, const glm::dvec3& b) {
+        return std::acos(std::clamp(glm::dot(a, b), -1.0, 1.0));
+    };
+    bool valid = valid_ && observer.latitude_deg == observer0_.latitude_deg &&
+                 observer.longitude_deg == observer0_.longitude_deg &&
+                 observer.pressure_hPa == observer0_.pressure_hPa &&
+                 observer.temperature_C == observer0_.temperature_C && cone <= cone0_rad_;
+    if (valid) {
+        const double dt_s = std::abs(double(t.unixNs - t0_.unixNs)) * 1e-9;
+        valid = kSkyRate_radPerS * dt_s + angle(axis, axis0_) + refraction + (cone - cone0_rad_) <
+                kMarginRad;
+    }
+    if (!valid) {
+        // Survey: every star's apparent direction now, as scene::VisibleStars computes it
+        // (below the horizon too, since such a star may rise into view).
+        const double jde = scene::JulianEphemerisDay(t);
+        kept_.clear();
+        for (const scene::CatalogStar& s : catalog_) {
+            const scene::CelestialPosition p =
+                scene::HorizontalPosition(scene::StarApparentGeocentric(s, jde), t, observer);
+            if (angle(p.direction, axis) <= cone + kMarginRad) kept_.push_back(s);
+        }
+        valid_ = true;
+        t0_ = t;
+        axis0_ = axis;
+        cone0_rad_ = cone;
+        observer0_ = observer;
+        ++surveys_;
+    }
+    return scene::VisibleStars(kept_, t, observer);
+}
+
 double SampleSolidAngle_sr(const ChannelCamera& cam, int sx, int sy) {
     const double du = 2.0 * cam.TanHalfH() / cam.SampleWidth();
     const double dv = 2.0 * cam.TanHalfV() / cam.SampleHeight();
@@ -69,14 +119,17 @@ double SampleSolidAngle_sr(const ChannelCamera& cam, int sx, int sy) {
 }
 
 void AddMoonAndStars(const ChannelCamera& cam, const VisibilityBuffer& vis, const MoonDisc& moon,
-                     const std::vector<scene::VisibleStar>& stars, Image& radiance) {
+                     const std::vector<scene::VisibleStar>& stars, Image& radiance,
+                     std::vector<uint8_t>* rowsDrawn) {
     const int sw = cam.SampleWidth(), sh = cam.SampleHeight();
     CHECK(radiance.width == sw && radiance.height == sh && radiance.channels == 3);
     CHECK(vis.width == sw && vis.height == sh);
+    CHECK(!rowsDrawn || rowsDrawn->size() == size_t(sh));
     const auto isSky = [&](int x, int y) { return vis.primitive[vis.Index(x, y)] == kNoPrimitive; };
     const auto add = [&](int x, int y, double L) {
         float* p = radiance.At(x, y);
         for (int c = 0; c < 3; ++c) p[c] += float(L);
+        if (rowsDrawn) (*rowsDrawn)[size_t(y)] = 1;
     };
 
     double mx = 0, my = 0;

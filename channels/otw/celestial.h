@@ -2,6 +2,7 @@
 // samples of an out-the-window frame.
 #pragma once
 
+#include <cmath>
 #include <glm/glm.hpp>
 #include <vector>
 
@@ -42,9 +43,43 @@ double MoonLuminance(const MoonDisc& moon, const glm::dvec3& d);
 // Adds the moon (per sample, to sky samples inside the disc) and each star (its illuminance
 // over the solid angle of the one sample holding its direction, when that sample sees sky) to
 // the supersampled radiance image (rgb, cd/m², grey light); the sensor's footprint integration
-// then spreads a star's light over its pixel. `vis` is the frame's visibility buffer.
+// then spreads a star's light over its pixel. `vis` is the frame's visibility buffer. When
+// rowsDrawn is given (one flag per sample row), the rows of the samples drawn on are set to 1.
 void AddMoonAndStars(const ChannelCamera& camera, const VisibilityBuffer& vis, const MoonDisc& moon,
-                     const std::vector<scene::VisibleStar>& stars, Image& radiance);
+                     const std::vector<scene::VisibleStar>& stars, Image& radiance,
+                     std::vector<uint8_t>* rowsDrawn = nullptr);
+
+// The catalogue's stars that can be in a camera's view, for scene::VisibleStars every frame
+// without carrying all ~900 stars to their apparent place each time (libnova's precession,
+// nutation and aberration per star were ~3 % of an OTW frame). A star is kept when, at the last
+// survey (all stars carried to their place), it lay within the view's corner angle plus
+// kMarginRad of the camera axis; the survey holds while the sky's rotation since it (at most
+// Earth's rate, 7.3e-5 rad/s), the camera axis's turn and refraction (at most its value at the
+// horizon, at the survey and now) add up to less than that margin, and is redone otherwise.
+class StarsNearView {
+  public:
+    explicit StarsNearView(std::vector<scene::CatalogStar> catalog);
+
+    // scene::VisibleStars(catalog, t, observer) less stars that cannot project into the camera's
+    // view: the same stars, values and order for every star in view (catalogIndex excepted:
+    // it indexes the kept subset).
+    std::vector<scene::VisibleStar> Visible(const ChannelCamera& camera, scene::UtcTime t,
+                                            const scene::Observer& observer);
+
+    size_t KeptCount() const { return kept_.size(); }
+    int Surveys() const { return surveys_; }
+
+    static constexpr double kMarginRad = 5.0 * M_PI / 180.0;
+
+  private:
+    std::vector<scene::CatalogStar> catalog_, kept_;
+    bool valid_ = false;
+    scene::UtcTime t0_;
+    glm::dvec3 axis0_{0.0};
+    double cone0_rad_ = 0.0;
+    scene::Observer observer0_;
+    int surveys_ = 0;
+};
 
 // Solid angle (sr) of sample (sx, sy) of the camera's supersampled grid: its area on the image
 // plane at unit distance times cos³ of its angle off the optical axis.

@@ -38,10 +38,11 @@ FlashLight FlashLightAt(const scene::Lightning& lightning, const LitFlashes& lit
 
 void DrawLightning(const ChannelCamera& cam, const VisibilityBuffer& vis,
                    const scene::Lightning& lightning, const LitFlashes& lit, double beta,
-                   Image& radiance) {
+                   Image& radiance, std::vector<uint8_t>* rowsDrawn) {
     const int sw = cam.SampleWidth(), sh = cam.SampleHeight();
     CHECK(radiance.width == sw && radiance.height == sh && radiance.channels == 3);
     CHECK(vis.width == sw && vis.height == sh);
+    CHECK(!rowsDrawn || rowsDrawn->size() == size_t(sh));
     const glm::dvec3 eye = cam.worldFromCamera.position_m;
     const glm::dmat3 cameraFromWorld = glm::transpose(cam.worldFromCamera.worldFromBody);
     const double tanH = cam.TanHalfH(), tanV = cam.TanHalfV();
@@ -85,6 +86,7 @@ void DrawLightning(const ChannelCamera& cam, const VisibilityBuffer& vis,
                                  (d2 * SampleSolidAngle_sr(cam, ix, iy));
                 float* px = radiance.At(ix, iy);
                 for (int c = 0; c < 3; ++c) px[c] += float(L);
+                if (rowsDrawn) (*rowsDrawn)[size_t(iy)] = 1;
             }
         }
     }

@@ -38,9 +38,10 @@ FlashLight FlashLightAt(const scene::Lightning& lightning, const LitFlashes& lit
 // components). The channel is optically thin, so each element dl radiates isotropically with
 // intensity I_l dl (Lightning::MeanSegmentIntensity_cdPerM): it adds I_l dl exp(−β d) / (d² Ω)
 // to the sample it projects into, Ω that sample's solid angle, unless the visibility buffer
-// holds something nearer there. Elements are at most half a sample apart on screen.
+// holds something nearer there. Elements are at most half a sample apart on screen. When
+// rowsDrawn is given (one flag per sample row), the rows of the samples drawn on are set to 1.
 void DrawLightning(const ChannelCamera& camera, const VisibilityBuffer& vis,
                    const scene::Lightning& lightning, const LitFlashes& lit, double extinction_perM,
-                   Image& radiance);
+                   Image& radiance, std::vector<uint8_t>* rowsDrawn = nullptr);
 
 }  // namespace seasense::channels

@@ -300,6 +300,17 @@ constexpr float kMaxSeaPixelCosSpread = 0.005f;
 constexpr float kMaxSeaPixelRelativeCosSpread = 0.1f;
 constexpr float kMaxSeaPixelDepthRatio = 1.1f;
 
+// Vertex positions and normals of a triangle as SSE (x, y, z, 0), gathered once for the many
+// samples that see it.
+struct CachedTriangle {
+    uint32_t prim = kNoPrimitive;
+    int mesh = 0;
+    uint64_t frame = 0;  // OtwChannel's frame count when gathered (0: never)
+    F4 p0 = _mm_setzero_ps(), p1 = p0, p2 = p0, n0 = p0, n1 = p0, n2 = p0;
+    F4 a0 = p0, a1 = p0, a2 = p0;  // sea vertex attributes (ViewGeometry::OceanAttributes)
+    bool shadowable = false;       // a shadow ray from some point of it may meet a caster
+};
+
 // Per-thread scratch of the shading pass. The pixels of a row block are sorted into sky, sea
 // and model entries so that each kind is shaded in a tight loop: sky and sea four lanes at a
 // time in structure-of-arrays chunks (the bulk of the frame), the few model samples one by
@@ -321,6 +332,14 @@ struct BlockScratch {
     std::vector<uint8_t> vis;
     size_t skyCount = 0, seaCount = 0;
     SeaChunk chunk{};  // zeroed: lanes past a chunk's end are computed, then dropped
+    // Triangles met, direct-mapped by primitive id and tagged with the frame: neighbouring
+    // samples mostly see the same few triangles (a strip's ids are consecutive), and the next
+    // pixel rows the same ones again (sea vertices are ~6 pixels apart), so each is gathered
+    // about once per block. Entries of another frame or primitive are gathered anew; the
+    // gathered values depend only on the frame and the primitive, so whatever the cache holds
+    // the shading is the same.
+    static constexpr uint32_t kTriangleCacheSize = 1024;
+    std::vector<CachedTriangle> triangles = std::vector<CachedTriangle>(kTriangleCacheSize);
 
     // Empties the lists and makes the sky and sea lists hold at least n entries.
     void Reset(size_t n) {
@@ -335,16 +354,6 @@ struct BlockScratch {
         modelLit.clear();
         origins.clear(), originOwner.clear();
     }
-};
-
-// Vertex positions and normals of a triangle as SSE (x, y, z, 0), gathered once for the many
-// samples that see it.
-struct CachedTriangle {
-    uint32_t prim = kNoPrimitive;
-    int mesh = 0;
-    F4 p0 = _mm_setzero_ps(), p1 = p0, p2 = p0, n0 = p0, n1 = p0, n2 = p0;
-    F4 a0 = p0, a1 = p0, a2 = p0;  // sea vertex attributes (ViewGeometry::OceanAttributes)
-    bool shadowable = false;       // a shadow ray from some point of it may meet a caster
 };
 
 F4 Load3(const glm::vec3& v) { return _mm_setr_ps(v.x, v.y, v.z, 0.0f); }
@@ -386,6 +395,7 @@ struct FrameGeometry {
     glm::dvec3 forward;
     double tanH, tanV;
     glm::vec3 colStep;
+    uint64_t frame = 0;  // OtwChannel's frame count, from 1 (CachedTriangle::frame)
 
     glm::vec3 RowBase(double ndcY) const {
         return glm::vec3(forward + R * glm::dvec3(-tanH, 0.0, ndcY * tanV));
@@ -454,14 +464,19 @@ struct FrameShading {
 
 // Pass 1 of a block of pixel rows [py0, py1): sorts its pixels into sky, sea and model
 // entries (pixel-rate where the pixel is uniform, else per sample) with surface positions
-// and normals, and collects the shadow rays that need tracing.
+// and normals, and collects the shadow rays that need tracing. kN is the supersampling factor
+// when known at compile time (the default 2, whose per-pixel loops then unroll; the same
+// operations in the same order), 0 for any other, read from the frame.
+template <int kN>
 class BlockClassifier {
   public:
     BlockClassifier(const FrameGeometry& g, const FrameShading& f, int py0, BlockScratch& sc)
-        : g_(g), f_(f), sc_(sc), y0_(py0 * g.n) {}
+        : g_(g), f_(f), sc_(sc), y0_(py0 * g.n) {
+        CHECK(kN == 0 || kN == g.n);
+    }
 
     void Pixels(int py) {
-        const int n = g_.n, sw = g_.sampleWidth;
+        const int n = N(), sw = g_.sampleWidth;
         for (int j = 0; j < n; ++j) {
             const int y = py * n + j;
             sampleRow_[j] = g_.RowBase(1.0 - 2.0 * (y + 0.5) / g_.sampleHeight);
@@ -497,11 +512,14 @@ class BlockClassifier {
     }
 
   private:
+    int N() const { return kN > 0 ? kN : g_.n; }
+
     // The cached triangle prim.
     const CachedTriangle& Triangle(uint32_t prim) {
-        CachedTriangle& tri = tri_[prim % kTriangleCacheSize];
-        if (tri.prim == prim) return tri;
+        CachedTriangle& tri = sc_.triangles[prim % BlockScratch::kTriangleCacheSize];
+        if (tri.prim == prim && tri.frame == g_.frame) return tri;
         g_.Fetch(prim, tri);
+        tri.frame = g_.frame;
         tri.shadowable = false;
         if (f_.shadows) {
             // Every shadow-ray origin on the triangle lies in its bounding box grown by the
@@ -522,9 +540,9 @@ class BlockClassifier {
     // Whether depths of the pixel's samples are within kMaxSeaPixelDepthRatio.
     bool DepthsClose(int x0) const {
         float dMin = std::numeric_limits<float>::infinity(), dMax = 0.0f;
-        for (int j = 0; j < g_.n; ++j) {
+        for (int j = 0; j < N(); ++j) {
             const float* depth = g_.vis.depth.data() + rowIndex_[j] + size_t(x0);
-            for (int i = 0; i < g_.n; ++i)
+            for (int i = 0; i < N(); ++i)
                 dMin = std::min(dMin, depth[i]), dMax = std::max(dMax, depth[i]);
         }
         return dMax <= kMaxSeaPixelDepthRatio * dMin;
@@ -548,18 +566,20 @@ class BlockClassifier {
     // pixel rate (at the mean barycentrics) unless depth or c = n·v vary too much across it
     // (then returns false, nothing added). On one triangle c is linear in the barycentrics.
     bool SeaTrianglePixel(int x0, uint32_t k, uint32_t prim) {
-        const int n = g_.n, count = n * n;
+        const int n = N(), count = n * n;
         if (!DepthsClose(x0)) return false;
         const CachedTriangle& tri = Triangle(prim);
-        float b1[kMaxSupersampling * kMaxSupersampling], b2[kMaxSupersampling * kMaxSupersampling];
+        // The samples' barycentrics are read in place, row by row (a local copy of them cost a
+        // memmove call per row).
+        const float *b1[kMaxSupersampling], *b2[kMaxSupersampling];
         float b1Sum = 0.0f, b2Sum = 0.0f;
         for (int j = 0; j < n; ++j) {
             const size_t index = rowIndex_[j] + size_t(x0);
+            b1[j] = g_.vis.b1.data() + index;
+            b2[j] = g_.vis.b2.data() + index;
             for (int i = 0; i < n; ++i) {
-                b1[j * n + i] = g_.vis.b1[index + size_t(i)];
-                b2[j * n + i] = g_.vis.b2[index + size_t(i)];
-                b1Sum += b1[j * n + i];
-                b2Sum += b2[j * n + i];
+                b1Sum += b1[j][i];
+                b2Sum += b2[j][i];
             }
         }
         // The mean (a power-of-two scale for N = 1, 2, 4: exact).
@@ -570,16 +590,20 @@ class BlockClassifier {
         const float c0 = Dot3(tri.n0, toEye);
         const float d1 = Dot3(tri.n1, toEye) - c0, d2 = Dot3(tri.n2, toEye) - c0;
         float cMin = std::numeric_limits<float>::infinity(), cMax = -cMin;
-        for (int s = 0; s < count; ++s) {
-            const float c = c0 + b1[s] * d1 + b2[s] * d2;
-            cMin = std::min(cMin, c), cMax = std::max(cMax, c);
+        for (int j = 0; j < n; ++j) {
+            for (int i = 0; i < n; ++i) {
+                const float c = c0 + b1[j][i] * d1 + b2[j][i] * d2;
+                cMin = std::min(cMin, c), cMax = std::max(cMax, c);
+            }
         }
         if (!CosSpreadSmall(cMin, cMax, std::sqrt(Dot3(toEye, toEye)))) return false;
         const size_t e =
             AddSea(k | kPixelEntry, p, nSum, InterpolateAttributes(tri, b1Sum * inv, b2Sum * inv));
         if (tri.shadowable) {
             F4 samples[kMaxSupersampling * kMaxSupersampling], unused;
-            for (int s = 0; s < count; ++s) Interpolate(tri, b1[s], b2[s], samples[s], unused);
+            for (int j = 0; j < n; ++j)
+                for (int i = 0; i < n; ++i)
+                    Interpolate(tri, b1[j][i], b2[j][i], samples[j * n + i], unused);
             SeaShadowRays(e, samples, count);
         }
         return true;
@@ -588,7 +612,7 @@ class BlockClassifier {
     // As SeaTrianglePixel, for a pixel whose sea samples lie on different triangles: the
     // samples' positions and normals are interpolated one by one and averaged.
     bool SeaPixel(int x0, uint32_t k) {
-        const int n = g_.n, count = n * n;
+        const int n = N(), count = n * n;
         if (!DepthsClose(x0)) return false;
         F4 p[kMaxSupersampling * kMaxSupersampling], nrm[kMaxSupersampling * kMaxSupersampling];
         F4 pSum = _mm_setzero_ps(), nSum = _mm_setzero_ps(), aSum = _mm_setzero_ps();
@@ -693,10 +717,6 @@ class BlockClassifier {
     const int y0_;                            // first sample row of the block
     glm::vec3 sampleRow_[kMaxSupersampling];  // RowBase of the pixel row's sample rows
     size_t rowIndex_[kMaxSupersampling];      // visibility index of their first sample
-    // Triangles last met, direct-mapped by primitive id: neighbouring samples mostly see the
-    // same few triangles (a strip's ids are consecutive), so each is gathered about once.
-    static constexpr uint32_t kTriangleCacheSize = 16;
-    CachedTriangle tri_[kTriangleCacheSize];
 };
 
 // Traces the block's shadow rays and stores the sun visibility of its sea and model entries;
@@ -835,7 +855,8 @@ OtwChannel::OtwChannel(const scene::World& world, const scene::ChannelSettings& 
     const glm::dvec3 foam = reflectance("foam", {0.50, 0.53, 0.55});
     for (int c = 0; c < 3; ++c)
         shore_[c] = {kSeaRrs[c], kCoastalK_perm[c], float(wet[c]), float(dry[c]), float(foam[c])};
-    stars_ = scene::StarSky(scene::LoadStarCatalog(scene::DefaultStarCatalogPath()));
+    stars_ =
+        std::make_unique<StarsNearView>(scene::LoadStarCatalog(scene::DefaultStarCatalogPath()));
 }
 
 OtwChannel::OtwChannel(const scene::World& world, const scene::ChannelSettings& settings,
@@ -973,6 +994,7 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
                     cam.TanHalfV(),
                     glm::vec3(0.0f)};
     g.colStep = glm::vec3(g.R * glm::dvec3(2.0 * g.tanH / sw, 0.0, 0.0));
+    g.frame = ++frames_;
     CHECK(geometry_.OceanAttributes().size() == ocean.positions.size());
     g.meshes.push_back({ocean.positions.data(), ocean.normals.data(), ocean.indices.data(),
                         geometry_.OceanAttributes().data()});
@@ -1027,8 +1049,13 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
         const int py1 = std::min(cam.height, py0 + pixelRowsPerBlock);
         BlockScratch& s = scratch.local();
         s.Reset(size_t(py1 - py0) * size_t(n) * size_t(sw));
-        BlockClassifier classify(g, f, py0, s);
-        for (int py = py0; py < py1; ++py) classify.Pixels(py);
+        if (n == 2) {
+            BlockClassifier<2> classify(g, f, py0, s);
+            for (int py = py0; py < py1; ++py) classify.Pixels(py);
+        } else {
+            BlockClassifier<0> classify(g, f, py0, s);
+            for (int py = py0; py < py1; ++py) classify.Pixels(py);
+        }
         blockRays[size_t(block)] = TraceSunVisibility(f, n, s);
         // The block's rows are contiguous in the image: sample k is at out + 3k.
         float* out = radiance.At(0, py0 * n);
@@ -1052,37 +1079,44 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     // straight into radiance.
     const auto overlay = [&](const auto& draw, const glm::dvec3& perCdm2) {
         if (!basis_) {
-            draw(radiance);
+            draw(radiance, nullptr);
             return;
         }
-        // overlay_ is all zeros between uses: each use clears the samples it drew on.
+        // overlay_ is all zeros between uses: each use clears the samples it drew on. Only the
+        // sample rows drawn on are visited (a few stars, the moon, bolts), not the whole image.
         if (overlay_.width != sw || overlay_.height != sh) overlay_ = Image(sw, sh, 3);
-        draw(overlay_);
+        overlayRows_.assign(size_t(sh), 0);
+        draw(overlay_, &overlayRows_);
         const glm::vec3 v(perCdm2);
-        for (size_t i = 0; i < overlay_.pixels.size(); i += 3) {
-            const float y = overlay_.pixels[i + 1];
-            if (y == 0.0f) continue;
-            for (int c = 0; c < 3; ++c) {
-                radiance.pixels[i + size_t(c)] += y * v[c];
-                overlay_.pixels[i + size_t(c)] = 0.0f;
+        const size_t rowValues = 3 * size_t(sw);
+        for (size_t row = 0; row < size_t(sh); ++row) {
+            if (!overlayRows_[row]) continue;
+            for (size_t i = row * rowValues; i < (row + 1) * rowValues; i += 3) {
+                const float y = overlay_.pixels[i + 1];
+                if (y == 0.0f) continue;
+                for (int c = 0; c < 3; ++c) {
+                    radiance.pixels[i + size_t(c)] += y * v[c];
+                    overlay_.pixels[i + size_t(c)] = 0.0f;
+                }
             }
         }
     };
     if (basis_) {
         // The moon and the stars have different colours.
         overlay(
-            [&](Image& img) {
-                AddMoonAndStars(cam, vis, MakeMoonDisc(moonAboveClouds, state.sun), {}, img);
+            [&](Image& img, std::vector<uint8_t>* rows) {
+                AddMoonAndStars(cam, vis, MakeMoonDisc(moonAboveClouds, state.sun), {}, img, rows);
             },
             basis_->moon);
         overlay(
-            [&](Image& img) {
-                AddMoonAndStars(cam, vis, MoonDisc{}, stars_.Visible(state.utc, observer), img);
+            [&](Image& img, std::vector<uint8_t>* rows) {
+                AddMoonAndStars(cam, vis, MoonDisc{}, stars_->Visible(cam, state.utc, observer),
+                                img, rows);
             },
             basis_->stars);
     } else {
         AddMoonAndStars(cam, vis, MakeMoonDisc(moonAboveClouds, state.sun),
-                        stars_.Visible(state.utc, observer), radiance);
+                        stars_->Visible(cam, state.utc, observer), radiance);
     }
     // --- Cloud layers (channels/otw/cloud_layer) over the sky, sun, moon and stars. ---
     if (world_.Clouds()) {
@@ -1096,8 +1130,11 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     }
     // --- end of cloud layers ---
     if (lightning)
-        overlay([&](Image& img) { DrawLightning(cam, vis, *lightning, flashes, beta, img); },
-                basis_ ? basis_->lightning : glm::dvec3(1.0));
+        overlay(
+            [&](Image& img, std::vector<uint8_t>* rows) {
+                DrawLightning(cam, vis, *lightning, flashes, beta, img, rows);
+            },
+            basis_ ? basis_->lightning : glm::dvec3(1.0));
     // --- Surf spray (channels/otw/spray_overlay): foam-white droplet clumps, depth-tested (the
     // foam reflectance and the downwelling light are in the basis's components). ---
     DrawSpray(world_, state, cam, vis, {shore_[0].rhoFoam, shore_[1].rhoFoam, shore_[2].rhoFoam},

@@ -18,6 +18,7 @@ namespace seasense::channels {
 class BlackbodyGlowTable;
 class ChannelPlumes;
 class CloudSky;
+class StarsNearView;
 
 // --- Band basis (channels/nvg) ---
 // Shading in another band's three-component basis instead of Rec.709 (NVG: three photocathode
@@ -81,13 +82,15 @@ class OtwChannel {
     std::unique_ptr<radiometry::AnalyticSky> sky_;
     glm::dvec3 skySun_{0.0};
     glm::dvec3 skyMoon_{0.0};
-    scene::StarSky stars_;  // the bright-star list (configs/stars), places cached per hour
+    std::unique_ptr<StarsNearView> stars_;  // the bright-star list (configs/stars)
     std::unique_ptr<ShadeScratch> scratch_;
     std::unique_ptr<ChannelPlumes> plumes_;  // scenario plumes (channels/plume)
     std::unique_ptr<CloudSky> clouds_;       // cloud pass scratch (environment.clouds)
     OtwFrameStats stats_;
+    uint64_t frames_ = 0;  // frames rendered (tags the shading pass's triangle cache)
     std::unique_ptr<OtwBandBasis> basis_;            // null: Rec.709
     Image overlay_;                                  // band basis: grey overlays before conversion
+    std::vector<uint8_t> overlayRows_;               // band basis: sample rows overlay_ drew on
     std::unique_ptr<BlackbodyGlowTable> basisGlow_;  // band basis: the flames' glow
 };
 

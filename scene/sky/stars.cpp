@@ -134,17 +134,14 @@ double ZenithExtinctionV_mag(double height_m) {
     return 0.1451 * std::exp(-height_m / 7996.0) + 0.120 * std::exp(-height_m / 1500.0) + 0.016;
 }
 
-namespace {
-
-// The stars above the horizon, given each catalogue star's apparent geocentric place (place(i)).
-template <class Place>
-std::vector<VisibleStar> StarsAboveHorizon(const std::vector<CatalogStar>& catalog,
-                                           const Place& place, UtcTime t,
-                                           const Observer& observer) {
+std::vector<VisibleStar> VisibleStars(const std::vector<CatalogStar>& catalog, UtcTime t,
+                                      const Observer& observer) {
+    const double jde = JulianEphemerisDay(t);
     const double k = ZenithExtinctionV_mag(observer.height_m);
     std::vector<VisibleStar> out;
     for (size_t i = 0; i < catalog.size(); ++i) {
-        const CelestialPosition p = HorizontalPosition(place(i), t, observer);
+        const CelestialPosition p =
+            HorizontalPosition(StarApparentGeocentric(catalog[i], jde), t, observer);
         if (p.altitude_rad < 0.0) continue;
         VisibleStar s;
         s.direction = p.direction;
@@ -155,30 +152,6 @@ std::vector<VisibleStar> StarsAboveHorizon(const std::vector<CatalogStar>& catal
         out.push_back(s);
     }
     return out;
-}
-
-}  // namespace
-
-std::vector<VisibleStar> VisibleStars(const std::vector<CatalogStar>& catalog, UtcTime t,
-                                      const Observer& observer) {
-    const double jde = JulianEphemerisDay(t);
-    return StarsAboveHorizon(
-        catalog, [&](size_t i) { return StarApparentGeocentric(catalog[i], jde); }, t, observer);
-}
-
-StarSky::StarSky(std::vector<CatalogStar> catalog) : catalog_(std::move(catalog)) {}
-
-std::vector<VisibleStar> StarSky::Visible(UtcTime t, const Observer& observer) {
-    const double jdeHour = std::round(JulianEphemerisDay(t) * 24.0) / 24.0;
-    if (!havePlaces_ || jdeHour != placesJde_) {
-        places_.resize(catalog_.size());
-        for (size_t i = 0; i < catalog_.size(); ++i)
-            places_[i] = StarApparentGeocentric(catalog_[i], jdeHour);
-        placesJde_ = jdeHour;
-        havePlaces_ = true;
-    }
-    return StarsAboveHorizon(
-        catalog_, [&](size_t i) { return places_[i]; }, t, observer);
 }
 
 }  // namespace seasense::scene

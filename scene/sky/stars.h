@@ -60,26 +60,4 @@ struct VisibleStar {
 std::vector<VisibleStar> VisibleStars(const std::vector<CatalogStar>& catalog, UtcTime t,
                                       const Observer& observer);
 
-// A catalogue with its apparent geocentric places kept for the hour: what a channel asks every
-// frame. Visible(t) equals VisibleStars(catalog, t, observer) except that the apparent places
-// are those of t's Julian Ephemeris Day rounded to the nearest hour, a pure function of t (so
-// any frame gives the same stars whatever was rendered before it). The apparent place of a
-// star drifts by at most ~0.64″ per day (Meeus, "Astronomical Algorithms" 2nd ed.: precession
-// 50.3″/yr ≈ 0.14″/d, ch. 21; annual aberration 20.5″ over a year ≈ 0.35″/d, ch. 23; nutation's
-// largest rates, 17.2″ over 18.6 yr, 1.32″ over 182.6 d and 0.20″ over 13.66 d, ≈ 0.15″/d,
-// ch. 22), so the rounding moves a star by ≤ 0.014″ — 1/20 000 of a 640-pixel 60° pixel.
-class StarSky {
-  public:
-    explicit StarSky(std::vector<CatalogStar> catalog = {});
-    const std::vector<CatalogStar>& Catalog() const { return catalog_; }
-    // Not thread-safe: the hour's places are cached in the object.
-    std::vector<VisibleStar> Visible(UtcTime t, const Observer& observer);
-
-  private:
-    std::vector<CatalogStar> catalog_;
-    std::vector<EquatorialPosition> places_;  // apparent geocentric places at placesJde_
-    double placesJde_ = 0.0;
-    bool havePlaces_ = false;
-};
-
 }  // namespace seasense::scene

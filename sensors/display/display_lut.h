@@ -31,7 +31,7 @@ class DisplayLut {
   private:
     int edge_;
     float minLog2_, scale_;     // grid coordinate = (log2 x − minLog2) · scale
-    std::vector<float> table_;  // edge³ × 3, red fastest
+    std::vector<float> table_;  // edge³ × 3, red fastest, and one float of padding
 };
 
 }  // namespace seasense::sensors

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace seasense::channels {
@@ -166,6 +167,45 @@ TEST(Celestial, MoonInViewIsDrawnWithItsLightAndOccultsStars) {
     // the western (left, looking north) one.
     EXPECT_NEAR(E, s.moon.illuminance_lux, 0.02 * s.moon.illuminance_lux);
     EXPECT_GT(Eleft, 0.97 * E);
+}
+
+// StarsNearView against every star carried to its place each frame (scene::VisibleStars): a
+// camera panning and pitching over a night while the sky turns draws the same image bit for
+// bit, and the cached subset is a small part of the catalogue, surveyed on few frames.
+TEST(Celestial, StarsNearViewDrawsWhatTheWholeCatalogueDraws) {
+    const std::vector<scene::CatalogStar> catalog =
+        scene::LoadStarCatalog(scene::DefaultStarCatalogPath());
+    StarsNearView near(catalog);
+    scene::Observer observer;
+    observer.latitude_deg = 36.6;
+    observer.longitude_deg = -121.9;
+    observer.height_m = 12.0;
+    const scene::UtcTime start = *scene::ParseIso8601("2026-06-22T06:00:00Z");
+    ChannelCamera cam = TestCamera();
+    cam.hfov_rad = 40.0 * kDeg;
+    const VisibilityBuffer vis = AllSky(cam);
+    constexpr int kFrames = 240;
+    int framesWithStars = 0;
+    for (int f = 0; f < kFrames; ++f) {
+        // 0.3° of heading per frame, a 3° pitch swell, 20 s of sky time per frame (the sky
+        // turns 0.08° a frame): 72° of pan and 80 min of sky.
+        scene::Attitude a;
+        a.heading_rad = 0.3 * kDeg * f;
+        a.pitch_rad = (10.0 + 3.0 * std::sin(0.2 * f)) * kDeg;
+        a.roll_rad = 2.0 * kDeg * std::sin(0.13 * f);
+        cam.worldFromCamera = scene::PoseFrom(glm::dvec3(0.0, 0.0, 12.0), a);
+        const scene::UtcTime t = start.PlusSeconds(20.0 * f);
+        Image all(cam.SampleWidth(), cam.SampleHeight(), 3), kept = all;
+        AddMoonAndStars(cam, vis, MoonDisc{}, scene::VisibleStars(catalog, t, observer), all);
+        AddMoonAndStars(cam, vis, MoonDisc{}, near.Visible(cam, t, observer), kept);
+        ASSERT_EQ(all.pixels, kept.pixels) << "frame " << f;
+        framesWithStars +=
+            std::any_of(all.pixels.begin(), all.pixels.end(), [](float v) { return v > 0.0f; });
+    }
+    EXPECT_EQ(framesWithStars, kFrames);
+    EXPECT_LT(near.KeptCount(), catalog.size() / 4);
+    EXPECT_LT(near.Surveys(), kFrames / 4);
+    EXPECT_GT(near.Surveys(), 1);
 }
 
 }  // namespace
