@@ -159,6 +159,7 @@ class FlirChannel {
         // Heat-balance models: index into heatBalance_ (one per material), or −1.
         int heatBalance = -1;
     };
+    struct ShadeBlock;
     struct ShadeScratch;
     struct FrameShading;
 
@@ -176,6 +177,9 @@ class FlirChannel {
     // Shades the sample rows [y0, y1) into out (the rows' first sample); returns the number
     // of shadow rays traced.
     uint64_t ShadeRows(const FrameShading& frame, int y0, int y1, float* out);
+    // Shade the first count (≤ kChunk) gathered sky or sea samples of a row block into out.
+    void ShadeSky(ShadeBlock& block, size_t count, float* out) const;
+    void ShadeSea(const FrameShading& frame, ShadeBlock& block, size_t count, float* out) const;
 
     const scene::World& world_;
     FlirImagerSetup setup_;
