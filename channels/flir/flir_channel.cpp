@@ -73,10 +73,25 @@ double SunIrradiance_W_m2(const scene::Scenario& scenario, double time_s, glm::d
            kSunEfficacy_lm_W;
 }
 
+double OrientationTemperatures::SunMemo::Irradiance_W_m2(double time_s, glm::dvec3& direction) {
+    if (!valid_ || time_s != time_s_) {
+        irradiance_W_m2_ = SunIrradiance_W_m2(scenario_, time_s, direction_);
+        time_s_ = time_s;
+        valid_ = true;
+    }
+    direction = direction_;
+    return irradiance_W_m2_;
+}
+
 OrientationTemperatures::OrientationTemperatures(
     const radiometry::HeatBalanceParameters& parameters, const Environment& environment,
-    const scene::Scenario& scenario)
-    : parameters_(parameters), environment_(environment), scenario_(scenario) {}
+    const scene::Scenario& scenario, std::shared_ptr<SunMemo> sun)
+    : parameters_(parameters),
+      environment_(environment),
+      scenario_(scenario),
+      sun_(std::move(sun)) {
+    CHECK(sun_);
+}
 
 glm::dvec3 OrientationTemperatures::ClassNormal(int o) {
     if (o == 0) return {0.0, 0.0, 1.0};
@@ -85,9 +100,9 @@ glm::dvec3 OrientationTemperatures::ClassNormal(int o) {
     return {std::sin(az), std::cos(az), 0.0};
 }
 
-OrientationTemperatures::Drivers OrientationTemperatures::DriversAt(double time_s) const {
+OrientationTemperatures::Drivers OrientationTemperatures::DriversAt(double time_s) {
     glm::dvec3 sunDir;
-    const double E = SunIrradiance_W_m2(scenario_, time_s, sunDir);
+    const double E = sun_->Irradiance_W_m2(time_s, sunDir);
     Drivers all;
     for (int cls = 0; cls < kClasses; ++cls) {
         const int o = cls % kOrientations;
@@ -115,6 +130,15 @@ std::array<double, OrientationTemperatures::kClasses> OrientationTemperatures::S
 
 std::array<double, OrientationTemperatures::kClasses> OrientationTemperatures::At(double time_s) {
     CHECK(time_s >= -kSpinUp_s);
+    if (lastValid_ && time_s == lastTime_s_) return last_;
+    last_ = Compute(time_s);
+    lastTime_s_ = time_s;
+    lastValid_ = true;
+    return last_;
+}
+
+std::array<double, OrientationTemperatures::kClasses> OrientationTemperatures::Compute(
+    double time_s) {
     const auto NodeTime = [](size_t k) { return -kSpinUp_s + double(k) * kGridStep_s; };
     const size_t k = size_t(std::floor((time_s + kSpinUp_s) / kGridStep_s));
     if (nodes_.empty()) {
@@ -262,8 +286,10 @@ FlirChannel::EntityThermal FlirChannel::ThermalOf(const radiometry::Material& m,
         if (added) {
             radiometry::HeatBalanceParameters p = m.thermal.heatBalance;
             p.emissivity = m.emissivityLwir;
+            if (!sunMemo_)
+                sunMemo_ = std::make_shared<OrientationTemperatures::SunMemo>(world_.GetScenario());
             heatBalance_.push_back(
-                std::make_unique<OrientationTemperatures>(p, env, world_.GetScenario()));
+                std::make_unique<OrientationTemperatures>(p, env, world_.GetScenario(), sunMemo_));
         }
         t.heatBalance = it->second;
     } else {
