@@ -73,10 +73,25 @@ double SunIrradiance_W_m2(const scene::Scenario& scenario, double time_s, glm::d
            kSunEfficacy_lm_W;
 }
 
+double OrientationTemperatures::SunMemo::Irradiance_W_m2(double time_s, glm::dvec3& direction) {
+    if (!valid_ || time_s != time_s_) {
+        irradiance_W_m2_ = SunIrradiance_W_m2(scenario_, time_s, direction_);
+        time_s_ = time_s;
+        valid_ = true;
+    }
+    direction = direction_;
+    return irradiance_W_m2_;
+}
+
 OrientationTemperatures::OrientationTemperatures(
     const radiometry::HeatBalanceParameters& parameters, const Environment& environment,
-    const scene::Scenario& scenario)
-    : parameters_(parameters), environment_(environment), scenario_(scenario) {}
+    const scene::Scenario& scenario, std::shared_ptr<SunMemo> sun)
+    : parameters_(parameters),
+      environment_(environment),
+      scenario_(scenario),
+      sun_(std::move(sun)) {
+    CHECK(sun_);
+}
 
 glm::dvec3 OrientationTemperatures::ClassNormal(int o) {
     if (o == 0) return {0.0, 0.0, 1.0};
@@ -85,9 +100,9 @@ glm::dvec3 OrientationTemperatures::ClassNormal(int o) {
     return {std::sin(az), std::cos(az), 0.0};
 }
 
-OrientationTemperatures::Drivers OrientationTemperatures::DriversAt(double time_s) const {
+OrientationTemperatures::Drivers OrientationTemperatures::DriversAt(double time_s) {
     glm::dvec3 sunDir;
-    const double E = SunIrradiance_W_m2(scenario_, time_s, sunDir);
+    const double E = sun_->Irradiance_W_m2(time_s, sunDir);
     Drivers all;
     for (int cls = 0; cls < kClasses; ++cls) {
         const int o = cls % kOrientations;
@@ -115,6 +130,15 @@ std::array<double, OrientationTemperatures::kClasses> OrientationTemperatures::S
 
 std::array<double, OrientationTemperatures::kClasses> OrientationTemperatures::At(double time_s) {
     CHECK(time_s >= -kSpinUp_s);
+    if (lastValid_ && time_s == lastTime_s_) return last_;
+    last_ = Compute(time_s);
+    lastTime_s_ = time_s;
+    lastValid_ = true;
+    return last_;
+}
+
+std::array<double, OrientationTemperatures::kClasses> OrientationTemperatures::Compute(
+    double time_s) {
     const auto NodeTime = [](size_t k) { return -kSpinUp_s + double(k) * kGridStep_s; };
     const size_t k = size_t(std::floor((time_s + kSpinUp_s) / kGridStep_s));
     if (nodes_.empty()) {
@@ -262,8 +286,10 @@ FlirChannel::EntityThermal FlirChannel::ThermalOf(const radiometry::Material& m,
         if (added) {
             radiometry::HeatBalanceParameters p = m.thermal.heatBalance;
             p.emissivity = m.emissivityLwir;
+            if (!sunMemo_)
+                sunMemo_ = std::make_shared<OrientationTemperatures::SunMemo>(world_.GetScenario());
             heatBalance_.push_back(
-                std::make_unique<OrientationTemperatures>(p, env, world_.GetScenario()));
+                std::make_unique<OrientationTemperatures>(p, env, world_.GetScenario(), sunMemo_));
         }
         t.heatBalance = it->second;
     } else {
@@ -333,44 +359,101 @@ struct FlirChannel::FrameShading {
     glm::dvec3 forward{0.0}, right{0.0}, up{0.0};
 };
 
-// Per-thread scratch of the shading pass, kept between frames. Samples of a row block are
-// sorted into sky, sea and model lists so that sky and sea are shaded four lanes at a time in
-// structure-of-arrays chunks; the few model samples go one by one.
-struct FlirChannel::ShadeScratch {
-    struct Block {
-        std::vector<uint32_t> skyK, seaK;  // sample index within the block
-        std::vector<float> skyZ, skyLength;
-        std::vector<float> px, py, pz, nx, ny, nz;
-        std::vector<float> depth, wet, foam;  // sea-mesh attributes (ViewGeometry)
-        std::vector<uint32_t> modelK;
-        std::vector<glm::vec3> modelP, modelN;
-        std::vector<int> modelMesh;
-        std::vector<glm::vec3> origins;
-        std::vector<uint32_t> originOwner;
-        std::vector<uint8_t> lit, visible;
-        alignas(16) float a[kChunk], b[kChunk], c[kChunk], d[kChunk], e[kChunk];
-
-        void Reserve(size_t n) {
-            if (skyK.size() >= n) return;
-            for (std::vector<float>* v :
-                 {&skyZ, &skyLength, &px, &py, &pz, &nx, &ny, &nz, &depth, &wet, &foam})
-                v->resize(n);
-            skyK.resize(n), seaK.resize(n);
-        }
-    };
-    tbb::enumerable_thread_specific<Block> perThread;
+// Per-thread scratch of the shading pass, kept between frames. Samples are sorted into sky, sea
+// and model lists as they are gathered; sky and sea are shaded four lanes at a time whenever
+// kChunk of them have gathered, so their arrays stay in L1 between gathering and shading. The few
+// model samples of a row block go one by one at its end.
+struct FlirChannel::ShadeBlock {
+    // Sky: sample index within the block, view direction's z and squared length.
+    alignas(16) uint32_t skyK[kChunk];
+    alignas(16) float skyZ[kChunk], skyLength[kChunk];
+    // Sea: sample index, and per sample the (x, y, z, 0) records of position and
+    // (unnormalized) normal and the sea-mesh attributes (depth, wet, foam, 0) as
+    // TriangleCache writes them, turned to lanes by a 4×4 transpose when shaded.
+    alignas(16) uint32_t seaK[kChunk];
+    alignas(16) float seaP[4 * kChunk], seaN[4 * kChunk], seaA[4 * kChunk];
+    std::vector<uint32_t> modelK;
+    std::vector<glm::vec3> modelP, modelN;
+    std::vector<int> modelMesh;
+    std::vector<glm::vec3> origins;
+    std::vector<uint32_t> originOwner;
+    std::vector<uint8_t> lit, visible;
+    alignas(16) float a[kChunk], b[kChunk], c[kChunk], d[kChunk], e[kChunk];
 };
+struct FlirChannel::ShadeScratch {
+    tbb::enumerable_thread_specific<ShadeBlock> perThread;
+};
+
+void FlirChannel::ShadeSky(ShadeBlock& sc, size_t count, float* out) const {
+    // L_sky(cos θ) with cos θ = d_z / |d|.
+    for (size_t i = 0; i < count; i += 4) {
+        const size_t lanes = std::min<size_t>(4, count - i);
+        const F4 z = LoadLanes(&sc.skyZ[i], lanes, 1.0f);
+        const F4 len2 = LoadLanes(&sc.skyLength[i], lanes, 1.0f);
+        _mm_store_ps(sc.a + i, _mm_div_ps(z, _mm_sqrt_ps(len2)));
+    }
+    skyTable_(count, sc.a, sc.b);
+    for (size_t i = 0; i < count; ++i) out[sc.skyK[i]] = sc.b[i];
+}
+
+void FlirChannel::ShadeSea(const FrameShading& f, ShadeBlock& sc, size_t count, float* out) const {
+    // Emissivity at the local view angle (Masuda's wind average for the unresolved slopes), sky
+    // reflected about the resolved normal (a ray reflected into the sea meets the next wave's
+    // sky); sand where the sea lies on the beach and foam over both (SurfInfraredRadiance4);
+    // through the path. The records past count (the last lane group's unused lanes) repeat the
+    // last sample, so that those lanes compute finite values that are never stored.
+    for (size_t i = count; i % 4 != 0; ++i)
+        for (float* r : {sc.seaP, sc.seaN, sc.seaA}) std::copy_n(r + 4 * (count - 1), 4, r + 4 * i);
+    const auto Lanes = [](const float* records, F4& x, F4& y, F4& z, F4& w) {
+        x = _mm_load_ps(records), y = _mm_load_ps(records + 4), z = _mm_load_ps(records + 8),
+        w = _mm_load_ps(records + 12);
+        _MM_TRANSPOSE4_PS(x, y, z, w);
+    };
+    const F4 eyeX = Set4(f.eye.x), eyeY = Set4(f.eye.y), eyeZ = Set4(f.eye.z);
+    for (size_t i = 0; i < count; i += 4) {
+        F4 nx, ny, nz, px, py, pz, unused;
+        Lanes(sc.seaN + 4 * i, nx, ny, nz, unused);
+        Lanes(sc.seaP + 4 * i, px, py, pz, unused);
+        const F4 invN = _mm_div_ps(Set4(1.0f), _mm_sqrt_ps(Dot4(nx, ny, nz, nx, ny, nz)));
+        nx = _mm_mul_ps(nx, invN), ny = _mm_mul_ps(ny, invN), nz = _mm_mul_ps(nz, invN);
+        const F4 tx = _mm_sub_ps(eyeX, px), ty = _mm_sub_ps(eyeY, py), tz = _mm_sub_ps(eyeZ, pz);
+        const F4 range2 = Dot4(tx, ty, tz, tx, ty, tz);
+        const F4 range = _mm_sqrt_ps(range2);
+        const F4 invRange = _mm_div_ps(Set4(1.0f), range);
+        const F4 ndv = _mm_mul_ps(Dot4(nx, ny, nz, tx, ty, tz), invRange);
+        const F4 rz =
+            _mm_sub_ps(_mm_mul_ps(_mm_mul_ps(Set4(2.0f), ndv), nz), _mm_mul_ps(tz, invRange));
+        _mm_store_ps(sc.a + i, Max4(ndv, _mm_setzero_ps()));  // cos θ_view
+        _mm_store_ps(sc.b + i, Abs4(rz));                     // reflected ray's cos θ_zenith
+        _mm_store_ps(sc.c + i, _mm_sqrt_ps(range));           // √range
+    }
+    seaEmissivity_(count, sc.a, sc.d);
+    skyTable_(count, sc.b, sc.e);
+    pathTau_(count, sc.c, sc.a);
+    const F4 seaB = Set4(f.seaB), airB = Set4(f.airB);
+    const F4 one = Set4(1.0f);
+    for (size_t i = 0; i < count; i += 4) {
+        F4 depth, wet, foam, unused;
+        Lanes(sc.seaA + 4 * i, depth, wet, foam, unused);
+        const F4 L = SurfInfraredRadiance4(f.surf, _mm_load_ps(sc.d + i), seaB,
+                                           _mm_load_ps(sc.e + i), depth, wet, foam);
+        const F4 tau = _mm_load_ps(sc.a + i);
+        _mm_store_ps(sc.b + i,
+                     _mm_add_ps(_mm_mul_ps(tau, L), _mm_mul_ps(_mm_sub_ps(one, tau), airB)));
+    }
+    for (size_t i = 0; i < count; ++i) out[sc.seaK[i]] = sc.b[i];
+}
 
 uint64_t FlirChannel::ShadeRows(const FrameShading& f, int y0, int y1, float* out) {
     constexpr int kC = OrientationTemperatures::kClasses,
                   kO = OrientationTemperatures::kOrientations;
-    ShadeScratch::Block& sc = scratch_->perThread.local();
+    ShadeBlock& sc = scratch_->perThread.local();
     const int sw = f.sampleWidth;
-    sc.Reserve(size_t(y1 - y0) * size_t(sw));
     sc.modelK.clear(), sc.modelP.clear(), sc.modelN.clear(), sc.modelMesh.clear();
     sc.origins.clear(), sc.originOwner.clear();
 
-    // Pass 1: sort the samples by kind; sky view directions, surface positions and normals.
+    // Sort the samples by kind: sky view directions, sea surface records (shaded a chunk at a
+    // time), model positions and normals.
     size_t skyCount = 0, seaCount = 0;
     TriangleCache tri;
     for (int y = y0; y < y1; ++y) {
@@ -388,20 +471,19 @@ uint64_t FlirChannel::ShadeRows(const FrameShading& f, int y0, int y1, float* ou
                 sc.skyK[skyCount] = k;
                 sc.skyZ[skyCount] = d.z;
                 sc.skyLength[skyCount] = glm::dot(d, d);
-                ++skyCount;
+                if (++skyCount == kChunk) ShadeSky(sc, skyCount, out), skyCount = 0;
                 continue;
             }
-            alignas(16) float p[4], n[4];
+            // The surface point goes straight into the next sea record; a model sample copies
+            // it out (the record is then reused).
+            float* p = sc.seaP + 4 * seaCount;
+            float* n = sc.seaN + 4 * seaCount;
             int mesh = 0;
             tri.Surface(f.vis.primitiveBase, f.meshes, prim, b1[x], b2[x], p, n, mesh);
             if (mesh == 0) {
                 sc.seaK[seaCount] = k;
-                sc.px[seaCount] = p[0], sc.py[seaCount] = p[1], sc.pz[seaCount] = p[2];
-                sc.nx[seaCount] = n[0], sc.ny[seaCount] = n[1], sc.nz[seaCount] = n[2];
-                alignas(16) float a[4];
-                tri.Attributes(b1[x], b2[x], a);
-                sc.depth[seaCount] = a[0], sc.wet[seaCount] = a[1], sc.foam[seaCount] = a[2];
-                ++seaCount;
+                tri.Attributes(b1[x], b2[x], sc.seaA + 4 * seaCount);
+                if (++seaCount == kChunk) ShadeSea(f, sc, seaCount, out), seaCount = 0;
                 continue;
             }
             const glm::vec3 position(p[0], p[1], p[2]);
@@ -420,65 +502,8 @@ uint64_t FlirChannel::ShadeRows(const FrameShading& f, int y0, int y1, float* ou
             }
         }
     }
-
-    // Pass 2: sky, L_sky(cos θ) with cos θ = d_z / |d|.
-    for (size_t c = 0; c < skyCount; c += kChunk) {
-        const size_t count = std::min(kChunk, skyCount - c);
-        for (size_t i = 0; i < count; i += 4) {
-            const size_t lanes = std::min<size_t>(4, count - i);
-            const F4 z = LoadLanes(&sc.skyZ[c + i], lanes, 1.0f);
-            const F4 len2 = LoadLanes(&sc.skyLength[c + i], lanes, 1.0f);
-            _mm_store_ps(sc.a + i, _mm_div_ps(z, _mm_sqrt_ps(len2)));
-        }
-        skyTable_(count, sc.a, sc.b);
-        for (size_t i = 0; i < count; ++i) out[sc.skyK[c + i]] = sc.b[i];
-    }
-
-    // Pass 3: sea. Emissivity at the local view angle (Masuda's wind average for the unresolved
-    // slopes), sky reflected about the resolved normal (a ray reflected into the sea meets the
-    // next wave's sky); sand where the sea lies on the beach and foam over both
-    // (SurfInfraredRadiance4); through the path.
-    const F4 eyeX = Set4(f.eye.x), eyeY = Set4(f.eye.y), eyeZ = Set4(f.eye.z);
-    for (size_t c = 0; c < seaCount; c += kChunk) {
-        const size_t count = std::min(kChunk, seaCount - c);
-        for (size_t i = 0; i < count; i += 4) {
-            const size_t lanes = std::min<size_t>(4, count - i);
-            const size_t j = c + i;
-            F4 nx = LoadLanes(&sc.nx[j], lanes, 0.0f), ny = LoadLanes(&sc.ny[j], lanes, 0.0f),
-               nz = LoadLanes(&sc.nz[j], lanes, 1.0f);
-            const F4 invN = _mm_div_ps(Set4(1.0f), _mm_sqrt_ps(Dot4(nx, ny, nz, nx, ny, nz)));
-            nx = _mm_mul_ps(nx, invN), ny = _mm_mul_ps(ny, invN), nz = _mm_mul_ps(nz, invN);
-            const F4 tx = _mm_sub_ps(eyeX, LoadLanes(&sc.px[j], lanes, 0.0f));
-            const F4 ty = _mm_sub_ps(eyeY, LoadLanes(&sc.py[j], lanes, 0.0f));
-            const F4 tz = _mm_sub_ps(eyeZ, LoadLanes(&sc.pz[j], lanes, 1.0f));
-            const F4 range2 = Dot4(tx, ty, tz, tx, ty, tz);
-            const F4 range = _mm_sqrt_ps(range2);
-            const F4 invRange = _mm_div_ps(Set4(1.0f), range);
-            const F4 ndv = _mm_mul_ps(Dot4(nx, ny, nz, tx, ty, tz), invRange);
-            const F4 rz =
-                _mm_sub_ps(_mm_mul_ps(_mm_mul_ps(Set4(2.0f), ndv), nz), _mm_mul_ps(tz, invRange));
-            _mm_store_ps(sc.a + i, Max4(ndv, _mm_setzero_ps()));  // cos θ_view
-            _mm_store_ps(sc.b + i, Abs4(rz));                     // reflected ray's cos θ_zenith
-            _mm_store_ps(sc.c + i, _mm_sqrt_ps(range));           // √range
-        }
-        seaEmissivity_(count, sc.a, sc.d);
-        skyTable_(count, sc.b, sc.e);
-        pathTau_(count, sc.c, sc.a);
-        const F4 seaB = Set4(f.seaB), airB = Set4(f.airB);
-        const F4 one = Set4(1.0f);
-        for (size_t i = 0; i < count; i += 4) {
-            const size_t lanes = std::min<size_t>(4, count - i);
-            const size_t j = c + i;
-            const F4 L = SurfInfraredRadiance4(
-                f.surf, _mm_load_ps(sc.d + i), seaB, _mm_load_ps(sc.e + i),
-                LoadLanes(&sc.depth[j], lanes, kDeepColumn_m), LoadLanes(&sc.wet[j], lanes, 0.0f),
-                LoadLanes(&sc.foam[j], lanes, 0.0f));
-            const F4 tau = _mm_load_ps(sc.a + i);
-            _mm_store_ps(sc.b + i,
-                         _mm_add_ps(_mm_mul_ps(tau, L), _mm_mul_ps(_mm_sub_ps(one, tau), airB)));
-        }
-        for (size_t i = 0; i < count; ++i) out[sc.seaK[c + i]] = sc.b[i];
-    }
+    if (skyCount > 0) ShadeSky(sc, skyCount, out);
+    if (seaCount > 0) ShadeSea(f, sc, seaCount, out);
 
     // Pass 4: models (a small fraction of the frame): sunlit or shaded by the shadow rays.
     sc.lit.assign(sc.modelK.size(), f.sunDir.z > 0.0f ? 1 : 0);

@@ -40,6 +40,22 @@ radiometry::Band InfraredBandOf(scene::InfraredBand band);
 // start, so a temperature is a pure function of the time (whatever frames were asked before).
 class OrientationTemperatures {
   public:
+    // The sun (direct normal irradiance, W·m⁻², and unit ENU direction) at the time last asked,
+    // kept for the next call at the same time: the ephemeris series is most of the cost of a
+    // frame's drivers, and the materials of one channel all ask for the frame's time.
+    class SunMemo {
+      public:
+        explicit SunMemo(const scene::Scenario& scenario) : scenario_(scenario) {}
+        // SunIrradiance_W_m2(scenario, time_s, direction), computed once per distinct time_s.
+        double Irradiance_W_m2(double time_s, glm::dvec3& direction);
+
+      private:
+        const scene::Scenario& scenario_;
+        bool valid_ = false;
+        double time_s_ = 0.0, irradiance_W_m2_ = 0.0;
+        glm::dvec3 direction_{0.0};
+    };
+
     static constexpr int kOrientations = 10;
     static constexpr int kClasses = 2 * kOrientations;  // [shaded 0..9, sunlit 10..19]
     static constexpr double kSpinUp_s = 86400.0;
@@ -53,19 +69,23 @@ class OrientationTemperatures {
         double windSpeed_mps = 0.0;
         double skyLongwave_W_m2 = 300.0;
     };
+    // sun: shared by the materials of one channel (not thread-safe: one caller at a time).
     OrientationTemperatures(const radiometry::HeatBalanceParameters& parameters,
-                            const Environment& environment, const scene::Scenario& scenario);
+                            const Environment& environment, const scene::Scenario& scenario,
+                            std::shared_ptr<SunMemo> sun);
 
     // Unit outward normal (world ENU) of orientation class o < kOrientations.
     static glm::dvec3 ClassNormal(int orientation);
     // Temperatures (K) of the kClasses classes at time_s (≥ −kSpinUp_s; seconds since the
-    // scenario start).
+    // scenario start). The last result is kept for a repeated time_s (entities of one material).
     std::array<double, kClasses> At(double time_s);
 
   private:
     using Drivers = std::array<radiometry::ThermalDrivers, kClasses>;
     // The drivers of every class at time_s (one sun position for all of them).
-    Drivers DriversAt(double time_s) const;
+    Drivers DriversAt(double time_s);
+    // At without the kept result.
+    std::array<double, kClasses> Compute(double time_s);
     // Integrates each class from temperatures `from` under drivers a to drivers b.
     std::array<double, kClasses> Step(const std::array<double, kClasses>& from, const Drivers& a,
                                       const Drivers& b) const;
@@ -75,6 +95,10 @@ class OrientationTemperatures {
     const scene::Scenario& scenario_;
     std::vector<std::array<double, kClasses>> nodes_;  // temperatures at grid nodes 0, 1, …
     Drivers lastNodeDrivers_;                          // drivers at the last node in nodes_
+    std::shared_ptr<SunMemo> sun_;
+    bool lastValid_ = false;  // lastTime_s_ and last_: the previous call of At
+    double lastTime_s_ = 0.0;
+    std::array<double, kClasses> last_{};
 };
 
 // A function tabulated at uniformly spaced nodes x_i = i·xMax/(n − 1), linear between them;
@@ -159,6 +183,7 @@ class FlirChannel {
         // Heat-balance models: index into heatBalance_ (one per material), or −1.
         int heatBalance = -1;
     };
+    struct ShadeBlock;
     struct ShadeScratch;
     struct FrameShading;
 
@@ -176,6 +201,9 @@ class FlirChannel {
     // Shades the sample rows [y0, y1) into out (the rows' first sample); returns the number
     // of shadow rays traced.
     uint64_t ShadeRows(const FrameShading& frame, int y0, int y1, float* out);
+    // Shade the first count (≤ kChunk) gathered sky or sea samples of a row block into out.
+    void ShadeSky(ShadeBlock& block, size_t count, float* out) const;
+    void ShadeSea(const FrameShading& frame, ShadeBlock& block, size_t count, float* out) const;
 
     const scene::World& world_;
     FlirImagerSetup setup_;
@@ -190,6 +218,7 @@ class FlirChannel {
     UniformTable skyTable_, seaEmissivity_, pathTau_;
     std::vector<EntityThermal> entities_;
     std::vector<std::unique_ptr<OrientationTemperatures>> heatBalance_;
+    std::shared_ptr<OrientationTemperatures::SunMemo> sunMemo_;  // shared by heatBalance_
     std::vector<std::array<float, OrientationTemperatures::kClasses>> entityB_;
     // Surf zone: foam (always: deep-water whitecaps too), dry and wet sand (with a surf zone).
     bool hasSurf_ = false;

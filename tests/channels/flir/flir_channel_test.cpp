@@ -8,10 +8,12 @@
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 
 #include "channels/pipeline/channel_pipeline.h"
 #include "radiometry/planck/planck.h"
@@ -227,6 +229,49 @@ TEST(FlirChannel, OneAndTwoThreadsGiveBitIdenticalFrames) {
     ASSERT_EQ(one.pixels.size(), two.pixels.size());
     EXPECT_EQ(std::memcmp(one.pixels.data(), two.pixels.data(), one.pixels.size() * 4), 0);
     fs::remove_all(dir);
+}
+
+TEST(FlirChannel, MaterialTemperaturesArePureFunctionsOfTimeWhateverWasAskedBefore) {
+    // configs/five-channel.yaml: two hulls of one material, another hull material and the two
+    // sands share the channel's sun (kept for the last time asked) and each keeps its last
+    // result. Asked in an interleaved order, repeated and going back in time, every answer
+    // equals that of a fresh channel asked only that question.
+    const scene::Scenario sc =
+        scene::LoadScenario(fs::path(SEASENSE_SOURCE_DIR) / "configs/five-channel.yaml");
+    const auto it = std::find_if(sc.channels.begin(), sc.channels.end(),
+                                 [](const scene::ChannelSettings& c) { return c.name == "flir"; });
+    ASSERT_NE(it, sc.channels.end());
+    ASSERT_GE(sc.entities.size(), 3u);
+    const scene::World world(sc);
+    // Question q < 2: entity 0 or 2 (hull_gray, also entity 1's, and hull_white); q = 2: the
+    // sands. Expected: a fresh channel per question and time.
+    using Temperatures = std::vector<double>;
+    const auto Ask = [](FlirChannel& f, int q, double t) {
+        if (q == 2) {
+            const auto T = f.SandTemperatures_K(t);
+            return Temperatures(T.begin(), T.end());
+        }
+        const auto T = f.EntityTemperatures_K(size_t(2 * q), t);
+        return Temperatures(T.begin(), T.end());
+    };
+    std::map<std::pair<int, double>, Temperatures> expected;
+    for (double t : {1200.0, 30.0})
+        for (int q = 0; q < 3; ++q) {
+            FlirChannel fresh(world, *it);
+            expected[{q, t}] = Ask(fresh, q, t);
+        }
+    FlirChannel flir(world, *it);
+    for (const auto& [q, t] : std::vector<std::pair<int, double>>{{0, 1200.0},
+                                                                  {1, 1200.0},
+                                                                  {2, 1200.0},
+                                                                  {0, 1200.0},
+                                                                  {1, 30.0},
+                                                                  {0, 30.0},
+                                                                  {2, 30.0},
+                                                                  {2, 1200.0},
+                                                                  {0, 1200.0},
+                                                                  {1, 1200.0}})
+        EXPECT_EQ(Ask(flir, q, t), (expected[{q, t}])) << "question " << q << " at " << t << " s";
 }
 
 TEST(FlirChannel, CaptureWritesRadianceAndTemperatureExr) {
