@@ -224,7 +224,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     struct Scratch {
         PlumeScreenBins::List strip, list;
         std::vector<PlumeScreenBins::List> cellLists{PlumeScreenBins::kTile / kCell};
-        std::vector<float> range, depthRows;
+        std::vector<float> range, depthRows, cellMinDepth;
     };
     tbb::enumerable_thread_specific<Scratch> scratch;
     // One task per row of cells (simple_partitioner): the rows' costs differ by orders of
@@ -311,9 +311,12 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
 
     // The depths of cell row cy's samples in its cells with puffs, read once in the visibility
     // buffer's order (its rows streamed rather than 2 × 2 samples at a time) into kCell·N rows
-    // of vis.width at out; −1 where the sample sees the sky.
-    const auto ReadDepths = [&](int cy, const CellRow& row, float* out) {
+    // of vis.width at out; −1 where the sample sees the sky. cellMin[cx]: the least of cell
+    // cx's values (so that a cell whose every surface lies in front of its puffs is skipped
+    // whole).
+    const auto ReadDepths = [&](int cy, const CellRow& row, float* out, float* cellMin) {
         const int rowSamples = kCell * N, sy0 = cy * rowSamples;
+        for (int cx = 0; cx < cellsX; ++cx) cellMin[cx] = std::numeric_limits<float>::infinity();
         for (int j = 0; j < std::min(rowSamples, vis.height - sy0); ++j) {
             const size_t idx0 = vis.Index(0, sy0 + j);
             const float* depth = vis.depth.data() + idx0;
@@ -321,11 +324,17 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             float* o = out + size_t(j) * size_t(vis.width);
             for (int cx = 0; cx < cellsX; ++cx) {
                 if (row.count[size_t(cx)] == 0) continue;
+                float least = cellMin[cx];
                 for (int sx = cx * rowSamples; sx < std::min((cx + 1) * rowSamples, vis.width);
                      ++sx) {
-                    const bool sky = primitive[sx] == kNoPrimitive || depth[sx] <= 0.0f;
-                    o[sx] = sky ? -1.0f : depth[sx];
+                    // Both tests evaluated (no short circuit), so that the loop vectorises.
+                    const float d = depth[sx];
+                    const bool sky = (primitive[sx] == kNoPrimitive) | (d <= 0.0f);
+                    const float v = sky ? -1.0f : d;
+                    o[sx] = v;
+                    least = v < least ? v : least;
                 }
+                cellMin[cx] = least;
             }
         }
     };
@@ -342,11 +351,13 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             const int rowSamples = kCell * N;
             std::vector<float>& depthRows = local.depthRows;
             depthRows.resize(size_t(rowSamples) * size_t(vis.width));
+            std::vector<float>& cellMinDepth = local.cellMinDepth;
+            cellMinDepth.resize(size_t(cellsX));
             for (int cy = rows.begin(); cy != rows.end(); ++cy) {
                 uint64_t covered = 0, traces = 0, tests = 0;
                 const CellRow& row = cellRows[size_t(cy)];
                 const int sy0 = cy * rowSamples;
-                ReadDepths(cy, row, depthRows.data());
+                ReadDepths(cy, row, depthRows.data(), cellMinDepth.data());
                 const auto DepthAt = [&](int sx, int sy) {
                     return depthRows[size_t(sy - sy0) * size_t(vis.width) + size_t(sx)];
                 };
@@ -385,6 +396,12 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                             b2 = std::max(b2, double(rowB[size_t(py)]) * rowB[size_t(py)]);
                         const double cosMin = 1.0 / std::sqrt(1.0 + a2 + b2);
                         depthInFront = float(double(nearM) / (cosMin * double(dNear)) * 1.0001);
+                    }
+                    // Every pixel of the cell would be skipped by that test below.
+                    if (cellMinDepth[size_t(cx)] >= depthInFront) {
+                        covered += uint64_t(std::min(W, (cx + 1) * kCell) - cx * kCell) *
+                                   uint64_t(std::min(H, (cy + 1) * kCell) - cy * kCell);
+                        continue;
                     }
                     bool clearSky = false;
                     const bool smooth =
