@@ -226,11 +226,9 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     };
     // The depths of cell row cy's samples in its cells with puffs, read once in the visibility
     // buffer's order (its rows streamed rather than 2 × 2 samples at a time) into kCell·N rows
-    // of vis.width at out; −1 where the sample sees the sky. cellMin[cx]: the least of cell
-    // cx's values.
-    const auto ReadDepths = [&](int cy, const CellRow& row, float* out, float* cellMin) {
+    // of vis.width at out; −1 where the sample sees the sky.
+    const auto ReadDepths = [&](int cy, const CellRow& row, float* out) {
         const int rowSamples = kCell * N, sy0 = cy * rowSamples;
-        for (int cx = 0; cx < cellsX; ++cx) cellMin[cx] = std::numeric_limits<float>::infinity();
         for (int j = 0; j < std::min(rowSamples, vis.height - sy0); ++j) {
             const size_t idx0 = vis.Index(0, sy0 + j);
             const float* depth = vis.depth.data() + idx0;
@@ -238,21 +236,31 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             float* o = out + size_t(j) * size_t(vis.width);
             for (int cx = 0; cx < cellsX; ++cx) {
                 if (row.count[size_t(cx)] == 0) continue;
-                float least = cellMin[cx];
                 for (int sx = cx * rowSamples; sx < std::min((cx + 1) * rowSamples, vis.width);
                      ++sx) {
                     // Both tests evaluated (no short circuit), so that the loop vectorises.
                     const float d = depth[sx];
                     const bool sky = (primitive[sx] == kNoPrimitive) | (d <= 0.0f);
-                    const float v = sky ? -1.0f : d;
-                    o[sx] = v;
-                    least = v < least ? v : least;
+                    o[sx] = sky ? -1.0f : d;
                 }
-                cellMin[cx] = least;
             }
         }
     };
-
+    // Whether every sample of cell (cx, cy) sees a surface at a depth of at least `least`
+    // (ReadDepths' values, sky −1, all ≥ least); stops at the first that does not.
+    const auto AllDepthsAtLeast = [&](int cx, int cy, float least) {
+        const int rowSamples = kCell * N, sy0 = cy * rowSamples, sx0 = cx * rowSamples;
+        const int sx1 = std::min(sx0 + rowSamples, vis.width);
+        for (int j = 0; j < std::min(rowSamples, vis.height - sy0); ++j) {
+            const size_t idx0 = vis.Index(0, sy0 + j);
+            for (int sx = sx0; sx < sx1; ++sx) {
+                const float d = vis.depth[idx0 + size_t(sx)];
+                const bool sky = (vis.primitive[idx0 + size_t(sx)] == kNoPrimitive) | (d <= 0.0f);
+                if (!((sky ? -1.0f : d) >= least)) return false;
+            }
+        }
+        return true;
+    };
     // A depth beyond which a sample's surface is nearer than dNear anywhere in cell (cx, cy), so
     // that its pixel is skipped without its direction: range r = near / (cos θ · depth), θ the
     // angle from the optical axis, and cos θ = 1 / |(a, 1, b)| ≥ cosMin over the cell's pixels,
@@ -282,7 +290,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     struct Scratch {
         PlumeScreenBins::List strip, list;
         std::vector<PlumeScreenBins::List> cellLists{PlumeScreenBins::kTile / kCell};
-        std::vector<float> range, depthRows, cellMinDepth;
+        std::vector<float> range, depthRows;
     };
     tbb::enumerable_thread_specific<Scratch> scratch;
     // One task per row of cells (simple_partitioner): the rows' costs differ by orders of
@@ -293,8 +301,6 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             Scratch& local = scratch.local();
             PlumeScreenBins::List& strip = local.strip;
             std::span<PlumeScreenBins::List> cellLists(local.cellLists);
-            local.depthRows.resize(size_t(kCell * N) * size_t(vis.width));
-            local.cellMinDepth.resize(size_t(cellsX));
             for (int cy = r.begin(); cy != r.end(); ++cy) {
                 CellRow& row = cellRows[size_t(cy)];
                 row.start.assign(size_t(cellsX) + 1, 0);
@@ -330,12 +336,11 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                 // The cells whose every surface lies in front of their puffs: their pixels
                 // are all skipped in pass 2 (minDepth ≥ depthInFront), so their corners are
                 // traced only if another cell uses them.
-                ReadDepths(cy, row, local.depthRows.data(), local.cellMinDepth.data());
                 row.inFront.assign(size_t(cellsX), 0);
                 for (int cx = 0; cx < cellsX; ++cx)
                     if (row.count[size_t(cx)] != 0)
-                        row.inFront[size_t(cx)] = local.cellMinDepth[size_t(cx)] >=
-                                                  DepthInFront(cx, cy, row.near_m[size_t(cx)]);
+                        row.inFront[size_t(cx)] =
+                            AllDepthsAtLeast(cx, cy, DepthInFront(cx, cy, row.near_m[size_t(cx)]));
             }
         },
         tbb::simple_partitioner());
@@ -414,13 +419,11 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             const int rowSamples = kCell * N;
             std::vector<float>& depthRows = local.depthRows;
             depthRows.resize(size_t(rowSamples) * size_t(vis.width));
-            std::vector<float>& cellMinDepth = local.cellMinDepth;
-            cellMinDepth.resize(size_t(cellsX));
             for (int cy = rows.begin(); cy != rows.end(); ++cy) {
                 uint64_t covered = 0, traces = 0, tests = 0;
                 const CellRow& row = cellRows[size_t(cy)];
                 const int sy0 = cy * rowSamples;
-                ReadDepths(cy, row, depthRows.data(), cellMinDepth.data());
+                ReadDepths(cy, row, depthRows.data());
                 const auto DepthAt = [&](int sx, int sy) {
                     return depthRows[size_t(sy - sy0) * size_t(vis.width) + size_t(sx)];
                 };
