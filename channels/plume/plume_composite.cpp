@@ -209,10 +209,76 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
         std::vector<uint32_t> index, start, count;
         std::vector<float> near_m, far_m;
         std::vector<float> smallOpticalDepth, halfSmallOpticalDepth;
+        // Whether every surface of the cell lies in front of its puffs (the cell is skipped).
+        std::vector<uint8_t> inFront;
     };
     std::vector<CellRow> cellRows{size_t(cellsY)};
-    // Pass 1, the cells' lists and the nodes traced to the sky: each node by the cell it is
-    // the near corner of (the last column's and row's by the cells before them).
+    // Cell cx's list of row (not copied).
+    const auto TakeList = [](const CellRow& row, int cx, PlumeScreenBins::List& list) {
+        list.count = row.count[size_t(cx)];
+        list.index.assign(row.index.begin() + row.start[size_t(cx)],
+                          row.index.begin() + row.start[size_t(cx) + 1]);
+        list.near_m = row.near_m[size_t(cx)];
+        list.far_m = row.far_m[size_t(cx)];
+        list.smallOpticalDepth = row.smallOpticalDepth[size_t(cx)];
+        list.halfSmallOpticalDepth = row.halfSmallOpticalDepth[size_t(cx)];
+        list.copied = false;
+    };
+    // The depths of cell row cy's samples in its cells with puffs, read once in the visibility
+    // buffer's order (its rows streamed rather than 2 × 2 samples at a time) into kCell·N rows
+    // of vis.width at out; −1 where the sample sees the sky.
+    const auto ReadDepths = [&](int cy, const CellRow& row, float* out) {
+        const int rowSamples = kCell * N, sy0 = cy * rowSamples;
+        for (int j = 0; j < std::min(rowSamples, vis.height - sy0); ++j) {
+            const size_t idx0 = vis.Index(0, sy0 + j);
+            const float* depth = vis.depth.data() + idx0;
+            const uint32_t* primitive = vis.primitive.data() + idx0;
+            float* o = out + size_t(j) * size_t(vis.width);
+            for (int cx = 0; cx < cellsX; ++cx) {
+                if (row.count[size_t(cx)] == 0) continue;
+                for (int sx = cx * rowSamples; sx < std::min((cx + 1) * rowSamples, vis.width);
+                     ++sx) {
+                    // Both tests evaluated (no short circuit), so that the loop vectorises.
+                    const float d = depth[sx];
+                    const bool sky = (primitive[sx] == kNoPrimitive) | (d <= 0.0f);
+                    o[sx] = sky ? -1.0f : d;
+                }
+            }
+        }
+    };
+    // Whether every sample of cell (cx, cy) sees a surface at a depth of at least `least`
+    // (ReadDepths' values, sky −1, all ≥ least); stops at the first that does not.
+    const auto AllDepthsAtLeast = [&](int cx, int cy, float least) {
+        const int rowSamples = kCell * N, sy0 = cy * rowSamples, sx0 = cx * rowSamples;
+        const int sx1 = std::min(sx0 + rowSamples, vis.width);
+        for (int j = 0; j < std::min(rowSamples, vis.height - sy0); ++j) {
+            const size_t idx0 = vis.Index(0, sy0 + j);
+            for (int sx = sx0; sx < sx1; ++sx) {
+                const float d = vis.depth[idx0 + size_t(sx)];
+                const bool sky = (vis.primitive[idx0 + size_t(sx)] == kNoPrimitive) | (d <= 0.0f);
+                if (!((sky ? -1.0f : d) >= least)) return false;
+            }
+        }
+        return true;
+    };
+    // A depth beyond which a sample's surface is nearer than dNear anywhere in cell (cx, cy), so
+    // that its pixel is skipped without its direction: range r = near / (cos θ · depth), θ the
+    // angle from the optical axis, and cos θ = 1 / |(a, 1, b)| ≥ cosMin over the cell's pixels,
+    // so depth ≥ near / (cosMin · dNear) gives r ≤ dNear. The 1e-4 margin covers the float
+    // rounding of the per-pixel range (a few ulp), so a pixel skipped by it is one the test
+    // rMax ≤ dNear of pass 2 skips: the image is unchanged.
+    const auto DepthInFront = [&](int cx, int cy, float dNear) {
+        if (!(dNear > 0.0f)) return std::numeric_limits<float>::infinity();
+        double a2 = 0.0, b2 = 0.0;
+        for (int px = cx * kCell; px < std::min(W, (cx + 1) * kCell); ++px)
+            a2 = std::max(a2, double(colA[size_t(px)]) * colA[size_t(px)]);
+        for (int py = cy * kCell; py < std::min(H, (cy + 1) * kCell); ++py)
+            b2 = std::max(b2, double(rowB[size_t(py)]) * rowB[size_t(py)]);
+        const double cosMin = 1.0 / std::sqrt(1.0 + a2 + b2);
+        return float(double(nearM) / (cosMin * double(dNear)) * 1.0001);
+    };
+
+    // Pass 1, the cells' lists and which cells lie wholly behind surfaces in front of their puffs.
     std::vector<BandTrace> nodes(size_t(nodesX) * size_t(nodesY));
     std::vector<uint64_t> rowCovered(size_t(cellsY), 0), rowTraces(size_t(cellsY), 0),
         rowTests(size_t(cellsY), 0);
@@ -236,8 +302,6 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             PlumeScreenBins::List& strip = local.strip;
             std::span<PlumeScreenBins::List> cellLists(local.cellLists);
             for (int cy = r.begin(); cy != r.end(); ++cy) {
-                // The row's counts, kept in registers (the rows' slots share cache lines).
-                uint64_t traces = 0, tests = 0;
                 CellRow& row = cellRows[size_t(cy)];
                 row.start.assign(size_t(cellsX) + 1, 0);
                 row.count.assign(size_t(cellsX), 0);
@@ -267,19 +331,53 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                     row.far_m[size_t(cx)] = list.far_m;
                     row.smallOpticalDepth[size_t(cx)] = list.smallOpticalDepth;
                     row.halfSmallOpticalDepth[size_t(cx)] = list.halfSmallOpticalDepth;
-                    for (int k = 0; k < 4; ++k) {
-                        const int nx = cx + k % 2, ny = cy + k / 2;
-                        if ((nx > cx && nx < cellsX) || (ny > cy && ny < cellsY)) continue;
-                        const size_t n = size_t(ny) * size_t(nodesX) + size_t(nx);
-                        nodes[n] = bins.Trace(list, PixelDirection(nx * kCell, ny * kCell),
-                                              kPlumeSkyRange_m);
-                        nodeT[n] = std::exp(-nodes[n].opticalDepth);
-                        ++traces;
-                        tests += list.size();
-                    }
                 }
                 row.start[size_t(cellsX)] = uint32_t(row.index.size());
-                rowTraces[size_t(cy)] = traces, rowTests[size_t(cy)] = tests;
+                // The cells whose every surface lies in front of their puffs: their pixels
+                // are all skipped in pass 2 (minDepth ≥ depthInFront), so their corners are
+                // traced only if another cell uses them.
+                row.inFront.assign(size_t(cellsX), 0);
+                for (int cx = 0; cx < cellsX; ++cx)
+                    if (row.count[size_t(cx)] != 0)
+                        row.inFront[size_t(cx)] =
+                            AllDepthsAtLeast(cx, cy, DepthInFront(cx, cy, row.near_m[size_t(cx)]));
+            }
+        },
+        tbb::simple_partitioner());
+
+    // Pass 1b, the nodes traced to the sky: each node by the cell it is the near corner of (the
+    // last column's and row's by the cells before them), when that cell has puffs and one of
+    // the cells around the node with puffs is not skipped (the others never read it).
+    std::vector<uint64_t> nodeRowTraces(size_t(nodesY), 0), nodeRowTests(size_t(nodesY), 0);
+    const auto Used = [&](int cx, int cy) {
+        if (cx < 0 || cy < 0 || cx >= cellsX || cy >= cellsY) return false;
+        const CellRow& row = cellRows[size_t(cy)];
+        return row.count[size_t(cx)] != 0 && !row.inFront[size_t(cx)];
+    };
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, nodesY, 1),
+        [&](const tbb::blocked_range<int>& r) {
+            PlumeScreenBins::List& list = scratch.local().list;
+            for (int ny = r.begin(); ny != r.end(); ++ny) {
+                // The row's counts, kept in registers (the rows' slots share cache lines).
+                uint64_t traces = 0, tests = 0;
+                const int cy = std::min(ny, cellsY - 1);
+                const CellRow& row = cellRows[size_t(cy)];
+                for (int nx = 0; nx < nodesX; ++nx) {
+                    const int cx = std::min(nx, cellsX - 1);
+                    if (row.count[size_t(cx)] == 0) continue;
+                    if (!Used(nx - 1, ny - 1) && !Used(nx, ny - 1) && !Used(nx - 1, ny) &&
+                        !Used(nx, ny))
+                        continue;
+                    TakeList(row, cx, list);
+                    const size_t n = size_t(ny) * size_t(nodesX) + size_t(nx);
+                    nodes[n] =
+                        bins.Trace(list, PixelDirection(nx * kCell, ny * kCell), kPlumeSkyRange_m);
+                    nodeT[n] = std::exp(-nodes[n].opticalDepth);
+                    ++traces;
+                    tests += list.size();
+                }
+                nodeRowTraces[size_t(ny)] = traces, nodeRowTests[size_t(ny)] = tests;
             }
         },
         tbb::simple_partitioner());
@@ -309,27 +407,6 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
         return smooth;
     };
 
-    // The depths of cell row cy's samples in its cells with puffs, read once in the visibility
-    // buffer's order (its rows streamed rather than 2 × 2 samples at a time) into kCell·N rows
-    // of vis.width at out; −1 where the sample sees the sky.
-    const auto ReadDepths = [&](int cy, const CellRow& row, float* out) {
-        const int rowSamples = kCell * N, sy0 = cy * rowSamples;
-        for (int j = 0; j < std::min(rowSamples, vis.height - sy0); ++j) {
-            const size_t idx0 = vis.Index(0, sy0 + j);
-            const float* depth = vis.depth.data() + idx0;
-            const uint32_t* primitive = vis.primitive.data() + idx0;
-            float* o = out + size_t(j) * size_t(vis.width);
-            for (int cx = 0; cx < cellsX; ++cx) {
-                if (row.count[size_t(cx)] == 0) continue;
-                for (int sx = cx * rowSamples; sx < std::min((cx + 1) * rowSamples, vis.width);
-                     ++sx) {
-                    const bool sky = primitive[sx] == kNoPrimitive || depth[sx] <= 0.0f;
-                    o[sx] = sky ? -1.0f : depth[sx];
-                }
-            }
-        }
-    };
-
     // Pass 2, cells in parallel (a row of cells each); each pixel depends only on its own rays
     // and the cell's corner nodes.
     tbb::parallel_for(
@@ -352,14 +429,13 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                 };
                 for (int cx = 0; cx < cellsX; ++cx) {
                     if (row.count[size_t(cx)] == 0) continue;
-                    list.count = row.count[size_t(cx)];
-                    list.index.assign(row.index.begin() + row.start[size_t(cx)],
-                                      row.index.begin() + row.start[size_t(cx) + 1]);
-                    list.near_m = row.near_m[size_t(cx)];
-                    list.far_m = row.far_m[size_t(cx)];
-                    list.smallOpticalDepth = row.smallOpticalDepth[size_t(cx)];
-                    list.halfSmallOpticalDepth = row.halfSmallOpticalDepth[size_t(cx)];
-                    list.copied = false;
+                    // Every pixel of the cell is skipped by the test minDepth ≥ depthInFront.
+                    if (row.inFront[size_t(cx)]) {
+                        covered += uint64_t(std::min(W, (cx + 1) * kCell) - cx * kCell) *
+                                   uint64_t(std::min(H, (cy + 1) * kCell) - cy * kCell);
+                        continue;
+                    }
+                    TakeList(row, cx, list);
                     // The ranges where the cell's puffs can matter.
                     const float dNear = list.near_m, dFar = list.far_m;
                     const BandTrace* corner[4];
@@ -369,23 +445,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                         corner[k] = &nodes[n];
                         cornerT[k] = nodeT[n];
                     }
-                    // A depth beyond which a sample's surface is nearer than dNear anywhere in
-                    // the cell, so that its pixel is skipped without its direction: range
-                    // r = near / (cos θ · depth), θ the angle from the optical axis, and
-                    // cos θ = 1 / |(a, 1, b)| ≥ cosMin over the cell's pixels, so depth ≥
-                    // near / (cosMin · dNear) gives r ≤ dNear. The 1e-4 margin covers the
-                    // float rounding of the per-pixel range (a few ulp), so a pixel skipped
-                    // here is one the test rMax ≤ dNear below skips: the image is unchanged.
-                    float depthInFront = std::numeric_limits<float>::infinity();
-                    if (dNear > 0.0f) {
-                        double a2 = 0.0, b2 = 0.0;
-                        for (int px = cx * kCell; px < std::min(W, (cx + 1) * kCell); ++px)
-                            a2 = std::max(a2, double(colA[size_t(px)]) * colA[size_t(px)]);
-                        for (int py = cy * kCell; py < std::min(H, (cy + 1) * kCell); ++py)
-                            b2 = std::max(b2, double(rowB[size_t(py)]) * rowB[size_t(py)]);
-                        const double cosMin = 1.0 / std::sqrt(1.0 + a2 + b2);
-                        depthInFront = float(double(nearM) / (cosMin * double(dNear)) * 1.0001);
-                    }
+                    const float depthInFront = DepthInFront(cx, cy, dNear);
                     bool clearSky = false;
                     const bool smooth =
                         Smooth(corner, cornerT, list.smallOpticalDepth > kInterpolationTolerance,
@@ -525,6 +585,10 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
         stats.pixelsCovered += rowCovered[size_t(y)];
         stats.traces += rowTraces[size_t(y)];
         stats.puffTests += rowTests[size_t(y)];
+    }
+    for (int y = 0; y < nodesY; ++y) {
+        stats.traces += nodeRowTraces[size_t(y)];
+        stats.puffTests += nodeRowTests[size_t(y)];
     }
     stats.ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
