@@ -80,8 +80,11 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
         out = OceanMesh{};
         return;
     }
-    // World-fixed azimuths: a whole number of segments around the circle.
-    const int circle = std::max(8, int(std::ceil(2.0 * M_PI / req.angularStep_rad)));
+    // World-fixed azimuths: a whole number of segments around the circle (for a view mesh a
+    // multiple of kMaxColumnStride, so that every stride divides it).
+    int circle = std::max(8, int(std::ceil(2.0 * M_PI / req.angularStep_rad)));
+    if (req.widenByReach)
+        circle = (circle + kMaxColumnStride - 1) / kMaxColumnStride * kMaxColumnStride;
     const double dphi = 2.0 * M_PI / circle;
     const bool sectorFull = req.azimuthMax_rad - req.azimuthMin_rad >= 2.0 * M_PI - 1e-9;
     if (!sectorFull) CHECK(req.azimuthMax_rad > req.azimuthMin_rad);
@@ -116,6 +119,24 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
         hi = int64_t(std::ceil((req.azimuthMax_rad + margin_rad) / dphi));
         if (hi - lo >= circle) lo = 0, hi = circle;
     };
+    // Column stride per ring: near the eye a ring's columns are seen much closer together than
+    // its radius times the azimuth step, since the eye looks down on them: two columns r · dphi
+    // apart at rest radius r lie r · dphi / √(r² + h²) apart in view angle (h the eye's height
+    // over the trough, as in OceanMeshRadii), so every s-th column, s ≤ √(1 + (h / r)²), keeps
+    // them within the angular step. s is a power of two, at most kMaxColumnStride, and never
+    // grows outward, so each coarse ring's columns are also the next ring's.
+    std::vector<int> stride(size_t(rings), 1);
+    if (req.widenByReach) {
+        const double hEff = std::max(req.eye_m.z, 0.05) + 0.5 * frame.SignificantHeight_m();
+        for (int j = 0; j < rings; ++j) {
+            const double r = radii[size_t(j)];
+            const double allowed =
+                r > 0.0 ? std::sqrt(1.0 + (hEff / r) * (hEff / r)) : double(kMaxColumnStride);
+            int sj = 1;
+            while (2 * sj <= kMaxColumnStride && 2.0 * sj <= allowed) sj *= 2;
+            stride[size_t(j)] = j > 0 ? std::min(sj, stride[size_t(j) - 1]) : sj;
+        }
+    }
     std::vector<int64_t> bandLo(size_t(rings - 1)), bandHi(size_t(rings - 1));
     if (req.widenByReach) {
         // Displacement bounds over discs of radius 4^k m around the eye (k = 0 … 6, then the
@@ -136,7 +157,14 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
             const double margin = r > reach
                                       ? std::min(std::asin(reach / r) + dphi, kMaxReachMargin_rad)
                                       : kMaxReachMargin_rad;
-            sectorColumns(margin, bandLo[size_t(j)], bandHi[size_t(j)]);
+            int64_t& lo = bandLo[size_t(j)];
+            int64_t& hi = bandHi[size_t(j)];
+            sectorColumns(margin, lo, hi);
+            // Whole segments of the band's inner (coarser) ring.
+            const int64_t sj = stride[size_t(j)];
+            lo = lo >= 0 ? lo / sj * sj : -((-lo + sj - 1) / sj * sj);
+            hi = hi >= 0 ? (hi + sj - 1) / sj * sj : -(-hi / sj * sj);
+            if (hi - lo >= circle) lo = 0, hi = circle;
         }
     } else {
         int64_t lo = 0, hi = 0;
@@ -150,8 +178,10 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
     for (int j = 0; j < rings; ++j) {
         const size_t a = size_t(std::max(j - 1, 0)), b = size_t(std::min(j, rings - 2));
         const int64_t lo = std::min(bandLo[a], bandLo[b]), hi = std::max(bandHi[a], bandHi[b]);
-        const bool whole = hi - lo >= circle;
-        const int count = whole ? circle : int(hi - lo) + 1;
+        const int sj = stride[size_t(j)];
+        // Columns all round (then stored as a whole circle, so that its count identifies it).
+        const bool whole = hi - lo >= circle - sj;
+        const int count = whole ? circle / sj : int(hi - lo) / sj + 1;
         ringFirst[size_t(j)] = whole ? 0 : int(lo);
         ringStart[size_t(j) + 1] = ringStart[size_t(j)] + uint32_t(count);
         if (count > widest) {
@@ -164,19 +194,22 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
     // The index buffer depends only on the grid's shape: rebuilt when that changes.
     const bool sameShape = out.rings == rings && out.circleSegments == circle &&
                            out.ringStart == ringStart && out.ringFirstColumn == ringFirst &&
-                           !out.indices.empty();
+                           out.ringStride == stride && !out.indices.empty();
     out.rings = rings;
     out.circleSegments = circle;
     out.ringStart = ringStart;
     out.ringFirstColumn = ringFirst;
+    out.ringStride = stride;
     out.radii_m = radii;
     out.footprint_m = footprint;
     // Sine and cosine of every column any ring uses, from the leftmost.
     int64_t colLo = INT64_MAX, colHi = INT64_MIN;
     for (int j = 0; j < rings; ++j) {
         colLo = std::min<int64_t>(colLo, ringFirst[size_t(j)]);
-        colHi = std::max<int64_t>(colHi, int64_t(ringFirst[size_t(j)]) +
-                                             (ringStart[size_t(j) + 1] - ringStart[size_t(j)]));
+        colHi =
+            std::max<int64_t>(colHi, int64_t(ringFirst[size_t(j)]) +
+                                         int64_t(ringStart[size_t(j) + 1] - ringStart[size_t(j)]) *
+                                             stride[size_t(j)]);
     }
     std::vector<double> sinAz(size_t(colHi - colLo)), cosAz(size_t(colHi - colLo));
     for (int64_t c = colLo; c < colHi; ++c) {
@@ -201,9 +234,10 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
         const float fp = footprint[size_t(j)];
         const FftFilter filter = frame.Filter(fp);
         const int columns = int(ringStart[size_t(j) + 1] - ringStart[size_t(j)]);
-        const size_t c0 = size_t(ringFirst[size_t(j)] - colLo);
+        const size_t c0 = size_t(ringFirst[size_t(j)] - colLo), sj = size_t(stride[size_t(j)]);
         for (int i = 0; i < columns; ++i) {
-            const double rx = radius * sinAz[c0 + size_t(i)], ry = radius * cosAz[c0 + size_t(i)];
+            const double rx = radius * sinAz[c0 + sj * size_t(i)],
+                         ry = radius * cosAz[c0 + sj * size_t(i)];
             const size_t v = size_t(ringStart[size_t(j)]) + size_t(i);
             GeometrySums s{};
             const double x0 = req.eye_m.x + rx, y0 = req.eye_m.y + ry;
@@ -247,30 +281,51 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
     });
 
     if (sameShape) return;
-    // Vertex of world column c on ring j.
+    // Vertex of world column c (a multiple of the ring's stride) on ring j.
     const auto vertex = [&](int j, int64_t c) {
         const uint32_t n = ringStart[size_t(j) + 1] - ringStart[size_t(j)];
-        const int64_t i =
-            n == uint32_t(circle) ? ((c % circle) + circle) % circle : c - ringFirst[size_t(j)];
+        const int64_t sj = stride[size_t(j)];
+        const bool whole = int64_t(n) * sj == circle;
+        const int64_t col = whole ? ((c % circle) + circle) % circle : c - ringFirst[size_t(j)];
+        CHECK(col % sj == 0);
+        const int64_t i = col / sj;
         CHECK(i >= 0 && i < int64_t(n));
         return ringStart[size_t(j)] + uint32_t(i);
     };
-    out.indices.clear();
-    size_t quads = 0;
-    for (int j = 0; j + 1 < rings; ++j)
-        quads += size_t(std::min<int64_t>(bandHi[size_t(j)] - bandLo[size_t(j)], circle));
-    out.indices.reserve(quads * 6);
+    // Each band's triangles: one per inner segment and one per outer segment; bands are
+    // written in parallel at their offsets, so the buffer is the same for any thread count.
+    std::vector<size_t> bandOffset(size_t(rings), 0);
     for (int j = 0; j + 1 < rings; ++j) {
+        const int64_t span = std::min<int64_t>(bandHi[size_t(j)] - bandLo[size_t(j)], circle);
+        bandOffset[size_t(j) + 1] =
+            bandOffset[size_t(j)] +
+            3 * size_t(span / stride[size_t(j)] + span / stride[size_t(j) + 1]);
+    }
+    out.indices.resize(bandOffset.back());
+    tbb::parallel_for(0, rings - 1, [&](int j) {
         const bool whole = bandHi[size_t(j)] - bandLo[size_t(j)] >= circle;
         const int64_t lo = whole ? 0 : bandLo[size_t(j)], hi = whole ? circle : bandHi[size_t(j)];
-        for (int64_t c = lo; c < hi; ++c) {
-            const uint32_t a = vertex(j, c), b = vertex(j, c + 1);
-            const uint32_t cc = vertex(j + 1, c), d = vertex(j + 1, c + 1);
-            // Azimuth increases clockwise seen from above and radius outward, so (a, b, c)
-            // and (b, d, c) are counter-clockwise seen from above.
-            out.indices.insert(out.indices.end(), {a, b, cc, b, d, cc});
+        const int64_t s = stride[size_t(j)], t = stride[size_t(j) + 1], m = s / t;
+        uint32_t* dst = out.indices.data() + bandOffset[size_t(j)];
+        const auto emit = [&](uint32_t p, uint32_t q, uint32_t r) {
+            dst[0] = p, dst[1] = q, dst[2] = r;
+            dst += 3;
+        };
+        for (int64_t c = lo; c < hi; c += s) {
+            const uint32_t a = vertex(j, c), b = vertex(j, c + s);
+            // Azimuth increases clockwise seen from above and radius outward, so (a, b, o) and
+            // (x, o', o) with o' clockwise of o are counter-clockwise seen from above. Where the
+            // outer ring is finer (m > 1 columns per inner segment) its vertices are fanned to
+            // the nearer inner vertex: no T-junction, since every vertex of both rings on the
+            // segment is a corner of the band's triangles.
+            for (int64_t k = 0; k < m / 2; ++k)
+                emit(a, vertex(j + 1, c + (k + 1) * t), vertex(j + 1, c + k * t));
+            emit(a, b, vertex(j + 1, c + (m / 2) * t));
+            for (int64_t k = m / 2; k < m; ++k)
+                emit(b, vertex(j + 1, c + (k + 1) * t), vertex(j + 1, c + k * t));
         }
-    }
+        CHECK(dst == out.indices.data() + bandOffset[size_t(j) + 1]);
+    });
 }
 
 }  // namespace seasense::scene

@@ -44,6 +44,8 @@ struct OceanMeshRequest {
     bool widenByReach = false;
 };
 
+// The coarsest column stride of a ring near the eye with OceanMeshRequest::widenByReach.
+inline constexpr int kMaxColumnStride = 16;
 // The largest sideways widening of a band with OceanMeshRequest::widenByReach: 20°.
 inline constexpr double kMaxReachMargin_rad = 20.0 * 3.14159265358979323846 / 180.0;
 
@@ -59,8 +61,8 @@ struct OceanMesh {
     std::vector<uint32_t> indices;  // counter-clockwise seen from above
     // Ring j's vertices are ringStart[j] … ringStart[j + 1] − 1, its columns ringFirstColumn[j],
     // ringFirstColumn[j] + 1, …: column c lies at azimuth c · 2π / circleSegments, fixed in the
-    // world; a ring with ringStart[j + 1] − ringStart[j] == circleSegments is a whole circle
-    // (column c is vertex ringStart[j] + c mod circleSegments). Without widenByReach every ring
+    // world; a ring whose columns go round the whole circle wraps (column c is column
+    // c mod circleSegments). Without widenByReach every ring
     // has the same columns: ring j, column i is vertex j · (segments + !fullCircle) + i, column
     // i at azimuth (firstColumn + i) · 2π / circleSegments. With it, segments, fullCircle and
     // firstColumn describe the widest ring.
@@ -71,7 +73,11 @@ struct OceanMesh {
     int firstColumn = 0;
     std::vector<uint32_t> ringStart;   // rings + 1 entries
     std::vector<int> ringFirstColumn;  // per ring (0 for whole circles)
-    std::vector<double> radii_m;       // rest-position radius of each ring
+    // Per ring: it holds every ringStride[j]-th column (1 without widenByReach; with it, coarser
+    // near the eye, see ocean_mesh.cpp): vertex ringStart[j] + i is column ringFirstColumn[j]
+    // + i · ringStride[j], and a whole circle has circleSegments / ringStride[j] vertices.
+    std::vector<int> ringStride;
+    std::vector<double> radii_m;     // rest-position radius of each ring
     std::vector<float> footprint_m;  // per ring: the sampling footprint the surface is filtered to
 };
 

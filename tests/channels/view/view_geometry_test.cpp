@@ -100,16 +100,19 @@ TEST(ViewGeometry, ContiguousChannelsShareTheirSeaVertices) {
     // World column c of ring j, or nullptr where that ring has no such column.
     const auto at = [](const scene::OceanMesh& m, int j, int c) -> const glm::vec3* {
         const int n = int(m.ringStart[size_t(j) + 1] - m.ringStart[size_t(j)]);
-        const int i = n == m.circleSegments
-                          ? ((c % m.circleSegments) + m.circleSegments) % m.circleSegments
-                          : c - m.ringFirstColumn[size_t(j)];
-        return i >= 0 && i < n ? &m.positions[m.ringStart[size_t(j)] + size_t(i)] : nullptr;
+        const int s = m.ringStride[size_t(j)];
+        const int col = n * s == m.circleSegments
+                            ? ((c % m.circleSegments) + m.circleSegments) % m.circleSegments
+                            : c - m.ringFirstColumn[size_t(j)];
+        if (col < 0 || col % s != 0 || col / s >= n) return nullptr;
+        return &m.positions[m.ringStart[size_t(j)] + size_t(col / s)];
     };
+    ASSERT_EQ(a.ringStride, b.ringStride);
     int shared = 0;
     for (int j = 0; j < a.rings; ++j) {
         const int n = int(a.ringStart[size_t(j) + 1] - a.ringStart[size_t(j)]);
         for (int i = 0; i < n; ++i) {
-            const int c = a.ringFirstColumn[size_t(j)] + i;
+            const int c = a.ringFirstColumn[size_t(j)] + i * a.ringStride[size_t(j)];
             const glm::vec3* pb = at(b, j, c);
             if (!pb) continue;
             ASSERT_EQ(*at(a, j, c), *pb) << "ring " << j << " column " << c;

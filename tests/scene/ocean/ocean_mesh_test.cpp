@@ -182,10 +182,9 @@ TEST(OceanMesh, ReachWidenedBandsCoverEverySeaPointDrawnInTheSector) {
         for (int j = 0; j < m.rings; ++j)
             for (uint32_t v = m.ringStart[size_t(j)]; v < m.ringStart[size_t(j) + 1]; ++v) {
                 ringOf[v] = j;
-                columnOf[v] =
-                    ((m.ringFirstColumn[size_t(j)] + int(v - m.ringStart[size_t(j)])) % circle +
-                     circle) %
-                    circle;
+                const int c = m.ringFirstColumn[size_t(j)] +
+                              int(v - m.ringStart[size_t(j)]) * m.ringStride[size_t(j)];
+                columnOf[v] = (c % circle + circle) % circle;
             }
         std::set<std::pair<int, int>> quads;
         std::map<std::pair<uint32_t, uint32_t>, int> edgeUses;
@@ -199,15 +198,21 @@ TEST(OceanMesh, ReachWidenedBandsCoverEverySeaPointDrawnInTheSector) {
                 ++edgeUses[std::minmax(p, q)];
         }
         for (const auto& [edge, n] : edgeUses) ASSERT_LE(n, 2);
+        // Near the eye the rings hold every second, fourth, … column (fanned to the next ring).
+        EXPECT_GT(m.ringStride.front(), 1);
+        EXPECT_EQ(m.ringStride.back(), 1);
         for (bool u : used) ASSERT_TRUE(u);
-        // No ring wider than with the fixed 20° margin, and far rings narrower.
+        // No ring wider than with the fixed 20° margin (but for the rounding of its band ends
+        // to whole segments of the coarser ring inside), and far rings narrower.
         OceanMeshRequest fixed = View(eye, centre, half + kMaxReachMargin_rad);
         OceanMesh m20;
         BuildOceanMesh(*frame, fixed, m20);
-        ASSERT_EQ(m20.rings, m.rings);
-        const uint32_t columns20 = uint32_t(m20.segments + 1);
-        for (int j = 0; j < m.rings; ++j)
-            EXPECT_LE(m.ringStart[size_t(j) + 1] - m.ringStart[size_t(j)], columns20) << j;
+        ASSERT_EQ(m20.circleSegments, circle);
+        for (int j = 0; j < m.rings; ++j) {
+            const int n = int(m.ringStart[size_t(j) + 1] - m.ringStart[size_t(j)]);
+            const int inner = m.ringStride[size_t(std::max(j - 1, 0))];
+            EXPECT_LE((n - 1) * m.ringStride[size_t(j)], m20.segments + 2 * inner) << j;
+        }
         // The horizon ring: the view's own columns, a column of rounding and one of margin
         // on each side.
         EXPECT_LE(m.ringStart.back() - m.ringStart[size_t(m.rings) - 1],
@@ -224,7 +229,10 @@ TEST(OceanMesh, ReachWidenedBandsCoverEverySeaPointDrawnInTheSector) {
                 const glm::dvec3 d = frame->Terms(x0, y0).displacement;
                 const double drawnAz = std::atan2(x0 + d.x - eye.x, y0 + d.y - eye.y);
                 if (std::abs(std::remainder(drawnAz - centre, 2.0 * kPi)) > half) continue;
-                const int column = ((int(std::floor(az / dphi)) % circle) + circle) % circle;
+                const int sj = m.ringStride[j];
+                const int column =
+                    (((int(std::floor(std::floor(az / dphi) / sj)) * sj) % circle) + circle) %
+                    circle;
                 ASSERT_TRUE(quads.count({int(j), column}))
                     << "band " << j << " r " << r << " azimuth " << az;
                 ++checked;
