@@ -382,8 +382,9 @@ void OceanSurface::Fill(OceanSurfaceFrame& frame, double t, bool withVelocity) c
     frame.surfReach_m_ = 0.0;
     if (surf_) {
         // Over the whole surface: the surf bound at every depth, the whole seabed.
-        frame.surfReach_m_ =
-            surf_->BoundAtDepths(-kInf, frame.cascadeBounds_, frame.GerstnerBound()).horizontal_m;
+        // One table per frame serves every BoundsNear (each view asks for a few discs).
+        frame.surfBounds_ = surf_->MakeBoundTable(frame.cascadeBounds_, frame.GerstnerBound());
+        frame.surfReach_m_ = surf_->BoundAtDepths(-kInf, frame.surfBounds_).horizontal_m;
         const SurfaceBounds all = frame.BoundsNear(0.0, 0.0, kInf);
         frame.maxHeight_m_ = all.height_m;
         frame.maxHorizontal_m_ = all.horizontal_m;
@@ -400,7 +401,7 @@ SurfaceBounds OceanSurfaceFrame::BoundsNear(double x, double y, double radius_m)
     // Rest positions within the radius; the seabed clamp looks under the displaced points.
     const double tide = surf_->Bathy().Tide_m();
     const double zBed = surf_->Bathy().MaxSeabedZWithin_m(x, y, radius_m + surfReach_m_);
-    const SurfWaves::Bound b = surf_->BoundAtDepths(tide - zBed, cascadeBounds_, GerstnerBound());
+    const SurfWaves::Bound b = surf_->BoundAtDepths(tide - zBed, surfBounds_);
     return {std::max({tide + b.height_m, zBed, 0.0}), b.horizontal_m};
 }
 

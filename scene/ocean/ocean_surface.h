@@ -161,7 +161,8 @@ class OceanSurfaceFrame {
     double maxHeight_m_ = 0.0;
     double maxHorizontal_m_ = 0.0;
     std::vector<SurfWaves::Bound> cascadeBounds_;  // per cascade: max |η|, max |D|
-    double surfReach_m_ = 0.0;  // largest horizontal displacement anywhere, with the surf
+    SurfWaves::BoundTable surfBounds_;  // SurfWaves::BoundAtDepths of this frame's bounds
+    double surfReach_m_ = 0.0;          // largest horizontal displacement anywhere, with the surf
     double significantHeight_m_ = 0.0;
 };
 

@@ -397,8 +397,17 @@ SurfWeights SurfWaves::Weights(double depth_m) const {
     return w;
 }
 
-SurfWaves::Bound SurfWaves::BoundAtDepths(double minDepth_m, const std::vector<Bound>& cascades,
-                                          const Bound& gerstner) const {
+namespace {
+
+void MaxInto(SurfWaves::Bound& out, const SurfWaves::Bound& b) {
+    out.height_m = std::max(out.height_m, b.height_m);
+    out.horizontal_m = std::max(out.horizontal_m, b.horizontal_m);
+}
+
+}  // namespace
+
+SurfWaves::Bound SurfWaves::DeepBound(const std::vector<Bound>& cascades,
+                                      const Bound& gerstner) const {
     CHECK(cascades.size() <= kMaxSurfCascades);
     CHECK(cascades_.empty() || cascades.size() == cascades_.size());
     // At or below the deepest fade the sea is the deep sea alone, every weight 1.
@@ -407,44 +416,90 @@ SurfWaves::Bound SurfWaves::BoundAtDepths(double minDepth_m, const std::vector<B
         deep.height_m += c.height_m;
         deep.horizontal_m += c.horizontal_m;
     }
-    Bound out = deep;
+    return deep;
+}
+
+SurfWaves::Bound SurfWaves::IntervalBound(int i, double surfDepth_m,
+                                          const std::vector<Bound>& cascades,
+                                          const Bound& gerstner) const {
     const size_t n = incoming_.size();
+    const double h0 = i * dh_m_, h1 = (i + 1) * dh_m_;
+    // The deep weights grow with depth, the surf weights fall.
+    const SurfWeights wDeep = Weights(h1), wSurf = Weights(surfDepth_m);
+    Bound b;
+    b.height_m = wDeep.gerstner * gerstner.height_m;
+    b.horizontal_m = wDeep.gerstner * gerstner.horizontal_m;
+    for (size_t c = 0; c < cascades.size(); ++c) {
+        const double w = cascades_.empty() ? 1.0 : wDeep.cascade[c];
+        b.height_m += w * cascades[c].height_m;
+        b.horizontal_m += w * cascades[c].horizontal_m;
+    }
+    double amplitude = 0.0, orbit = 0.0, longest = 0.0;
+    for (size_t m = 0; m < n; ++m) {
+        const DepthSample& s0 = depth_[size_t(i) * n + m];
+        const DepthSample& s1 = depth_[size_t(i + 1) * n + m];
+        const double w =
+            components_[incoming_[m]].spectral ? wSurf.spectralSurf : wSurf.gerstnerSurf;
+        const double a = std::max(s0.amplitude, s1.amplitude) * w;
+        const double invTanh = std::max(s0.invTanh, s1.invTanh);
+        amplitude += a;
+        orbit += a * invTanh;
+        longest = std::max(longest, invTanh);
+    }
+    // Height: cap · Re(Σ a e^{iψ}) ≤ min(|Σ a e^{iψ}|, γh/2) ≤ min(Σ a, γh/2) (see Terms).
+    // Behind a bar the cap only falls (Shelter ≤ 1); the swash adds at most its maximum where
+    // it reaches (depth below 2 R2).
+    const double halfGammaH = 0.5 * settings_.breakerIndex * h1;
+    b.height_m += std::min(amplitude, halfGammaH);
+    if (swash_.active && h0 < 2.0 * swash_.runup2_m) b.height_m += swash_.max_m;
+    b.horizontal_m += std::min(orbit, halfGammaH * longest);
+    return b;
+}
+
+SurfWaves::Bound SurfWaves::BoundAtDepths(double minDepth_m, const std::vector<Bound>& cascades,
+                                          const Bound& gerstner) const {
+    Bound out = DeepBound(cascades, gerstner);
     for (int i = 0; i + 1 < depthSamples_; ++i) {
         const double h0 = i * dh_m_, h1 = (i + 1) * dh_m_;
         if (h1 < minDepth_m) continue;
         if (h0 >= fadeDeep_m_) break;
-        // The deep weights grow with depth, the surf weights fall.
-        const SurfWeights wDeep = Weights(h1), wSurf = Weights(std::max(h0, minDepth_m));
-        Bound b;
-        b.height_m = wDeep.gerstner * gerstner.height_m;
-        b.horizontal_m = wDeep.gerstner * gerstner.horizontal_m;
-        for (size_t c = 0; c < cascades.size(); ++c) {
-            const double w = cascades_.empty() ? 1.0 : wDeep.cascade[c];
-            b.height_m += w * cascades[c].height_m;
-            b.horizontal_m += w * cascades[c].horizontal_m;
-        }
-        double amplitude = 0.0, orbit = 0.0, longest = 0.0;
-        for (size_t m = 0; m < n; ++m) {
-            const DepthSample& s0 = depth_[size_t(i) * n + m];
-            const DepthSample& s1 = depth_[size_t(i + 1) * n + m];
-            const double w =
-                components_[incoming_[m]].spectral ? wSurf.spectralSurf : wSurf.gerstnerSurf;
-            const double a = std::max(s0.amplitude, s1.amplitude) * w;
-            const double invTanh = std::max(s0.invTanh, s1.invTanh);
-            amplitude += a;
-            orbit += a * invTanh;
-            longest = std::max(longest, invTanh);
-        }
-        // Height: cap · Re(Σ a e^{iψ}) ≤ min(|Σ a e^{iψ}|, γh/2) ≤ min(Σ a, γh/2) (see Terms).
-        // Behind a bar the cap only falls (Shelter ≤ 1); the swash adds at most its maximum where
-        // it reaches (depth below 2 R2).
-        const double halfGammaH = 0.5 * settings_.breakerIndex * h1;
-        b.height_m += std::min(amplitude, halfGammaH);
-        if (swash_.active && h0 < 2.0 * swash_.runup2_m) b.height_m += swash_.max_m;
-        b.horizontal_m += std::min(orbit, halfGammaH * longest);
-        out.height_m = std::max(out.height_m, b.height_m);
-        out.horizontal_m = std::max(out.horizontal_m, b.horizontal_m);
+        MaxInto(out, IntervalBound(i, std::max(h0, minDepth_m), cascades, gerstner));
     }
+    return out;
+}
+
+SurfWaves::BoundTable SurfWaves::MakeBoundTable(const std::vector<Bound>& cascades,
+                                                const Bound& gerstner) const {
+    BoundTable t;
+    t.cascades = cascades;
+    t.gerstner = gerstner;
+    t.deep = DeepBound(cascades, gerstner);
+    int end = 0;  // intervals 0 … end − 1 lie shallower than the deepest fade
+    while (end + 1 < depthSamples_ && end * dh_m_ < fadeDeep_m_) ++end;
+    t.fromInterval.assign(size_t(end) + 1, Bound{});
+    for (int i = end - 1; i >= 0; --i) {
+        t.fromInterval[size_t(i)] = t.fromInterval[size_t(i) + 1];
+        MaxInto(t.fromInterval[size_t(i)], IntervalBound(i, i * dh_m_, cascades, gerstner));
+    }
+    return t;
+}
+
+SurfWaves::Bound SurfWaves::BoundAtDepths(double minDepth_m, const BoundTable& t) const {
+    // The first interval the loop of BoundAtDepths above keeps: the shallowest with
+    // h1 ≥ minDepth. It takes its surf weights at minDepth; every deeper one at its own
+    // shallow end (≥ minDepth), as tabulated, so the result is the loop's, bit for bit.
+    const int end = int(t.fromInterval.size()) - 1;
+    int i = 0;
+    if (minDepth_m > 0.0) {
+        const double guess = std::floor(minDepth_m / dh_m_) - 1.0;
+        i = guess > 0.0 ? int(std::min(guess, double(end))) : 0;
+        while (i < end && (i + 1) * dh_m_ < minDepth_m) ++i;
+        while (i > 0 && i * dh_m_ >= minDepth_m) --i;
+    }
+    Bound out = t.deep;
+    if (i >= end || !((i + 1) * dh_m_ >= minDepth_m)) return out;
+    MaxInto(out, IntervalBound(i, std::max(i * dh_m_, minDepth_m), t.cascades, t.gerstner));
+    MaxInto(out, t.fromInterval[size_t(i) + 1]);
     return out;
 }
 

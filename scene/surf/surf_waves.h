@@ -166,6 +166,18 @@ class SurfWaves {
     };
     Bound BoundAtDepths(double minDepth_m, const std::vector<Bound>& cascades,
                         const Bound& gerstner) const;
+    // The same for any minimum depth from one table per set of deep-sea bounds: each depth
+    // interval's bound with its surf weights at its shallow end, and their running maximum from
+    // the deep end; BoundAtDepths(minDepth, table) then costs one interval, and equals the
+    // function above bit for bit.
+    struct BoundTable {
+        std::vector<Bound> cascades;
+        Bound gerstner;
+        Bound deep;
+        std::vector<Bound> fromInterval;  // max over intervals ≥ i (a zero bound past the last)
+    };
+    BoundTable MakeBoundTable(const std::vector<Bound>& cascades, const Bound& gerstner) const;
+    Bound BoundAtDepths(double minDepth_m, const BoundTable& table) const;
 
     // Mean breaker line (cross-shore s, m) of the plane beach: +∞ if no component, −∞ if the waves
     // never break before the shore.
@@ -204,6 +216,10 @@ class SurfWaves {
     // --- end swash
 
   private:
+    Bound DeepBound(const std::vector<Bound>& cascades, const Bound& gerstner) const;
+    // Interval i's (depths i·dh … (i+1)·dh) bound with the surf weights at surfDepth_m.
+    Bound IntervalBound(int i, double surfDepth_m, const std::vector<Bound>& cascades,
+                        const Bound& gerstner) const;
     template <bool kVelocity>
     SurfaceTerms TermsImpl(double x0, double y0, double t_s, SurfPointInfo* info,
                            const TermsOptions& options) const;

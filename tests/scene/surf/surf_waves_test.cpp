@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "scene/ocean/ocean_surface.h"
@@ -207,6 +208,30 @@ TEST(SurfWaves, BoundsNearAPointHoldOverTheWholeDisc) {
     const SurfaceBounds deep = sea.At(0.0)->BoundsNear(3000.0, 150.0, 10.0);
     EXPECT_EQ(deep.height_m, open.At(0.0)->MaxHeight_m());
     EXPECT_EQ(deep.horizontal_m, open.At(0.0)->MaxHorizontal_m());
+}
+
+// The table of a frame's depth-interval bounds gives BoundAtDepths bit for bit for any
+// minimum depth: negative, zero, on and between the depth samples, past the deepest fade.
+TEST(SurfWaves, BoundTableEqualsTheIntervalLoop) {
+    const OceanSurface sea(SpectralBeach(true));
+    const SurfWaves& surf = *sea.Surf();
+    const std::vector<SurfWaves::Bound> cascades = {{0.8, 0.6}, {0.3, 0.25}};
+    const SurfWaves::Bound gerstner{0.45, 0.2};
+    const SurfWaves::BoundTable table = surf.MakeBoundTable(cascades, gerstner);
+    std::vector<double> depths = {-std::numeric_limits<double>::infinity(),
+                                  -5.0,
+                                  0.0,
+                                  surf.FadeDeep_m(),
+                                  2.0 * surf.FadeDeep_m(),
+                                  1e6};
+    for (int k = 0; k <= 4000; ++k) depths.push_back(1.1 * surf.FadeDeep_m() * k / 4000.0);
+    for (int k = 0; k <= 400; ++k) depths.push_back(0.25 * k);  // on round depths
+    for (double d : depths) {
+        const SurfWaves::Bound a = surf.BoundAtDepths(d, cascades, gerstner);
+        const SurfWaves::Bound b = surf.BoundAtDepths(d, table);
+        ASSERT_EQ(a.height_m, b.height_m) << d;
+        ASSERT_EQ(a.horizontal_m, b.horizontal_m) << d;
+    }
 }
 
 TEST(SurfWaves, ChopKeepsItsWeightWhereItIsDeepWaterForItsWavelength) {
