@@ -100,6 +100,18 @@ double NearestVisibleSeaRange_m(const ChannelCamera& cam, const scene::OceanSurf
     return NearestVisibleSeaRange_m(cam, disc.height_m, disc.horizontal_m);
 }
 
+scene::OceanMeshRequest SeaMeshRequest(const ChannelCamera& cam,
+                                       const scene::OceanSurfaceFrame& sea) {
+    scene::OceanMeshRequest req;
+    req.eye_m = cam.worldFromCamera.position_m;
+    req.angularStep_rad = kOceanVertexSpacing_px * cam.hfov_rad / double(cam.width);
+    // The view's own sector; the mesh widens each band by what the waves can carry sideways.
+    FrustumAzimuthSector(cam, 0.0, req.azimuthMin_rad, req.azimuthMax_rad);
+    req.widenByReach = true;
+    req.minRange_m = NearestVisibleSeaRange_m(cam, sea, req.eye_m);
+    return req;
+}
+
 ViewGeometry::ViewGeometry(const scene::World& world, const scene::ChannelSettings& settings)
     : world_(world), settings_(settings) {
     const scene::SceneState s0 = world.State(0);
@@ -197,14 +209,7 @@ void ViewGeometry::Update(const scene::SceneState& state) {
     oceanFrame_ = world_.Ocean().At(state.time_s);
     const scene::OceanSurfaceFrame& sea = *oceanFrame_;
     const Clock::time_point tSea = Clock::now();
-    scene::OceanMeshRequest req;
-    req.eye_m = cam.worldFromCamera.position_m;
-    req.angularStep_rad = kOceanVertexSpacing_px * cam.hfov_rad / double(cam.width);
-    // The view's own sector; the mesh widens each band by what the waves can carry sideways.
-    FrustumAzimuthSector(cam, 0.0, req.azimuthMin_rad, req.azimuthMax_rad);
-    req.widenByReach = true;
-    req.minRange_m = NearestVisibleSeaRange_m(cam, sea, req.eye_m);
-    scene::BuildOceanMesh(sea, req, ocean_);
+    scene::BuildOceanMesh(sea, SeaMeshRequest(cam, sea), ocean_);
     UpdateOceanAttributes();
 
     std::vector<RasterMesh> meshes;

@@ -94,4 +94,10 @@ double NearestVisibleSeaRange_m(const ChannelCamera& camera, double crestHeight_
 double NearestVisibleSeaRange_m(const ChannelCamera& camera, const scene::OceanSurfaceFrame& sea,
                                 const glm::dvec3& eye_m);
 
+// The sea mesh a channel asks for (ViewGeometry, and the mesh benchmarks): vertices 6 pixels
+// apart on screen, the camera's own azimuth sector widened per band by the waves' reach
+// (OceanMeshRequest::widenByReach), starting at the nearest visible range of this frame's sea.
+scene::OceanMeshRequest SeaMeshRequest(const ChannelCamera& camera,
+                                       const scene::OceanSurfaceFrame& sea);
+
 }  // namespace seasense::channels

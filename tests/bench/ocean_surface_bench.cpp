@@ -54,13 +54,7 @@ void BM_OceanLodMesh(benchmark::State& state) {
     const ChannelCamera cam =
         MakeChannelCamera(scene::PoseFrom(sc.eyepoint.position_m, sc.eyepoint.attitude), ch);
     // As ViewGeometry asks for it.
-    scene::OceanMeshRequest req;
-    req.eye_m = cam.worldFromCamera.position_m;
-    req.angularStep_rad = 6.0 * cam.hfov_rad / double(cam.width);
-    // As ViewGeometry asks: the view's own sector, widened per band by the waves' reach.
-    FrustumAzimuthSector(cam, 0.0, req.azimuthMin_rad, req.azimuthMax_rad);
-    req.widenByReach = true;
-    req.minRange_m = NearestVisibleSeaRange_m(cam, *frame, req.eye_m);
+    const scene::OceanMeshRequest req = SeaMeshRequest(cam, *frame);
     scene::OceanMesh mesh;
     for (auto _ : state) arena.execute([&] { scene::BuildOceanMesh(*frame, req, mesh); });
     state.counters["vertices"] = double(mesh.positions.size());

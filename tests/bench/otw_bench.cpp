@@ -135,15 +135,9 @@ void BM_OceanMesh(benchmark::State& state) {
     const scene::ChannelSettings& ch = SingleOtw().channels.at(0);
     tbb::task_arena arena(int(state.range(0)));
     const ChannelCamera cam = MakeChannelCamera(world.State(0).eyepoint, ch);
-    scene::OceanMeshRequest req;
-    req.eye_m = cam.worldFromCamera.position_m;
-    req.angularStep_rad = 6.0 * cam.hfov_rad / double(cam.width);
-    // As ViewGeometry asks: the view's own sector, widened per band by the waves' reach.
-    FrustumAzimuthSector(cam, 0.0, req.azimuthMin_rad, req.azimuthMax_rad);
-    req.widenByReach = true;
     double t = 0.0;
     const auto sea0 = world.Ocean().At(t);
-    req.minRange_m = NearestVisibleSeaRange_m(cam, *sea0, req.eye_m);
+    const scene::OceanMeshRequest req = SeaMeshRequest(cam, *sea0);  // as ViewGeometry asks
     scene::OceanMesh mesh;
     for (auto _ : state) {
         const auto sea = world.Ocean().At(t);
