@@ -67,9 +67,14 @@ bool StopBeforeIndex(const SegmentHeader& h, uint32_t index) {
     return s == RunStatus::Stopping && index > h.lastFrameIndex.load(std::memory_order_acquire);
 }
 
-uint32_t Needed(uint32_t index, uint32_t channels) {
-    // Index counters stay far below 2^32 / channels: runs are limited to 2^27 frames.
-    return (index + 1) * channels;
+// Whether every channel's counter (done or presented) has passed index. The totals only say
+// that something changed: a renderer may render frame i + 1 while frame i waits at the
+// barrier, so a sum could reach (i + 1) · channels while a slow channel has not finished i.
+bool EveryChannelPast(const SegmentHeader& h, std::atomic<uint32_t> ChannelBlock::*counter,
+                      uint32_t index) {
+    for (uint32_t c = 0; c < h.channelCount; ++c)
+        if ((h.channels[c].*counter).load(std::memory_order_acquire) <= index) return false;
+    return true;
 }
 
 }  // namespace
@@ -133,9 +138,7 @@ WaitResult HostLock::WaitAttached(const LivenessCheck& alive, double timeout_s) 
 
 bool HostLock::SlotFree(uint32_t index) const {
     if (index < uint32_t(kSlotCount)) return true;
-    const SegmentHeader& h = seg_.Header();
-    return h.presentedTotal.load(std::memory_order_acquire) >=
-           Needed(index - kSlotCount, h.channelCount);
+    return EveryChannelPast(seg_.Header(), &ChannelBlock::presented, index - kSlotCount);
 }
 
 uint8_t* HostLock::BeginPublish(uint32_t index) {
@@ -158,9 +161,8 @@ void HostLock::EndPublish(uint32_t index, int64_t frame, uint64_t bytes) {
 
 WaitResult HostLock::WaitPresented(uint32_t index, const LivenessCheck& alive, double timeout_s) {
     SegmentHeader& h = seg_.Header();
-    const uint32_t need = Needed(index, h.channelCount);
     return WaitFor(
-        h.presentedTotal, [&] { return h.presentedTotal.load(std::memory_order_acquire) >= need; },
+        h.presentedTotal, [&] { return EveryChannelPast(h, &ChannelBlock::presented, index); },
         [&] { return Status(h) == RunStatus::Aborted; }, alive, timeout_s);
 }
 
@@ -221,18 +223,24 @@ WaitResult ChannelLock::WaitPublished(uint32_t index, const LivenessCheck& alive
     return r;
 }
 
-void ChannelLock::Done(uint32_t index) {
+bool ChannelLock::Done(uint32_t index, bool wake) {
     SegmentHeader& h = seg_.Header();
     Block().done.store(index + 1, std::memory_order_release);
     h.doneTotal.fetch_add(1, std::memory_order_acq_rel);
-    WakeAll(h.doneTotal);
+    if (wake) WakeDone();
+    return AllDone(index);
+}
+
+void ChannelLock::WakeDone() { WakeAll(seg_.Header().doneTotal); }
+
+bool ChannelLock::AllDone(uint32_t index) const {
+    return EveryChannelPast(seg_.Header(), &ChannelBlock::done, index);
 }
 
 WaitResult ChannelLock::WaitAllDone(uint32_t index, const LivenessCheck& alive, double timeout_s) {
     SegmentHeader& h = seg_.Header();
-    const uint32_t need = Needed(index, h.channelCount);
     return WaitFor(
-        h.doneTotal, [&] { return h.doneTotal.load(std::memory_order_acquire) >= need; },
+        h.doneTotal, [&] { return EveryChannelPast(h, &ChannelBlock::done, index); },
         [&] { return StopBeforeIndex(h, index); }, alive, timeout_s);
 }
 

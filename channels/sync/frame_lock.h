@@ -71,8 +71,14 @@ class ChannelLock {
     // Waits until index i is published; on Ready, state points at its bytes.
     WaitResult WaitPublished(uint32_t index, const LivenessCheck& alive, double timeout_s,
                              const uint8_t** state, uint64_t* bytes, int64_t* frame);
-    // Marks index i rendered.
-    void Done(uint32_t index);
+    // Marks index i rendered; true when this completed the barrier (every channel has now
+    // rendered i). With wake = false the caller wakes the waiters later with WakeDone(): the
+    // last channel presents first, so that the wake-ups it causes cannot delay its own
+    // presentation behind the processes it woke.
+    bool Done(uint32_t index, bool wake = true);
+    void WakeDone();
+    // Whether every channel has rendered index i (the barrier's condition, without waiting).
+    bool AllDone(uint32_t index) const;
     // The barrier: waits until every channel has rendered index i.
     WaitResult WaitAllDone(uint32_t index, const LivenessCheck& alive, double timeout_s);
     // Marks index i presented (its timing and image in the slot are complete).

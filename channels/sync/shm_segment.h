@@ -12,8 +12,9 @@ namespace seasense::channels::sync {
 
 // "SEASHM01" read as a little-endian 64-bit word.
 inline constexpr uint64_t kSegmentMagic = 0x31304d4853414553ull;
-// Bumped whenever the layout below changes; a segment of another version is refused.
-inline constexpr uint32_t kLayoutVersion = 3;
+// Bumped whenever the layout below or the protocol over it changes; a segment of another
+// version is refused. 4: renderers render ahead, the barrier reads each channel's counters.
+inline constexpr uint32_t kLayoutVersion = 4;
 inline constexpr int kMaxChannels = 16;
 // State slots: the host publishes frame n+1 while channels may still present frame n, and
 // never writes the slot of frame n+2 before every channel has presented frame n.
@@ -93,8 +94,10 @@ struct alignas(64) SegmentHeader {
     alignas(64) std::atomic<uint32_t> status;  // RunStatus
     std::atomic<uint32_t> lastFrameIndex;      // when Stopping: last index to finish
     alignas(64) FutexWord published;           // frame indices published (index i ⇒ ≥ i + 1)
-    alignas(64) FutexWord doneTotal;           // Σ over channels of frames rendered
-    alignas(64) FutexWord presentedTotal;      // Σ over channels of frames presented
+    // Σ over channels of frames rendered / presented: futex words that change with every
+    // channel's own counter; waits test the channels' counters (frame_lock.cpp).
+    alignas(64) FutexWord doneTotal;
+    alignas(64) FutexWord presentedTotal;
     alignas(64) FutexWord attachedCount;
     StateSlot slots[kSlotCount];
     ChannelBlock channels[kMaxChannels];

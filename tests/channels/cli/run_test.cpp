@@ -142,6 +142,7 @@ TEST(Run, WritesImagesSyncLogMosaicAndSummaryUnderTheFrameLock) {
     for (const CsvRow& row : rows) byFrame[row.frame].push_back(row);
     ASSERT_EQ(byFrame.size(), 6u);
     int64_t previousLatestDone = INT64_MIN;
+    std::map<std::string, int64_t> previousPresent;
     for (auto& [frame, rs] : byFrame) {
         ASSERT_EQ(rs.size(), kChannels.size()) << "frame " << frame;
         int64_t latestDone = INT64_MIN, earliestPresent = INT64_MAX;
@@ -152,8 +153,11 @@ TEST(Run, WritesImagesSyncLogMosaicAndSummaryUnderTheFrameLock) {
             EXPECT_EQ(row.utc, rs[0].utc);
             latestDone = std::max(latestDone, row.done);
             earliestPresent = std::min(earliestPresent, row.present);
-            // No channel starts frame n + 1 before every channel has finished frame n.
-            EXPECT_GE(row.start, previousLatestDone);
+            // No channel presents frame n + 1 before every channel has finished frame n (it
+            // may render it meanwhile), and each presents its frames in order.
+            EXPECT_GE(row.present, previousLatestDone);
+            EXPECT_GT(row.present, previousPresent[row.channel]);
+            previousPresent[row.channel] = row.present;
         }
         // Nobody presents before everyone is done: the lock.
         EXPECT_GE(earliestPresent, latestDone) << "frame " << frame;

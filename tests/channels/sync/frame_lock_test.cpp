@@ -56,11 +56,24 @@ const LivenessCheck kAlways = [] { return true; };
 
 // One trivial renderer: checks every frame arrives in order with its own state, that the state
 // does not change under it, and that at presentation every channel has rendered the frame.
-// Returns the number of violations.
-int TrivialRenderer(const Segment& seg, const std::string& name, uint32_t frames) {
+// With ahead = true it renders frame i + 1 before it waits at frame i's barrier and presents
+// it, as `seasense channel` does. Returns the number of violations.
+int TrivialRenderer(const Segment& seg, const std::string& name, uint32_t frames,
+                    bool ahead = false) {
     ChannelLock lock(seg, name);
     const SegmentHeader& h = seg.Header();
     int violations = 0;
+    const auto present = [&](uint32_t i) {
+        if (lock.WaitAllDone(i, kAlways, 30.0) != WaitResult::Ready) return false;
+        // The lock: nobody presents frame i before every channel has rendered it.
+        for (uint32_t c = 0; c < h.channelCount; ++c)
+            if (h.channels[c].done.load() < i + 1) ++violations;
+        FrameTiming& t = lock.Block().timing[i % kSlotCount];
+        t.frame = int64_t(i);
+        t.presentNs = MonotonicNs();
+        lock.Presented(i);
+        return true;
+    };
     for (uint32_t i = 0; i < frames; ++i) {
         const uint8_t* state = nullptr;
         uint64_t bytes = 0;
@@ -73,15 +86,13 @@ int TrivialRenderer(const Segment& seg, const std::string& name, uint32_t frames
         std::this_thread::yield();  // "render"
         if (std::memcmp(copy, state, 64) != 0 || !StateIs(state, i)) ++violations;
         lock.Done(i);
-        if (lock.WaitAllDone(i, kAlways, 30.0) != WaitResult::Ready) return violations + 1000;
-        // The lock: nobody presents frame i before every channel has rendered it.
-        for (uint32_t c = 0; c < h.channelCount; ++c)
-            if (h.channels[c].done.load() < i + 1) ++violations;
-        FrameTiming& t = lock.Block().timing[i % kSlotCount];
-        t.frame = int64_t(i);
-        t.presentNs = MonotonicNs();
-        lock.Presented(i);
+        if (ahead) {
+            if (i > 0 && !present(i - 1)) return violations + 1000;
+        } else if (!present(i)) {
+            return violations + 1000;
+        }
     }
+    if (ahead && frames > 0 && !present(frames - 1)) return violations + 1000;
     return violations;
 }
 
@@ -144,7 +155,9 @@ TEST(FrameLock, FiveProcessesThousandFramesNeverBreakTheLock) {
             int status = 99;
             try {
                 Segment mine = Segment::Attach(runId, 5.0);
-                status = std::min(TrivialRenderer(mine, "ch" + std::to_string(c), kFrames), 98);
+                // Odd channels render a frame ahead while the even ones wait at the barrier.
+                status = std::min(
+                    TrivialRenderer(mine, "ch" + std::to_string(c), kFrames, c % 2 == 1), 98);
             } catch (...) {
                 status = 97;
             }
@@ -186,6 +199,34 @@ TEST(FrameLock, BarrierHoldsUntilTheSlowestChannelIsDone) {
     EXPECT_FALSE(host.SlotFree(2));  // ch1 has not presented yet
     slow.Presented(0);
     EXPECT_TRUE(host.SlotFree(2));
+    seg.Unlink();
+}
+
+// A channel that renders ahead has done two frames while its peer has done none: the sum of the
+// done counters equals "every channel did frame 0", but the barrier of frame 0 must stay shut.
+TEST(FrameLock, ChannelRenderingAheadDoesNotOpenTheBarrier) {
+    Segment seg = Segment::Create(Spec(UniqueRunId("ahead"), 2, 4));
+    HostLock host(seg);
+    ChannelLock fast(seg, "ch0"), slow(seg, "ch1");
+    for (uint32_t i = 0; i < 2; ++i) {
+        WriteState(host.BeginPublish(i), i);
+        host.EndPublish(i, int64_t(i), 64);
+    }
+    EXPECT_FALSE(fast.Done(0));
+    EXPECT_FALSE(fast.Done(1));
+    EXPECT_FALSE(fast.AllDone(0));
+    EXPECT_EQ(fast.WaitAllDone(0, kAlways, 0.1), WaitResult::TimedOut);
+    EXPECT_TRUE(slow.Done(0));  // the last channel to finish frame 0 completes its barrier
+    EXPECT_TRUE(fast.AllDone(0));
+    EXPECT_FALSE(fast.AllDone(1));
+    fast.Presented(0);
+    fast.Presented(1);  // (a broken renderer: presents frame 1 before its barrier)
+    // Slot 0 is reused for frame 2 only when every channel presented frame 0.
+    EXPECT_FALSE(host.SlotFree(2));
+    EXPECT_EQ(host.WaitPresented(0, kAlways, 0.1), WaitResult::TimedOut);
+    slow.Presented(0);
+    EXPECT_TRUE(host.SlotFree(2));
+    EXPECT_FALSE(host.SlotFree(3));
     seg.Unlink();
 }
 
