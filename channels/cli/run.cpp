@@ -9,14 +9,10 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <condition_variable>
 #include <cstdio>
 #include <cstring>
-#include <deque>
 #include <fstream>
-#include <functional>
 #include <memory>
-#include <mutex>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <thread>
@@ -25,6 +21,7 @@
 #include "channels/pipeline/channel_pipeline.h"
 #include "channels/sync/frame_lock.h"
 #include "channels/sync/mosaic.h"
+#include "channels/sync/presenter.h"
 #include "channels/sync/renderer_process.h"
 #include "channels/sync/shm_segment.h"
 #include "channels/sync/state_codec.h"
@@ -119,101 +116,6 @@ void SleepUntilNs(int64_t t) {
             std::chrono::nanoseconds(std::min<int64_t>(t - now, 20'000'000)));
     }
 }
-
-// A renderer's frame waiting to be presented: its timing and its display image.
-struct PresentItem {
-    uint32_t index = 0;
-    sync::FrameTiming timing;
-    std::vector<uint8_t> rgb;
-};
-
-// Presents a renderer's frames in order on a thread of their own: each waits at the frame-lock
-// barrier and is then presented. The first wait that ends the run (stop, host gone, signal,
-// timeout) ends the thread with the renderer's exit status.
-class Presenter {
-  public:
-    using PresentFn = std::function<std::optional<int>(PresentItem&)>;
-    explicit Presenter(PresentFn present)
-        : present_(std::move(present)), thread_([this] { Loop(); }) {}
-    ~Presenter() { Close(); }
-    Presenter(const Presenter&) = delete;
-    Presenter& operator=(const Presenter&) = delete;
-
-    void Push(PresentItem item) {
-        {
-            std::lock_guard<std::mutex> guard(mutex_);
-            queue_.push_back(std::move(item));
-        }
-        cv_.notify_one();
-    }
-    // Presents item on the calling thread when nothing is queued before it and ready() holds
-    // (the frame's barrier is already complete: this channel finished last), else queues it.
-    // Waking the presenter thread would cost a scheduler wake-up on a machine whose cores the
-    // renderers keep busy (tens of milliseconds of skew, measured).
-    void PresentOrPush(PresentItem item, const std::function<bool()>& ready) {
-        {
-            std::lock_guard<std::mutex> guard(mutex_);
-            if (queue_.empty() && !busy_ && !exit_ && ready()) {
-                exit_ = present_(item);
-                return;
-            }
-        }
-        Push(std::move(item));
-    }
-    // The exit status once the thread has ended the run.
-    std::optional<int> Ended() {
-        std::lock_guard<std::mutex> guard(mutex_);
-        return exit_;
-    }
-    // Waits until every pushed frame is presented (normal end, status 0) or the thread has
-    // ended; returns the thread's status if it ended the run, else status.
-    int Finish(int status) {
-        if (status == 0) {
-            std::unique_lock<std::mutex> guard(mutex_);
-            drained_.wait(guard, [&] { return (queue_.empty() && !busy_) || exit_; });
-        }
-        Close();
-        std::lock_guard<std::mutex> guard(mutex_);
-        return exit_ && status == 0 ? *exit_ : status;
-    }
-
-  private:
-    void Close() {
-        {
-            std::lock_guard<std::mutex> guard(mutex_);
-            closing_ = true;
-        }
-        cv_.notify_one();
-        if (thread_.joinable()) thread_.join();
-    }
-    void Loop() {
-        for (;;) {
-            PresentItem item;
-            {
-                std::unique_lock<std::mutex> guard(mutex_);
-                cv_.wait(guard, [&] { return closing_ || !queue_.empty(); });
-                if (queue_.empty()) return;
-                item = std::move(queue_.front());
-                queue_.pop_front();
-                busy_ = true;
-            }
-            const std::optional<int> e = present_(item);
-            std::lock_guard<std::mutex> guard(mutex_);
-            busy_ = false;
-            if (e) exit_ = e;
-            drained_.notify_all();
-            if (e) return;
-        }
-    }
-
-    PresentFn present_;
-    std::mutex mutex_;
-    std::condition_variable cv_, drained_;
-    std::deque<PresentItem> queue_;
-    bool closing_ = false, busy_ = false;
-    std::optional<int> exit_;
-    std::thread thread_;
-};
 
 }  // namespace
 
@@ -588,7 +490,7 @@ int RunChannelRenderer(const ChannelOptions& opt) {
     // Frame i waits at the barrier and is presented on the presenter thread while this thread
     // renders frame i + 1 (published once every channel has presented i − 1): a channel that
     // finishes early keeps its core busy instead of idling until the slowest one is done.
-    Presenter presenter([&](PresentItem& item) -> std::optional<int> {
+    sync::Presenter presenter([&](sync::PresentItem& item) -> std::optional<int> {
         if (auto e = ended(lock.WaitAllDone(item.index, alive, kWaitTimeout_s), item.index))
             return e;
         item.timing.presentNs = sync::MonotonicNs();
@@ -609,7 +511,7 @@ int RunChannelRenderer(const ChannelOptions& opt) {
         if (auto e =
                 ended(lock.WaitPublished(i, alive, kWaitTimeout_s, &stateBytes, &n, &frame), i))
             return presenter.Finish(*e);
-        PresentItem item;
+        sync::PresentItem item;
         item.index = i;
         item.timing.frame = frame;
         item.timing.startNs = sync::MonotonicNs();

@@ -11,10 +11,15 @@
 
 #include <algorithm>
 #include <atomic>
+#include <condition_variable>
 #include <cstring>
+#include <mutex>
+#include <optional>
 #include <thread>
+#include <utility>
 #include <vector>
 
+#include "channels/sync/presenter.h"
 #include "channels/sync/shm_segment.h"
 #include "scene/core/error.h"
 
@@ -367,4 +372,94 @@ TEST(Segment, NameCarriesUserAndRunAndIsPrivate) {
 }
 
 }  // namespace
+// The presenter presents every pushed frame once, in order, on another thread, and the caller
+// can go on meanwhile (the first present blocks until the caller releases it).
+TEST(Presenter, PresentsEveryFrameInOrderOffTheCallingThread) {
+    std::mutex m;
+    std::condition_variable cv;
+    bool release = false;
+    std::vector<uint32_t> order;
+    std::vector<std::thread::id> ids;
+    Presenter presenter([&](PresentItem& item) -> std::optional<int> {
+        std::unique_lock<std::mutex> guard(m);
+        cv.wait(guard, [&] { return release; });
+        order.push_back(item.index);
+        ids.push_back(std::this_thread::get_id());
+        return std::nullopt;
+    });
+    for (uint32_t i = 0; i < 50; ++i) {
+        PresentItem item;
+        item.index = i;
+        presenter.Push(std::move(item));
+    }
+    // Nothing presented yet: Push did not wait for the blocked present.
+    {
+        std::lock_guard<std::mutex> guard(m);
+        EXPECT_TRUE(order.empty());
+        release = true;
+    }
+    cv.notify_all();
+    EXPECT_EQ(presenter.Finish(0), 0);
+    ASSERT_EQ(order.size(), 50u);
+    for (uint32_t i = 0; i < 50; ++i) EXPECT_EQ(order[i], i);
+    for (const std::thread::id& id : ids) EXPECT_NE(id, std::this_thread::get_id());
+}
+
+// A frame whose barrier is already complete is presented on the calling thread, unless an
+// earlier frame is still queued: frames are presented in order.
+TEST(Presenter, PresentsInlineOnlyWhenNothingIsQueuedBeforeIt) {
+    std::atomic<bool> holdFirst{true};
+    std::mutex m;
+    std::vector<std::pair<uint32_t, bool>> log;  // index, presented on the test's thread
+    const std::thread::id self = std::this_thread::get_id();
+    Presenter presenter([&](PresentItem& item) -> std::optional<int> {
+        while (item.index == 0 && holdFirst) std::this_thread::yield();
+        std::lock_guard<std::mutex> guard(m);
+        log.emplace_back(item.index, std::this_thread::get_id() == self);
+        return std::nullopt;
+    });
+    PresentItem a;
+    a.index = 0;
+    presenter.PresentOrPush(std::move(a), [] { return false; });  // barrier not complete: queued
+    PresentItem b;
+    b.index = 1;
+    presenter.PresentOrPush(std::move(b), [] { return true; });  // frame 0 pending: queued
+    holdFirst = false;
+    EXPECT_EQ(presenter.Finish(0), 0);
+    ASSERT_EQ(log.size(), 2u);
+    EXPECT_EQ(log[0], std::make_pair(0u, false));
+    EXPECT_EQ(log[1], std::make_pair(1u, false));
+
+    Presenter second([&](PresentItem& item) -> std::optional<int> {
+        std::lock_guard<std::mutex> guard(m);
+        log.emplace_back(item.index, std::this_thread::get_id() == self);
+        return std::nullopt;
+    });
+    PresentItem c;
+    c.index = 7;
+    second.PresentOrPush(std::move(c), [] { return true; });  // nothing before it: inline
+    ASSERT_EQ(log.size(), 3u);
+    EXPECT_EQ(log[2], std::make_pair(7u, true));
+    EXPECT_EQ(second.Finish(0), 0);
+}
+
+// A present that ends the run (its wait reported a stop, a dead host, a signal) stops the
+// presenter: later frames are not presented and Finish reports the status.
+TEST(Presenter, AnEndingWaitStopsPresentingAndReportsItsStatus) {
+    std::atomic<int> presented{0};
+    Presenter presenter([&](PresentItem& item) -> std::optional<int> {
+        if (item.index == 3) return 130;
+        ++presented;
+        return std::nullopt;
+    });
+    for (uint32_t i = 0; i < 10; ++i) {
+        PresentItem item;
+        item.index = i;
+        presenter.Push(std::move(item));
+    }
+    EXPECT_EQ(presenter.Finish(0), 130);
+    EXPECT_EQ(presented.load(), 3);
+    EXPECT_EQ(presenter.Ended(), std::optional<int>(130));
+}
+
 }  // namespace seasense::channels::sync
