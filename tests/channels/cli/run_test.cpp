@@ -176,6 +176,15 @@ TEST(Run, WritesImagesSyncLogMosaicAndSummaryUnderTheFrameLock) {
     EXPECT_EQ(summary["frames"], 6);
     EXPECT_EQ(summary["status"], "complete");
     EXPECT_GT(summary["fps"].get<double>(), 0.0);
+    // The frame rate after the first frame, from the sync log: 5 frame intervals between the
+    // latest presentations of frames 0 and 5.
+    int64_t firstLatest = INT64_MIN, lastLatest = INT64_MIN;
+    for (const CsvRow& row : byFrame.begin()->second)
+        firstLatest = std::max(firstLatest, row.present);
+    for (const CsvRow& row : byFrame.rbegin()->second)
+        lastLatest = std::max(lastLatest, row.present);
+    EXPECT_NEAR(summary["steady_fps"].get<double>(),
+                5.0 / (double(lastLatest - firstLatest) * 1e-9), 1e-9);
     EXPECT_GE(summary["skew_us"]["max"].get<double>(), summary["skew_us"]["p50"].get<double>());
 
     cv::VideoCapture video((out / "mosaic.mp4").string());
