@@ -57,14 +57,19 @@ struct WaveSum {
 // Σ over waves of the Gerstner displacement at rest offset (x, y), where wave i has phase
 // k_i (d_i · (x, y)) + phase_i; shared by the double query path and the float mesh path. With
 // a footprint s > 0 (m) each wave is weighted by FootprintWeight (band-limited sampling); with
-// omega, the velocity ∂P/∂t for phases advancing as −ω t is summed too.
+// omega, the velocity ∂P/∂t for phases advancing as −ω t is summed too. With weights (the
+// FootprintWeight of each wave, computed once for many points of one footprint) the footprint
+// is not used.
 template <class Real>
 WaveSum<Real> SumWaves(size_t n, const Real* dirX, const Real* dirY, const Real* k,
                        const Real* amplitude, const Real* horizontal, const Real* phase, Real x,
-                       Real y, Real footprint = 0, const Real* omega = nullptr) {
+                       Real y, Real footprint = 0, const Real* omega = nullptr,
+                       const Real* weights = nullptr) {
     WaveSum<Real> w;
     for (size_t i = 0; i < n; ++i) {
-        const Real weight = footprint > Real(0) ? GerstnerFootprintWeight(k[i], footprint) : 1;
+        const Real weight = weights               ? weights[i]
+                            : footprint > Real(0) ? GerstnerFootprintWeight(k[i], footprint)
+                                                  : 1;
         if (weight <= Real(0)) continue;
         const Real theta = k[i] * (dirX[i] * x + dirY[i] * y) + phase[i];
         const Real s = std::sin(theta), c = std::cos(theta);
@@ -97,6 +102,12 @@ glm::vec<3, Real> UpwardNormal(const WaveSum<Real>& w) {
     const Real len = glm::length(nrm);
     nrm = len > Real(0) ? nrm / len : V(0, 0, 1);
     return nrm.z < Real(0) ? -nrm : nrm;  // folded surface: keep the normal upward
+}
+
+// Adds a float wave sum to mesh sums {η, Dx, Dy, ∂η/∂x, ∂η/∂y, ∂Dx/∂x, ∂Dy/∂y, ∂Dx/∂y}.
+void AddTerms(const WaveSum<float>& w, float sums[8]) {
+    const float terms[8] = {w.z, w.dx, w.dy, w.dzdx, w.dzdy, w.dxdx - 1.0f, w.dydy - 1.0f, w.dxdy};
+    for (int i = 0; i < 8; ++i) sums[i] += terms[i];
 }
 
 }  // namespace
@@ -148,11 +159,22 @@ GerstnerOcean::LocalFrame GerstnerOcean::Local(double ox, double oy, double t) c
 
 void GerstnerOcean::LocalFrame::Accumulate(float rx, float ry, float footprint_m,
                                            float sums[8]) const {
-    const WaveSum<float> w =
-        SumWaves(k_.size(), dirX_.data(), dirY_.data(), k_.data(), amplitude_.data(),
-                 horizontal_.data(), phase0_.data(), rx, ry, footprint_m);
-    const float terms[8] = {w.z, w.dx, w.dy, w.dzdx, w.dzdy, w.dxdx - 1.0f, w.dydy - 1.0f, w.dxdy};
-    for (int i = 0; i < 8; ++i) sums[i] += terms[i];
+    AddTerms(SumWaves(k_.size(), dirX_.data(), dirY_.data(), k_.data(), amplitude_.data(),
+                      horizontal_.data(), phase0_.data(), rx, ry, footprint_m),
+             sums);
+}
+
+void GerstnerOcean::LocalFrame::FootprintWeights(float footprint_m, float* weights) const {
+    for (size_t i = 0; i < k_.size(); ++i)
+        weights[i] = footprint_m > 0.0f ? GerstnerFootprintWeight(k_[i], footprint_m) : 1.0f;
+}
+
+void GerstnerOcean::LocalFrame::Accumulate(float rx, float ry, const float* weights,
+                                           float sums[8]) const {
+    AddTerms(SumWaves(k_.size(), dirX_.data(), dirY_.data(), k_.data(), amplitude_.data(),
+                      horizontal_.data(), phase0_.data(), rx, ry, 0.0f,
+                      static_cast<const float*>(nullptr), weights),
+             sums);
 }
 
 void GerstnerOcean::LocalFrame::Evaluate(float rx, float ry, glm::vec3& position, glm::vec3& normal,

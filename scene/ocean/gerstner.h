@@ -71,6 +71,10 @@ class GerstnerOcean {
         // Adds the band-limited terms at rest offset (rx, ry) for footprint_m (0: unfiltered)
         // to sums = {η, Dx, Dy, ∂η/∂x, ∂η/∂y, ∂Dx/∂x, ∂Dy/∂y, ∂Dx/∂y}.
         void Accumulate(float rx, float ry, float footprint_m, float sums[8]) const;
+        // The same with the waves' footprint weights from FootprintWeights (WaveCount() floats),
+        // for many points of one footprint (a mesh ring): the same bits.
+        void FootprintWeights(float footprint_m, float* weights) const;
+        void Accumulate(float rx, float ry, const float* weights, float sums[8]) const;
 
       private:
         friend class GerstnerOcean;

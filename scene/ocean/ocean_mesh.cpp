@@ -28,6 +28,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -233,6 +234,8 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
         const double drop = CurvatureDrop_m(radius);
         const float fp = footprint[size_t(j)];
         const FftFilter filter = frame.Filter(fp);
+        std::array<float, kMaxWaves> gerstnerWeights;  // the ring's footprint weights
+        local.FootprintWeights(fp, gerstnerWeights.data());
         const int columns = int(ringStart[size_t(j) + 1] - ringStart[size_t(j)]);
         const size_t c0 = size_t(ringFirst[size_t(j)] - colLo), sj = size_t(stride[size_t(j)]);
         for (int i = 0; i < columns; ++i) {
@@ -248,7 +251,8 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
             options.dominant = SurfWaves::Dominant::kWhereBroken;
             if (!surf) {
                 frame.AccumulateFft(x0, y0, filter, s);
-                if (gerstner) local.Accumulate(float(rx), float(ry), fp, s.data());
+                if (gerstner)
+                    local.Accumulate(float(rx), float(ry), gerstnerWeights.data(), s.data());
             } else if (frame.DryLandSums(x0, y0, s, &options.seabedZ_m)) {
                 out.surfFoam[v] = 0.0f;  // dry sand, never wet: no foam
             } else {
@@ -258,10 +262,10 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
                 frame.AccumulateFft(x0, y0, filter, s, info.weights.cascade.data());
                 const double wg = info.weights.gerstner;
                 if (gerstner && wg == 1.0) {
-                    local.Accumulate(float(rx), float(ry), fp, s.data());
+                    local.Accumulate(float(rx), float(ry), gerstnerWeights.data(), s.data());
                 } else if (gerstner && wg > 0.0) {
                     GeometrySums g{};
-                    local.Accumulate(float(rx), float(ry), fp, g.data());
+                    local.Accumulate(float(rx), float(ry), gerstnerWeights.data(), g.data());
                     for (int k = 0; k < kGeometryTerms; ++k)
                         s[size_t(k)] += float(wg) * g[size_t(k)];
                 }

@@ -32,14 +32,17 @@ constexpr uint64_t kSurfPhaseStream = 0x53555246'00000002ULL;
 
 // Bilinear lookup of mip level `level` of a cascade texture at rest position (x0, y0), weighted
 // by `weight`, added to sums. Texel i of level l is centred on the mean of the nodes it averages,
-// (i 2^l + (2^l − 1)/2) Δ, hence the half-texel shifts.
+// (i 2^l + (2^l − 1)/2) Δ, hence the half-texel shifts: the lookup is at texel coordinates
+// (x0 + Δ/2) / (2^l Δ) − ½, taken as ((x0 + Δ/2) / Δ) · 2^−l − ½ from (qx, qy) = (x0 + Δ/2) / Δ,
+// which the levels of one cascade share. The same bits: a correctly rounded quotient scaled by a
+// power of two is the correctly rounded quotient by the scaled divisor (no underflow here).
 template <class Texture>
-void AddBilinear(const Texture& c, int level, double x0, double y0, float weight,
+void AddBilinear(const Texture& c, int level, double qx, double qy, float weight,
                  GeometrySums& sums) {
     const int n = c.n >> level;
-    const double texel = c.texel_m * double(1 << level);
-    const double u = (x0 + 0.5 * c.texel_m) / texel - 0.5;
-    const double v = (y0 + 0.5 * c.texel_m) / texel - 0.5;
+    const double scale = 1.0 / double(1 << level);
+    const double u = qx * scale - 0.5;
+    const double v = qy * scale - 0.5;
     const double fu = std::floor(u), fv = std::floor(v);
     const float wx = float(u - fu), wy = float(v - fv);
     // Power-of-two periodic wrap; two's complement makes the mask right for negative indices.
@@ -245,8 +248,11 @@ void OceanSurfaceFrame::AccumulateFft(double x0, double y0, const FftFilter& fil
         const float w = cascadeWeights ? float(cascadeWeights[c]) : 1.0f;
         if (w == 0.0f) continue;
         const float f = filter.frac[c];
-        AddBilinear(textures_[c], filter.level[c], x0, y0, (1.0f - f) * w, sums);
-        if (f > 0.0f) AddBilinear(textures_[c], filter.level[c] + 1, x0, y0, f * w, sums);
+        const CascadeTexture& t = textures_[c];
+        const double qx = (x0 + 0.5 * t.texel_m) / t.texel_m;
+        const double qy = (y0 + 0.5 * t.texel_m) / t.texel_m;
+        AddBilinear(t, filter.level[c], qx, qy, (1.0f - f) * w, sums);
+        if (f > 0.0f) AddBilinear(t, filter.level[c] + 1, qx, qy, f * w, sums);
     }
 }
 

@@ -381,6 +381,10 @@ double SurfWaves::DepthTable(const std::vector<double>& t, double h) const {
 
 SurfWeights SurfWaves::Weights(double depth_m) const {
     SurfWeights w;
+    // At or below the deepest fade every Fade below is 1, so the defaults are exactly what the
+    // sums give: gerstnerSurf = √(1 − 1) = 0, lost = Σ var (1 − 1) = 0, spectralSurf = 0. Most
+    // of a view mesh's vertices lie there.
+    if (depth_m >= fadeDeep_m_) return w;
     w.gerstner = Fade(depth_m, peakFadeDeep_m_);
     w.gerstnerSurf = std::sqrt(std::max(0.0, 1.0 - w.gerstner * w.gerstner));
     if (cascades_.empty() || !(cascadeVariance_m2_ > 0.0)) {
@@ -523,7 +527,8 @@ SurfaceTerms SurfWaves::TermsImpl(double x0, double y0, double t, SurfPointInfo*
     local.seabedZ_m = zBed;
     local.weights = weights;
     const double variance = spectralVariance_m2_ + gerstnerVariance_m2_;
-    if (variance > 0.0) {
+    // All deep: surfShare is 0 / variance = 0, so the weights are exactly 0 and 1 (the defaults).
+    if (variance > 0.0 && !weights.AllDeep()) {
         const double surfShare =
             (weights.spectralSurf * weights.spectralSurf * spectralVariance_m2_ +
              weights.gerstnerSurf * weights.gerstnerSurf * gerstnerVariance_m2_) /

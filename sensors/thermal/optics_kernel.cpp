@@ -204,15 +204,90 @@ namespace {
 // ⌊a / b⌋ for b > 0.
 int FloorDiv(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
 
-// Pixels per step of the row loop: four four-lane accumulators, so that four independent
-// chains of additions hide the adder's latency (one chain is latency-bound).
+// Vectors per step of the tap loop (KernelSteps), and the pixels of the widest step (eight
+// lanes), which the phase arrays are padded to.
 constexpr int kGroups = 4;
-constexpr int kPixelsPerStep = 4 * kGroups;
+constexpr int kPixelsPerStep = 8 * kGroups;
+
+// The folded rows and tap pairs of one row, as SampleKernelRow lays them out.
+struct FoldedRow {
+    const float* phases;  // folded row 0; row i at phases + i · rowStride
+    size_t rowStride;
+    const float* taps;  // per folded row, perRow taps broadcast to four lanes
+    int folded, pairs, perRow;
+    bool centre;  // odd K: a centre column after the pairs
+    const size_t* first;
+    const size_t* second;
+};
+
+// GCC vector types of four and eight floats: + and * are the lanes' single-precision adds and
+// multiplies, so one body serves both widths with the same operations per pixel.
+typedef float Lanes4 __attribute__((vector_size(16)));
+typedef float Lanes8 __attribute__((vector_size(32)));
+
+// The tap loop for all pixels of the row, kGroups vectors of V (four accumulators, so that four
+// independent chains of additions hide the adder's latency) per step. Fixed summation order per
+// pixel (folded rows, then pairs, then the centre column): the result of a pixel does not
+// depend on its lane, on the width of V or on the threading. Always inlined, so that it is
+// compiled for the caller's instruction set (KernelSteps8: AVX).
+template <class V>
+__attribute__((always_inline)) inline void KernelSteps(const FoldedRow& r, int w, float* out) {
+    constexpr int kLanes = int(sizeof(V) / sizeof(float));
+    for (int x = 0; x < w; x += kLanes * kGroups) {
+        V acc[kGroups] = {};
+        for (int i = 0; i < r.folded; ++i) {
+            const float* row = r.phases + size_t(i) * r.rowStride + size_t(x);
+            const float* tap = r.taps + size_t(i) * size_t(r.perRow) * 4;
+            for (int p = 0; p < r.pairs; ++p) {
+                const float* u = row + r.first[size_t(p)];
+                const float* v = row + r.second[size_t(p)];
+                const V t = V{} + tap[4 * p];
+                for (int g = 0; g < kGroups; ++g) {
+                    V a, b;  // unaligned loads
+                    __builtin_memcpy(&a, u + kLanes * g, sizeof(V));
+                    __builtin_memcpy(&b, v + kLanes * g, sizeof(V));
+                    acc[g] = acc[g] + t * (a + b);
+                }
+            }
+            if (r.centre) {
+                const float* u = row + r.first[size_t(r.pairs)];
+                const V t = V{} + tap[4 * r.pairs];
+                for (int g = 0; g < kGroups; ++g) {
+                    V a;
+                    __builtin_memcpy(&a, u + kLanes * g, sizeof(V));
+                    acc[g] = acc[g] + t * a;
+                }
+            }
+        }
+        const int count = std::min(kLanes * kGroups, w - x);
+        if (count == kLanes * kGroups) {
+            __builtin_memcpy(out + x, acc, sizeof(acc));
+        } else {
+            alignas(32) float lanes[kLanes * kGroups];
+            __builtin_memcpy(lanes, acc, sizeof(acc));
+            std::copy(lanes, lanes + count, out + x);
+        }
+    }
+}
+
+void KernelSteps4(const FoldedRow& r, int w, float* out) { KernelSteps<Lanes4>(r, w, out); }
+
+// Eight lanes (twice the pixels per load and per add): target("avx") enables the 256-bit
+// registers without FMA, so nothing is fused. Chosen at run time (SamplingKernelWidePath), as
+// the plume bins' AVX2 path.
+__attribute__((target("avx"))) void KernelSteps8(const FoldedRow& r, int w, float* out) {
+    KernelSteps<Lanes8>(r, w, out);
+}
 
 }  // namespace
 
+bool SamplingKernelWidePath() {
+    static const bool avx = __builtin_cpu_supports("avx");
+    return avx;
+}
+
 void SampleKernelRow(const Image& samples, const SamplingKernel& kernel, int y, float* out,
-                     std::vector<float>& scratch) {
+                     std::vector<float>& scratch, bool wide) {
     const int n = kernel.supersamples, K = kernel.size, Kp = kernel.padded;
     CHECK(samples.channels == 1 && samples.width % n == 0 && samples.height % n == 0);
     const int W = samples.width, H = samples.height, w = W / n;
@@ -284,41 +359,15 @@ void SampleKernelRow(const Image& samples, const SamplingKernel& kernel, int y, 
         second[size_t(p)] =
             size_t(d2 - FloorDiv(d2, n) * n) * phaseStride + size_t(FloorDiv(d2, n) - mMin);
     }
-    // Fixed summation order per pixel (folded rows, then pairs, then the centre column): the
-    // result of a pixel does not depend on its lane or on the threading.
-    for (int step = 0; step < steps; ++step) {
-        const int x = step * kPixelsPerStep;
-        __m128 acc[kGroups];
-        for (__m128& v : acc) v = _mm_setzero_ps();
-        for (int i = 0; i < folded; ++i) {
-            const float* row = phases + size_t(i) * rowStride + size_t(x);
-            const float* tap = taps + size_t(i) * size_t(perRow) * 4;
-            for (int p = 0; p < pairs; ++p) {
-                const float* u = row + first[size_t(p)];
-                const float* v = row + second[size_t(p)];
-                const __m128 t = _mm_load_ps(tap + 4 * p);
-                for (int g = 0; g < kGroups; ++g)
-                    acc[g] = _mm_add_ps(acc[g], _mm_mul_ps(t, _mm_add_ps(_mm_loadu_ps(u + 4 * g),
-                                                                         _mm_loadu_ps(v + 4 * g))));
-            }
-            if (K % 2) {
-                const float* u = row + first[size_t(pairs)];
-                const __m128 t = _mm_load_ps(tap + 4 * pairs);
-                for (int g = 0; g < kGroups; ++g)
-                    acc[g] = _mm_add_ps(acc[g], _mm_mul_ps(t, _mm_loadu_ps(u + 4 * g)));
-            }
-        }
-        if (x + kPixelsPerStep <= w) {
-            for (int g = 0; g < kGroups; ++g) _mm_storeu_ps(out + x + 4 * g, acc[g]);
-        } else {
-            alignas(16) float lanes[kPixelsPerStep];
-            for (int g = 0; g < kGroups; ++g) _mm_store_ps(lanes + 4 * g, acc[g]);
-            std::copy(lanes, lanes + (w - x), out + x);
-        }
-    }
+    const FoldedRow folding{phases, rowStride,  taps,         folded,       pairs,
+                            perRow, K % 2 == 1, first.data(), second.data()};
+    if (wide && SamplingKernelWidePath())
+        KernelSteps8(folding, w, out);
+    else
+        KernelSteps4(folding, w, out);
 }
 
-Image ApplySamplingKernel(const Image& samples, const SamplingKernel& kernel) {
+Image ApplySamplingKernel(const Image& samples, const SamplingKernel& kernel, bool wide) {
     const int n = kernel.supersamples;
     CHECK(samples.channels == 1 && samples.width % n == 0 && samples.height % n == 0);
     Image out(samples.width / n, samples.height / n, 1);
@@ -326,7 +375,7 @@ Image ApplySamplingKernel(const Image& samples, const SamplingKernel& kernel) {
                       [&](const tbb::blocked_range<int>& r) {
                           std::vector<float> scratch;
                           for (int y = r.begin(); y < r.end(); ++y)
-                              SampleKernelRow(samples, kernel, y, out.At(0, y), scratch);
+                              SampleKernelRow(samples, kernel, y, out.At(0, y), scratch, wide);
                       });
     return out;
 }

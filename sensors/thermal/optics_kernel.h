@@ -80,11 +80,16 @@ int SamplingKernelRadius_px(const radiometry::Band& band, const OpticsGeometry& 
 // mirrored offsets is summed first, and then each pair of mirrored columns, and weighted once
 // (a quarter of the multiplies); the row is split into its N sample phases so that four
 // neighbouring pixels are four lanes. scratch is working memory, reused between calls (one
-// per thread). Fixed summation order per pixel: bit-identical for any threading.
+// per thread). Fixed summation order per pixel: bit-identical for any threading. wide: eight
+// pixels to a lane group where the CPU has AVX (SamplingKernelWidePath), else four; the same bits
+// either way (the same operations per pixel in the same order).
 void SampleKernelRow(const Image& samples, const SamplingKernel& kernel, int y, float* out,
-                     std::vector<float>& scratch);
+                     std::vector<float>& scratch, bool wide = true);
+
+// Whether SampleKernelRow's wide (AVX) path runs on this CPU.
+bool SamplingKernelWidePath();
 
 // The whole w×h image (parallel over rows with oneTBB; deterministic).
-Image ApplySamplingKernel(const Image& samples, const SamplingKernel& kernel);
+Image ApplySamplingKernel(const Image& samples, const SamplingKernel& kernel, bool wide = true);
 
 }  // namespace seasense::sensors

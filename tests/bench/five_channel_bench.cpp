@@ -8,9 +8,12 @@
 #include <memory>
 #include <vector>
 
+#include "channels/camera/channel_camera.h"
 #include "channels/pipeline/channel_pipeline.h"
 #include "channels/sync/mosaic.h"
 #include "channels/sync/state_codec.h"
+#include "channels/view/view_geometry.h"
+#include "scene/ocean/ocean_mesh.h"
 #include "scene/scenario/scenario_loader.h"
 
 namespace seasense::channels {
@@ -53,6 +56,28 @@ void BM_FiveChannelRenderer(benchmark::State& state) {
 BENCHMARK(BM_FiveChannelRenderer)
     ->ArgNames({"channel", "threads"})
     ->ArgsProduct({{0, 1, 2, 3, 4}, {1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// The sea mesh of channel range(0) alone (scene::BuildOceanMesh as ViewGeometry asks for it,
+// frame 10), 1 thread: the part of every channel's frame that the sea's vertices cost.
+void BM_FiveChannelSeaMesh(benchmark::State& state) {
+    const scene::Scenario& sc = FiveChannel();
+    const scene::ChannelSettings& ch = sc.channels.at(size_t(state.range(0)));
+    state.SetLabel(ch.name);
+    tbb::task_arena arena(1);
+    const scene::World world(sc);
+    const scene::FrameState fs = world.Advance(10);
+    const auto frame = world.Ocean().At(fs.time_s);
+    const scene::OceanMeshRequest req = SeaMeshRequest(MakeChannelCamera(fs.eyepoint, ch), *frame);
+    scene::OceanMesh mesh;
+    for (auto _ : state) arena.execute([&] { scene::BuildOceanMesh(*frame, req, mesh); });
+    state.counters["vertices"] = double(mesh.positions.size());
+}
+BENCHMARK(BM_FiveChannelSeaMesh)
+    ->ArgName("channel")
+    ->Arg(1)
+    ->Arg(3)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
