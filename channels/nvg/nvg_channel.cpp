@@ -95,7 +95,9 @@ sensors::IntensifierSettings ResolveIntensifier(const scene::ChannelSettings& ch
 NvgChannel::NvgChannel(const scene::World& world, const scene::ChannelSettings& settings)
     : intensifier_(ResolveIntensifier(settings, world.GetScenario())),
       response_(PhotocathodeBand(intensifier_)),
-      otw_(std::make_unique<OtwChannel>(world, settings, NvgBandBasis(world, response_))) {}
+      // Only the pixels inside the field stop: the intensifier reads no other (FieldStopSpans).
+      otw_(std::make_unique<OtwChannel>(world, settings, NvgBandBasis(world, response_),
+                                        sensors::FieldStopSpans(intensifier_))) {}
 
 void NvgChannel::Render(const scene::SceneState& state, Image& radiance) {
     otw_->Render(state, radiance);

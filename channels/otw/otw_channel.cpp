@@ -475,7 +475,8 @@ class BlockClassifier {
         CHECK(kN == 0 || kN == g.n);
     }
 
-    void Pixels(int py) {
+    // Classifies the pixels [pxBegin, pxEnd) of pixel row py.
+    void Pixels(int py, int pxBegin, int pxEnd) {
         const int n = N(), sw = g_.sampleWidth;
         for (int j = 0; j < n; ++j) {
             const int y = py * n + j;
@@ -485,7 +486,7 @@ class BlockClassifier {
         const glm::vec3 pixelRow = g_.RowBase(1.0 - 2.0 * (py * n + 0.5 * n) / g_.sampleHeight);
         const uint32_t kRow = uint32_t(size_t(py * n - y0_) * size_t(sw));
         const uint32_t* prim = g_.vis.primitive.data();
-        for (int px = 0; px < g_.width; ++px) {
+        for (int px = pxBegin; px < pxEnd; ++px) {
             const int x0 = px * n;
             const uint32_t prim0 = prim[rowIndex_[0] + size_t(x0)];
             bool same = true, allSea = true;
@@ -860,9 +861,13 @@ OtwChannel::OtwChannel(const scene::World& world, const scene::ChannelSettings& 
 }
 
 OtwChannel::OtwChannel(const scene::World& world, const scene::ChannelSettings& settings,
-                       const OtwBandBasis& basis)
+                       const OtwBandBasis& basis, std::vector<PixelSpan> renderSpans)
     : OtwChannel(world, settings) {
     CHECK(basis.reflectance.size() == reflectance_.size());
+    CHECK(renderSpans.empty() || renderSpans.size() == size_t(settings.height));
+    for (const PixelSpan& span : renderSpans)
+        CHECK(0 <= span.begin && span.begin <= span.end && span.end <= settings.width);
+    renderSpans_ = std::move(renderSpans);
     basis_ = std::make_unique<OtwBandBasis>(basis);
     reflectance_ = basis.reflectance;
     for (int c = 0; c < 3; ++c) shore_[c] = basis.shore[c];
@@ -1049,12 +1054,15 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
         const int py1 = std::min(cam.height, py0 + pixelRowsPerBlock);
         BlockScratch& s = scratch.local();
         s.Reset(size_t(py1 - py0) * size_t(n) * size_t(sw));
+        const auto span = [&](int py) {
+            return renderSpans_.empty() ? PixelSpan{0, cam.width} : renderSpans_[size_t(py)];
+        };
         if (n == 2) {
             BlockClassifier<2> classify(g, f, py0, s);
-            for (int py = py0; py < py1; ++py) classify.Pixels(py);
+            for (int py = py0; py < py1; ++py) classify.Pixels(py, span(py).begin, span(py).end);
         } else {
             BlockClassifier<0> classify(g, f, py0, s);
-            for (int py = py0; py < py1; ++py) classify.Pixels(py);
+            for (int py = py0; py < py1; ++py) classify.Pixels(py, span(py).begin, span(py).end);
         }
         blockRays[size_t(block)] = TraceSunVisibility(f, n, s);
         // The block's rows are contiguous in the image: sample k is at out + 3k.
@@ -1062,6 +1070,14 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
         ShadeSky(f, g, s, out);
         ShadeSea(f, g, s, out);
         ShadeModels(f, g, s, out);
+        // Samples of pixels outside the spans: 0 (the overlays below add onto them).
+        if (!renderSpans_.empty())
+            for (int py = py0; py < py1; ++py)
+                for (int j = 0; j < n; ++j) {
+                    float* row = radiance.At(0, py * n + j);
+                    std::fill(row, row + size_t(3 * n * span(py).begin), 0.0f);
+                    std::fill(row + size_t(3 * n * span(py).end), row + size_t(3 * sw), 0.0f);
+                }
     });
     for (uint64_t r : blockRays) stats_.shadowRays += r;
     stats_.shadeMs = Ms(t2, Clock::now());

@@ -53,8 +53,11 @@ class OtwChannel {
     // In a band basis (channels/nvg): the components of Render's image are the basis's, in its
     // units; every light (sun, moon, stars, sky, lightning, the glow of flames) in its own
     // components, on the sky, sea, models, clouds, spray and plumes.
+    // renderSpans (one per pixel row, or empty for all): only the pixels of each row's span
+    // are rendered; every other sample of Render's image is 0 before the overlays (the NVG
+    // channel's field stop passes no light there).
     OtwChannel(const scene::World& world, const scene::ChannelSettings& settings,
-               const OtwBandBasis& basis);
+               const OtwBandBasis& basis, std::vector<PixelSpan> renderSpans = {});
     ~OtwChannel();
 
     // Renders the supersampled at-aperture radiance of frame `state` into radiance:
@@ -92,6 +95,7 @@ class OtwChannel {
     Image overlay_;                                  // band basis: grey overlays before conversion
     std::vector<uint8_t> overlayRows_;               // band basis: sample rows overlay_ drew on
     std::unique_ptr<BlackbodyGlowTable> basisGlow_;  // band basis: the flames' glow
+    std::vector<PixelSpan> renderSpans_;             // per pixel row; empty: every pixel
 };
 
 }  // namespace seasense::channels

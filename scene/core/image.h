@@ -27,4 +27,9 @@ struct Image {
     }
 };
 
+// A run of pixels [begin, end) in one image row (empty when begin = end).
+struct PixelSpan {
+    int begin = 0, end = 0;
+};
+
 }  // namespace seasense

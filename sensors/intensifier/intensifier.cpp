@@ -99,17 +99,14 @@ Intensifier::Intensifier(const IntensifierSettings& settings, int supersampling)
     for (float& w : mtfKernel_) w = float(w / sum);
     // The field stop: pixels whose centre ray is within fieldStop/2 of the optical axis.
     const int w = s_.width_px, h = s_.height_px;
-    const double tanHalfH = std::tan(0.5 * s_.hfov_rad), tanHalfV = tanHalfH * h / w;
-    const double tanStop = std::tan(0.5 * s_.fieldStop_rad);
+    spans_ = FieldStopSpans(s_);
     mask_.assign(size_t(w) * size_t(h), 0);
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-            const double u = ((x + 0.5) / w * 2.0 - 1.0) * tanHalfH;
-            const double v = ((y + 0.5) / h * 2.0 - 1.0) * tanHalfV;
-            const bool in = u * u + v * v <= tanStop * tanStop;
-            mask_[size_t(y) * size_t(w) + size_t(x)] = in;
-            fieldCount_ += in;
-        }
+    for (int y = 0; y < h; ++y) {
+        const PixelSpan& span = spans_[size_t(y)];
+        std::fill(mask_.begin() + ptrdiff_t(size_t(y) * size_t(w) + size_t(span.begin)),
+                  mask_.begin() + ptrdiff_t(size_t(y) * size_t(w) + size_t(span.end)), 1);
+        fieldCount_ += size_t(span.end - span.begin);
+    }
     // Phosphor: screen luminance ∝ brightness, in P43's colour, scaled so that saturation is
     // the brightest displayable P43 green.
     glm::dvec3 p43 = radiometry::Rec709FromYxy(1.0, kP43x, kP43y);
@@ -131,14 +128,20 @@ void Intensifier::Process(const Image& samples, double time_s, int64_t frame) {
     const int w = s_.width_px, h = s_.height_px, n = n_;
     CHECK(samples.width == w * n && samples.height == h * n);
     const int comps = samples.channels;
-    // Footprint: the pixel's photon radiance is the mean over its samples, summed over bands.
+    // Footprint: the pixel's photon radiance is the mean over its samples, summed over bands,
+    // inside the field stop; outside it no light reaches the photocathode (0), so neither the
+    // noise nor the halo and tube blur of the electrons spread light from there into the field.
     tbb::parallel_for(0, h, [&](int y) {
-        int x = 0;
+        const PixelSpan span = spans_[size_t(y)];
+        float* row = radiance_.At(0, y);
+        std::fill(row, row + span.begin, 0.0f);
+        std::fill(row + span.end, row + w, 0.0f);
+        int x = span.begin;
         if (n == 2 && comps == 3) {
             // The default 2×2 samples of three bands: two pixels at a time, one per lane of an
             // SSE2 double pair, each lane adding its pixel's twelve values in the scalar
             // loop's order (the same sums bit for bit, without its serial chain of adds).
-            for (; x + 1 < w; x += 2) {
+            for (; x + 1 < span.end; x += 2) {
                 __m128d sum = _mm_setzero_pd();
                 for (int j = 0; j < 2; ++j) {
                     const float* a = samples.At(x * 2, y * 2 + j);  // six values per pixel
@@ -162,11 +165,11 @@ void Intensifier::Process(const Image& samples, double time_s, int64_t frame) {
                 *radiance_.At(x + 1, y) = out[1];
             }
         }
-        for (; x < w; ++x) {
+        for (; x < span.end; ++x) {
             double sum = 0.0;
             for (int j = 0; j < n; ++j) {
-                const float* row = samples.At(x * n, y * n + j);
-                for (int i = 0; i < n * comps; ++i) sum += row[i];
+                const float* sampleRow = samples.At(x * n, y * n + j);
+                for (int i = 0; i < n * comps; ++i) sum += sampleRow[i];
             }
             *radiance_.At(x, y) = float(sum / (n * n));
         }

@@ -29,9 +29,10 @@ class Intensifier {
     // an f/F objective, small-angle).
     double PhotoelectronsPerRadiance() const { return pePerRadiance_; }
 
-    // Last frame: per pixel photon radiance at the aperture (1 channel), the noisy photoelectron
-    // count after the photocathode (1 channel), screen brightness (1 channel, 0 … 1 =
-    // saturation), and the 8-bit sRGB P43 display (width×height×3, row 0 on top).
+    // Last frame: per pixel photon radiance at the aperture inside the field stop (0 outside:
+    // the stop passes no light; 1 channel), the noisy photoelectron count after the
+    // photocathode (1 channel), screen brightness (1 channel, 0 … 1 = saturation), and the
+    // 8-bit sRGB P43 display (width×height×3, row 0 on top).
     const Image& PhotonRadiance() const { return radiance_; }
     const Image& Photoelectrons() const { return electrons_; }
     const Image& Brightness() const { return brightness_; }
@@ -42,6 +43,8 @@ class Intensifier {
     double Gain() const { return gain_; }
     double Duty() const { return duty_; }
     double MeanPhotoelectrons() const { return meanPe_; }
+    // The pixels inside the field stop per row (FieldStopSpans of the settings).
+    const std::vector<PixelSpan>& FieldSpans() const { return spans_; }
     // Whether pixel (x, y) lies inside the circular field stop.
     bool InField(int x, int y) const { return mask_[size_t(y) * size_t(s_.width_px) + size_t(x)]; }
     // Halo radius and tube-MTF Gaussian σ in pixels.
@@ -55,6 +58,7 @@ class Intensifier {
     double pePerRadiance_ = 0.0;
     double haloRadius_px_ = 0.0, mtfSigma_px_ = 0.0;
     std::vector<float> mtfKernel_;
+    std::vector<PixelSpan> spans_;
     std::vector<uint8_t> mask_;
     size_t fieldCount_ = 0;  // pixels inside the field stop
     Image radiance_, electrons_, halo_, brightness_;

@@ -1,6 +1,7 @@
 // Reader of the image-intensifier settings from a scenario's `intensifier:` mapping.
 #include "sensors/intensifier/intensifier_settings.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <optional>
@@ -20,6 +21,24 @@ constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 
 double IntensifierSettings::FocalLength_m() const {
     return 0.5 * photocathodeDiameter_m / std::tan(0.5 * fieldStop_rad);
+}
+
+std::vector<PixelSpan> FieldStopSpans(const IntensifierSettings& s) {
+    const int w = s.width_px, h = s.height_px;
+    const double tanHalfH = std::tan(0.5 * s.hfov_rad), tanHalfV = tanHalfH * h / w;
+    const double tanStop = std::tan(0.5 * s.fieldStop_rad);
+    std::vector<PixelSpan> spans(size_t(std::max(h, 0)));
+    for (int y = 0; y < h; ++y) {
+        const double v = ((y + 0.5) / h * 2.0 - 1.0) * tanHalfV;
+        PixelSpan& span = spans[size_t(y)];
+        for (int x = 0; x < w; ++x) {
+            const double u = ((x + 0.5) / w * 2.0 - 1.0) * tanHalfH;
+            if (u * u + v * v > tanStop * tanStop) continue;
+            if (span.begin == span.end) span.begin = x;
+            span.end = x + 1;
+        }
+    }
+    return spans;
 }
 
 double IntensifierSettings::PixelPitch_m() const {

@@ -2,8 +2,10 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include "scene/config/config.h"
+#include "scene/core/image.h"
 
 namespace seasense::sensors {
 
@@ -62,6 +64,12 @@ struct IntensifierSettings {
     // Photoelectrons per pixel per frame of a photocathode current density (pe s⁻¹ mm⁻²).
     double PixelFramePe(double rate_pe_s_mm2) const;
 };
+
+// The pixels inside the circular field stop, row by row: [begin, end) of the pixels of row y
+// (0 = top) whose centre ray is within fieldStop_rad/2 of the optical axis (begin = end when
+// none). The stop is convex, so each row's pixels are one run. Light outside it never reaches
+// the photocathode: the intensifier reads and the NVG channel renders only these pixels.
+std::vector<PixelSpan> FieldStopSpans(const IntensifierSettings& settings);
 
 // Reads the `intensifier:` mapping (all keys optional; units in the key names):
 //   optics:       f_number, transmission, field_stop_deg, photocathode_diameter_mm

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <numbers>
@@ -16,6 +17,7 @@
 #include "radiometry/bands/builtin_bands.h"
 #include "scene/plumes/plume_system.h"
 #include "scene/scenario/scenario_loader.h"
+#include "sensors/intensifier/intensifier.h"
 #include "tests/support/sky_view.h"
 
 namespace seasense::channels {
@@ -340,5 +342,45 @@ TEST(NvgChannel, FrameWithCloudsAndPlumesIsIndependentOfThreadCount) {
     };
     EXPECT_EQ(render(1), render(2));
 }
+
+// The NVG channel renders only the pixels inside the field stop (the intensifier reads no
+// other): what the goggle shows and the photon radiance it records equal those of the same
+// frame rendered whole, bit for bit, and the rendered pixels equal the whole frame's.
+TEST(NvgChannel, RenderingOnlyTheFieldStopChangesNothingTheGoggleSees) {
+    const scene::Scenario sc = scene::LoadScenario(kConfigs / "five-channel.yaml");
+    const scene::World world(sc);
+    scene::ChannelSettings ch = *sc.FindChannel("nvg");
+    ch.width = 160;
+    ch.height = 120;
+    NvgChannel nvg(world, ch);
+    OtwChannel whole(world, ch, NvgBandBasis(world, nvg.Response()));
+    const scene::SceneState state = world.State(5);
+    Image part, full;
+    nvg.Render(state, part);
+    whole.Render(state, full);
+    const std::vector<PixelSpan> spans = sensors::FieldStopSpans(nvg.IntensifierSettings());
+    const int n = ch.supersampling;
+    int inside = 0, outside = 0;
+    for (int py = 0; py < ch.height; ++py) {
+        const PixelSpan span = spans[size_t(py)];
+        inside += span.end - span.begin;
+        outside += ch.width - (span.end - span.begin);
+        for (int j = 0; j < n; ++j)
+            for (int x = span.begin * n; x < span.end * n; ++x)
+                for (int c = 0; c < 3; ++c)
+                    ASSERT_EQ(part.At(x, py * n + j)[c], full.At(x, py * n + j)[c])
+                        << "sample " << x << ", " << py * n + j;
+    }
+    EXPECT_GT(inside, 0);
+    EXPECT_GT(outside, 0);
+    sensors::Intensifier a(nvg.IntensifierSettings(), n), b(nvg.IntensifierSettings(), n);
+    a.Process(part, state.time_s, state.frame);
+    b.Process(full, state.time_s, state.frame);
+    EXPECT_EQ(a.PhotonRadiance().pixels, b.PhotonRadiance().pixels);
+    EXPECT_EQ(a.Brightness().pixels, b.Brightness().pixels);
+    EXPECT_TRUE(std::equal(a.Display().begin(), a.Display().end(), b.Display().begin()));
+    EXPECT_GT(a.MeanPhotoelectrons(), 0.0);
+}
+
 }  // namespace
 }  // namespace seasense::channels

@@ -86,14 +86,18 @@ void CheckSnr(double meanPe, double F) {
             sum2[i] += v * v;
         }
     }
+    // Over the pixels inside the field stop (outside it no light reaches the photocathode).
     double var = 0.0, mean = 0.0;
+    int count = 0;
     for (size_t i = 0; i < px; ++i) {
+        if (!t.InField(int(i % size_t(s.width_px)), int(i / size_t(s.width_px)))) continue;
         const double m = sum[i] / frames;
         mean += m;
         var += (sum2[i] - frames * m * m) / (frames - 1);
+        ++count;
     }
-    mean /= double(px);
-    var /= double(px);
+    mean /= double(count);
+    var /= double(count);
     EXPECT_NEAR(mean / std::sqrt(var) / std::sqrt(meanPe / F), 1.0, 0.10)
         << "N " << meanPe << " F " << F;
 }
@@ -186,6 +190,49 @@ TEST(Intensifier, FieldStopIsA40DegreeCircle) {
         }
     EXPECT_GT(inside, 0);
     EXPECT_GT(outside, 0);
+}
+
+// The field stop lies in front of the photocathode: light outside it makes no photoelectrons,
+// so a scene bright everywhere outside the stop and black inside leaves the whole screen dark
+// — no halo or tube blur carries it in across the edge.
+TEST(Intensifier, LightOutsideTheFieldStopNeverReachesTheScreen) {
+    IntensifierSettings s = Small(160, 120);
+    s.halo_rad = 3.0 * kDegToRad;
+    s.haloFraction = 0.2;
+    Intensifier t(s, 2);
+    Image img(160 * 2, 120 * 2, 3);
+    for (int y = 0; y < 120 * 2; ++y)
+        for (int x = 0; x < 160 * 2; ++x)
+            if (!t.InField(x / 2, y / 2))
+                for (int c = 0; c < 3; ++c)
+                    img.At(x, y)[c] = float(1e4 / t.PhotoelectronsPerRadiance());
+    t.Process(img, 0.0, 0);
+    for (float v : t.PhotonRadiance().pixels) ASSERT_EQ(v, 0.0f);
+    for (float v : t.Photoelectrons().pixels) ASSERT_EQ(v, 0.0f);
+    for (float v : t.Brightness().pixels) ASSERT_EQ(v, 0.0f);
+    // The same light inside the stop does reach it.
+    Intensifier u(s, 2);
+    u.Process(Uniform(s, 2, 1e4 / u.PhotoelectronsPerRadiance()), 0.0, 0);
+    EXPECT_GT(*u.Brightness().At(80, 60), 0.0f);
+}
+
+// FieldStopSpans: each row's run holds exactly the pixels whose centre ray is within half the
+// field stop of the axis (the angle from the pixel's tangent-plane coordinates).
+TEST(Intensifier, FieldStopSpansHoldThePixelsWithinHalfTheStop) {
+    IntensifierSettings s = Small(200, 150);
+    s.fieldStop_rad = 36.0 * kDegToRad;
+    const std::vector<PixelSpan> spans = FieldStopSpans(s);
+    ASSERT_EQ(spans.size(), 150u);
+    const double tanH = std::tan(0.5 * s.hfov_rad), tanV = tanH * 150.0 / 200.0;
+    for (int y = 0; y < 150; ++y)
+        for (int x = 0; x < 200; ++x) {
+            const double u = ((x + 0.5) / 200 * 2 - 1) * tanH, v = ((y + 0.5) / 150 * 2 - 1) * tanV;
+            const double off_deg = std::atan(std::hypot(u, v)) / kDegToRad;
+            const bool in = x >= spans[size_t(y)].begin && x < spans[size_t(y)].end;
+            if (std::abs(off_deg - 18.0) > 1e-9) {
+                EXPECT_EQ(in, off_deg < 18.0) << x << ", " << y;
+            }
+        }
 }
 
 TEST(Intensifier, HaloHasTheConfiguredAngularDiameterAndGrowsWithTheSource) {
