@@ -3,13 +3,13 @@
 #include "channels/plume/plume_composite.h"
 
 #include <tbb/blocked_range.h>
-#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <numbers>
 
 #include "channels/flir/flir_channel.h"
@@ -102,6 +102,64 @@ float InfraredSource(const BandTrace& t, const PlumeLighting& light) {
                                        return T_K > 0.0f ? float(light.planck->Radiance(T_K))
                                                          : 0.0f;
                                    });
+}
+
+// One row of cells' lists: cell cx has index[start[cx], start[cx + 1]) (padded to 4).
+struct CellRow {
+    std::vector<uint32_t> index, start, count;
+    std::vector<float> near_m, far_m;
+    std::vector<float> smallOpticalDepth, halfSmallOpticalDepth;
+    // Whether every surface of the cell lies in front of its puffs (the cell is skipped).
+    std::vector<uint8_t> inFront;
+};
+
+// A frame's buffers, kept by the calling thread from one frame to the next: allocating and
+// zeroing them anew every frame cost page faults and memset (~0.5 MB of grid nodes at
+// 640×480). Every value is written in the frame before it is read, so what an earlier frame
+// left in them never shows.
+struct FrameBuffers {
+    std::vector<CellRow> cellRows;
+    std::vector<BandTrace> nodes;
+    std::vector<float> nodeT;
+    bool busy = false;
+};
+
+// The calling thread's FrameBuffers for one CompositePlumes call; a fresh set when they are in
+// use already (a call nested in another on the same thread, e.g. from a task the thread took
+// while it waited inside a parallel loop).
+class FrameBuffersLease {
+  public:
+    FrameBuffersLease() {
+        thread_local FrameBuffers kept;
+        if (kept.busy) {
+            own_ = std::make_unique<FrameBuffers>();
+            buffers = own_.get();
+        } else {
+            buffers = &kept;
+        }
+        buffers->busy = true;
+    }
+    ~FrameBuffersLease() { buffers->busy = false; }
+    FrameBuffersLease(const FrameBuffersLease&) = delete;
+    FrameBuffersLease& operator=(const FrameBuffersLease&) = delete;
+    FrameBuffers* buffers = nullptr;
+
+  private:
+    std::unique_ptr<FrameBuffers> own_;
+};
+
+// Scratch space of one worker thread, kept from task to task and frame to frame (the results
+// never depend on which thread's scratch a row used: every value is written before it is
+// read). A task uses it from start to end without running other tasks in between (no nested
+// parallelism), so no two users share it.
+struct Scratch {
+    PlumeScreenBins::List strip, list;
+    std::vector<PlumeScreenBins::List> cellLists{PlumeScreenBins::kTile / kCell};
+    std::vector<float> range, depthRows;
+};
+Scratch& LocalScratch() {
+    thread_local Scratch scratch;
+    return scratch;
 }
 
 }  // namespace
@@ -204,15 +262,9 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     // rectangles overlap its pixels or its far corner node, gathered once (pass 1) and kept
     // for pass 2; a cell with none is left alone (every puff adds at most the bins' per-puff
     // tolerance there).
-    // One row of cells' lists: cell cx has index[start[cx], start[cx + 1]) (padded to 4).
-    struct CellRow {
-        std::vector<uint32_t> index, start, count;
-        std::vector<float> near_m, far_m;
-        std::vector<float> smallOpticalDepth, halfSmallOpticalDepth;
-        // Whether every surface of the cell lies in front of its puffs (the cell is skipped).
-        std::vector<uint8_t> inFront;
-    };
-    std::vector<CellRow> cellRows{size_t(cellsY)};
+    FrameBuffersLease lease;
+    std::vector<CellRow>& cellRows = lease.buffers->cellRows;
+    if (cellRows.size() < size_t(cellsY)) cellRows.resize(size_t(cellsY));
     // Cell cx's list of row (not copied).
     const auto TakeList = [](const CellRow& row, int cx, PlumeScreenBins::List& list) {
         list.count = row.count[size_t(cx)];
@@ -235,7 +287,8 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             const uint32_t* primitive = vis.primitive.data() + idx0;
             float* o = out + size_t(j) * size_t(vis.width);
             for (int cx = 0; cx < cellsX; ++cx) {
-                if (row.count[size_t(cx)] == 0) continue;
+                // Pass 2 never reads the depths of cells without puffs or in front of them.
+                if (row.count[size_t(cx)] == 0 || row.inFront[size_t(cx)]) continue;
                 for (int sx = cx * rowSamples; sx < std::min((cx + 1) * rowSamples, vis.width);
                      ++sx) {
                     // Both tests evaluated (no short circuit), so that the loop vectorises.
@@ -267,42 +320,42 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     // so depth ≥ near / (cosMin · dNear) gives r ≤ dNear. The 1e-4 margin covers the float
     // rounding of the per-pixel range (a few ulp), so a pixel skipped by it is one the test
     // rMax ≤ dNear of pass 2 skips: the image is unchanged.
+    // The largest a² over each column of cells and b² over each row (made once, not per cell).
+    std::vector<double> cellA2(size_t(cellsX), 0.0), cellB2(size_t(cellsY), 0.0);
+    for (int cx = 0; cx < cellsX; ++cx)
+        for (int px = cx * kCell; px < std::min(W, (cx + 1) * kCell); ++px)
+            cellA2[size_t(cx)] =
+                std::max(cellA2[size_t(cx)], double(colA[size_t(px)]) * colA[size_t(px)]);
+    for (int cy = 0; cy < cellsY; ++cy)
+        for (int py = cy * kCell; py < std::min(H, (cy + 1) * kCell); ++py)
+            cellB2[size_t(cy)] =
+                std::max(cellB2[size_t(cy)], double(rowB[size_t(py)]) * rowB[size_t(py)]);
     const auto DepthInFront = [&](int cx, int cy, float dNear) {
         if (!(dNear > 0.0f)) return std::numeric_limits<float>::infinity();
-        double a2 = 0.0, b2 = 0.0;
-        for (int px = cx * kCell; px < std::min(W, (cx + 1) * kCell); ++px)
-            a2 = std::max(a2, double(colA[size_t(px)]) * colA[size_t(px)]);
-        for (int py = cy * kCell; py < std::min(H, (cy + 1) * kCell); ++py)
-            b2 = std::max(b2, double(rowB[size_t(py)]) * rowB[size_t(py)]);
-        const double cosMin = 1.0 / std::sqrt(1.0 + a2 + b2);
+        const double cosMin = 1.0 / std::sqrt(1.0 + cellA2[size_t(cx)] + cellB2[size_t(cy)]);
         return float(double(nearM) / (cosMin * double(dNear)) * 1.0001);
     };
 
     // Pass 1, the cells' lists and which cells lie wholly behind surfaces in front of their puffs.
-    std::vector<BandTrace> nodes(size_t(nodesX) * size_t(nodesY));
+    // The grid nodes' sky traces and their transmittances e^(−τ) (for the smoothness test of
+    // the four cells around each); every node a cell reads is written in pass 1b.
+    std::vector<BandTrace>& nodes = lease.buffers->nodes;
+    std::vector<float>& nodeT = lease.buffers->nodeT;
+    nodes.resize(size_t(nodesX) * size_t(nodesY));
+    nodeT.resize(nodes.size());
     std::vector<uint64_t> rowCovered(size_t(cellsY), 0), rowTraces(size_t(cellsY), 0),
         rowTests(size_t(cellsY), 0);
-    // The nodes' transmittances e^(−τ), for the smoothness test of the four cells around each.
-    std::vector<float> nodeT(nodes.size(), 1.0f);
-    // Scratch space per worker thread, made once per frame rather than once per task (the
-    // results never depend on which thread's scratch a row used: every value is written
-    // before it is read).
-    struct Scratch {
-        PlumeScreenBins::List strip, list;
-        std::vector<PlumeScreenBins::List> cellLists{PlumeScreenBins::kTile / kCell};
-        std::vector<float> range, depthRows;
-    };
-    tbb::enumerable_thread_specific<Scratch> scratch;
     // One task per row of cells (simple_partitioner): the rows' costs differ by orders of
     // magnitude (most have no plume), so coarser chunks leave one thread idle at the end.
     tbb::parallel_for(
         tbb::blocked_range<int>(0, cellsY, 1),
         [&](const tbb::blocked_range<int>& r) {
-            Scratch& local = scratch.local();
+            Scratch& local = LocalScratch();
             PlumeScreenBins::List& strip = local.strip;
             std::span<PlumeScreenBins::List> cellLists(local.cellLists);
             for (int cy = r.begin(); cy != r.end(); ++cy) {
                 CellRow& row = cellRows[size_t(cy)];
+                row.index.clear();
                 row.start.assign(size_t(cellsX) + 1, 0);
                 row.count.assign(size_t(cellsX), 0);
                 row.near_m.assign(size_t(cellsX), 0.0f);
@@ -357,7 +410,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     tbb::parallel_for(
         tbb::blocked_range<int>(0, nodesY, 1),
         [&](const tbb::blocked_range<int>& r) {
-            PlumeScreenBins::List& list = scratch.local().list;
+            PlumeScreenBins::List& list = LocalScratch().list;
             for (int ny = r.begin(); ny != r.end(); ++ny) {
                 // The row's counts, kept in registers (the rows' slots share cache lines).
                 uint64_t traces = 0, tests = 0;
@@ -365,12 +418,18 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                 const CellRow& row = cellRows[size_t(cy)];
                 for (int nx = 0; nx < nodesX; ++nx) {
                     const int cx = std::min(nx, cellsX - 1);
-                    if (row.count[size_t(cx)] == 0) continue;
+                    const size_t n = size_t(ny) * size_t(nodesX) + size_t(nx);
+                    // No puff reaches the node's cell, so none reaches the node: a clear sky
+                    // (the buffers are reused from frame to frame, so this is written).
+                    if (row.count[size_t(cx)] == 0) {
+                        nodes[n] = BandTrace{};
+                        nodeT[n] = 1.0f;
+                        continue;
+                    }
                     if (!Used(nx - 1, ny - 1) && !Used(nx, ny - 1) && !Used(nx - 1, ny) &&
                         !Used(nx, ny))
                         continue;
                     TakeList(row, cx, list);
-                    const size_t n = size_t(ny) * size_t(nodesX) + size_t(nx);
                     nodes[n] =
                         bins.Trace(list, PixelDirection(nx * kCell, ny * kCell), kPlumeSkyRange_m);
                     nodeT[n] = std::exp(-nodes[n].opticalDepth);
@@ -412,7 +471,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     tbb::parallel_for(
         tbb::blocked_range<int>(0, cellsY, 1),
         [&](const tbb::blocked_range<int>& rows) {
-            Scratch& local = scratch.local();
+            Scratch& local = LocalScratch();
             std::vector<float>& range = local.range;
             range.resize(samples);
             PlumeScreenBins::List& list = local.list;
@@ -451,41 +510,53 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                         Smooth(corner, cornerT, list.smallOpticalDepth > kInterpolationTolerance,
                                clearSky);
                     // Where the cell is not smooth, its sky pixels are refined on 2 × 2-pixel
-                    // sub-cells: sky traces at the 3 × 3 nodes every 2 pixels (made when
-                    // the first sky pixel needs them), the same criteria with the puffs
-                    // smaller than a sub-cell, and the pixels of a sub-cell that is not smooth
-                    // traced one by one (the nodes' pixels take their node's trace).
-                    bool refined = false;
+                    // sub-cells: sky traces at the 3 × 3 nodes every 2 pixels, the same
+                    // criteria with the puffs smaller than a sub-cell, and the pixels of a
+                    // sub-cell that is not smooth traced one by one (the nodes' pixels take their
+                    // node's trace). Each sub-cell is refined when its first sky pixel needs it,
+                    // and each node traced when its first sub-cell or pixel needs it (a trace
+                    // depends only on the cell's list and the node's direction, so the values
+                    // are the same whenever they are made).
                     BandTrace sub[3][3];
                     float subT[3][3];
-                    bool subSmooth[2][2], subClear[2][2];
-                    const auto Refine = [&] {
-                        refined = true;
-                        bins.Copy(list);
-                        for (int b = 0; b < 3; ++b)
-                            for (int a = 0; a < 3; ++a) {
-                                if (a % 2 == 0 && b % 2 == 0) {
-                                    sub[b][a] = *corner[(b / 2) * 2 + a / 2];
-                                    subT[b][a] = cornerT[(b / 2) * 2 + a / 2];
-                                    continue;
-                                }
-                                const int nx = cx * kCell + a * (kCell / 2),
-                                          ny = cy * kCell + b * (kCell / 2);
-                                sub[b][a] =
-                                    bins.Trace(list, PixelDirection(nx, ny), kPlumeSkyRange_m);
-                                subT[b][a] = std::exp(-sub[b][a].opticalDepth);
-                                ++traces;
-                                tests += list.size();
-                            }
-                        const bool subFine = list.halfSmallOpticalDepth > kInterpolationTolerance;
-                        for (int sb = 0; sb < 2; ++sb)
-                            for (int sa = 0; sa < 2; ++sa) {
-                                const BandTrace* c[4] = {&sub[sb][sa], &sub[sb][sa + 1],
-                                                         &sub[sb + 1][sa], &sub[sb + 1][sa + 1]};
-                                const float cT[4] = {subT[sb][sa], subT[sb][sa + 1],
-                                                     subT[sb + 1][sa], subT[sb + 1][sa + 1]};
-                                subSmooth[sb][sa] = Smooth(c, cT, subFine, subClear[sb][sa]);
-                            }
+                    bool subTraced[3][3] = {};
+                    bool subRefined[2][2] = {}, subSmooth[2][2], subClear[2][2];
+                    for (int k = 0; k < 4; ++k) {
+                        sub[(k / 2) * 2][(k % 2) * 2] = *corner[k];
+                        subT[(k / 2) * 2][(k % 2) * 2] = cornerT[k];
+                        subTraced[(k / 2) * 2][(k % 2) * 2] = true;
+                    }
+                    const bool subFine = list.halfSmallOpticalDepth > kInterpolationTolerance;
+                    // Counts `rays` rays about to be traced in one pass over the cell's list. The
+                    // list's data is gathered into contiguous arrays for its second pass on:
+                    // for one pass, copying costs about what it saves (the traces are the same
+                    // bit for bit either way).
+                    int passes = 0;
+                    const auto Count = [&](int rays) {
+                        if (++passes == 2) bins.Copy(list);
+                        traces += uint64_t(rays);
+                        tests += list.size();
+                    };
+                    const auto SubNode = [&](int a, int b) -> const BandTrace& {
+                        if (!subTraced[b][a]) {
+                            subTraced[b][a] = true;
+                            Count(1);
+                            sub[b][a] = bins.Trace(list,
+                                                   PixelDirection(cx * kCell + a * (kCell / 2),
+                                                                  cy * kCell + b * (kCell / 2)),
+                                                   kPlumeSkyRange_m);
+                            subT[b][a] = std::exp(-sub[b][a].opticalDepth);
+                        }
+                        return sub[b][a];
+                    };
+                    const auto RefineSubCell = [&](int sa, int sb) {
+                        if (subRefined[sb][sa]) return;
+                        subRefined[sb][sa] = true;
+                        const BandTrace* c[4] = {&SubNode(sa, sb), &SubNode(sa + 1, sb),
+                                                 &SubNode(sa, sb + 1), &SubNode(sa + 1, sb + 1)};
+                        const float cT[4] = {subT[sb][sa], subT[sb][sa + 1], subT[sb + 1][sa],
+                                             subT[sb + 1][sa + 1]};
+                        subSmooth[sb][sa] = Smooth(c, cT, subFine, subClear[sb][sa]);
                     };
                     for (int py = cy * kCell; py < std::min(H, (cy + 1) * kCell); ++py) {
                         for (int px = cx * kCell; px < std::min(W, (cx + 1) * kCell); ++px) {
@@ -534,15 +605,17 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                                           rMax, nullptr);
                                     continue;
                                 }
-                                if (!refined) Refine();
                                 const int lx = px - cx * kCell, ly = py - cy * kCell;
                                 constexpr int kHalf = kCell / 2;
                                 const int sa = lx / kHalf, sb = ly / kHalf;
                                 const int ix = lx - sa * kHalf, iy = ly - sb * kHalf;
                                 if (ix == 0 && iy == 0) {
-                                    Apply(sub[sb][sa], dir, px, py, range.data(), rMin, rMax,
+                                    Apply(SubNode(sa, sb), dir, px, py, range.data(), rMin, rMax,
                                           nullptr);
-                                } else if (subSmooth[sb][sa]) {
+                                    continue;
+                                }
+                                RefineSubCell(sa, sb);
+                                if (subSmooth[sb][sa]) {
                                     if (subClear[sb][sa]) continue;
                                     const BandTrace* c[4] = {&sub[sb][sa], &sub[sb][sa + 1],
                                                              &sub[sb + 1][sa],
@@ -550,8 +623,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                                     Apply(Bilinear(c, float(ix) / kHalf, float(iy) / kHalf), dir,
                                           px, py, range.data(), rMin, rMax, nullptr);
                                 } else {
-                                    ++traces;
-                                    tests += list.size();
+                                    Count(1);
                                     Apply(bins.Trace(list, dir, kPlumeSkyRange_m), dir, px, py,
                                           range.data(), rMin, rMax, nullptr);
                                 }
@@ -560,16 +632,13 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                             // One ray to the nearest surface and, at a depth edge, one to the
                             // farthest (the far samples see what lies beyond the near surface),
                             // in one pass over the puffs.
-                            bins.Copy(list);
                             if (rMax > rMin * kDepthEdgeRatio) {
                                 BandTrace nearTrace, farTrace;
+                                Count(2);
                                 bins.Trace2(list, dir, rMin, rMax, nearTrace, farTrace);
-                                traces += 2;
-                                tests += list.size();
                                 Apply(nearTrace, dir, px, py, range.data(), rMin, rMax, &farTrace);
                             } else {
-                                ++traces;
-                                tests += list.size();
+                                Count(1);
                                 Apply(bins.Trace(list, dir, rMin), dir, px, py, range.data(), rMin,
                                       rMax, nullptr);
                             }
