@@ -2,6 +2,7 @@
 // source functions of scattered and emitted light.
 #include "channels/plume/plume_composite.h"
 
+#include <emmintrin.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -121,6 +122,7 @@ struct FrameBuffers {
     std::vector<CellRow> cellRows;
     std::vector<BandTrace> nodes;
     std::vector<float> nodeT;
+    std::vector<PlumeScreenBins::List> blocks;
     bool busy = false;
 };
 
@@ -304,11 +306,28 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     const auto AllDepthsAtLeast = [&](int cx, int cy, float least) {
         const int rowSamples = kCell * N, sy0 = cy * rowSamples, sx0 = cx * rowSamples;
         const int sx1 = std::min(sx0 + rowSamples, vis.width);
+        // Four samples at a time (SSE2), the same test per lane, one branch per row.
+        const __m128 leastV = _mm_set1_ps(least), zero = _mm_setzero_ps();
+        const __m128 skyDepth = _mm_set1_ps(-1.0f);
+        const __m128i none = _mm_set1_epi32(int32_t(kNoPrimitive));
         for (int j = 0; j < std::min(rowSamples, vis.height - sy0); ++j) {
             const size_t idx0 = vis.Index(0, sy0 + j);
-            for (int sx = sx0; sx < sx1; ++sx) {
-                const float d = vis.depth[idx0 + size_t(sx)];
-                const bool sky = (vis.primitive[idx0 + size_t(sx)] == kNoPrimitive) | (d <= 0.0f);
+            const float* depth = vis.depth.data() + idx0;
+            const uint32_t* primitive = vis.primitive.data() + idx0;
+            int sx = sx0;
+            __m128 ok = _mm_castsi128_ps(_mm_set1_epi32(-1));
+            for (; sx + 4 <= sx1; sx += 4) {
+                const __m128 d = _mm_loadu_ps(depth + sx);
+                const __m128i p = _mm_loadu_si128(reinterpret_cast<const __m128i*>(primitive + sx));
+                const __m128 sky =
+                    _mm_or_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(p, none)), _mm_cmple_ps(d, zero));
+                const __m128 v = _mm_or_ps(_mm_and_ps(sky, skyDepth), _mm_andnot_ps(sky, d));
+                ok = _mm_and_ps(ok, _mm_cmpge_ps(v, leastV));
+            }
+            if (_mm_movemask_ps(ok) != 0xf) return false;
+            for (; sx < sx1; ++sx) {
+                const float d = depth[sx];
+                const bool sky = (primitive[sx] == kNoPrimitive) | (d <= 0.0f);
                 if (!((sky ? -1.0f : d) >= least)) return false;
             }
         }
@@ -336,7 +355,6 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
         return float(double(nearM) / (cosMin * double(dNear)) * 1.0001);
     };
 
-    // Pass 1, the cells' lists and which cells lie wholly behind surfaces in front of their puffs.
     // The grid nodes' sky traces and their transmittances e^(−τ) (for the smoothness test of
     // the four cells around each); every node a cell reads is written in pass 1b.
     std::vector<BandTrace>& nodes = lease.buffers->nodes;
@@ -345,8 +363,31 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     nodeT.resize(nodes.size());
     std::vector<uint64_t> rowCovered(size_t(cellsY), 0), rowTraces(size_t(cellsY), 0),
         rowTests(size_t(cellsY), 0);
-    // One task per row of cells (simple_partitioner): the rows' costs differ by orders of
-    // magnitude (most have no plume), so coarser chunks leave one thread idle at the end.
+    // Pass 0, the puffs of each tile's block: the tile and the one pixel beyond its right and
+    // bottom edges that its last cells reach, gathered from the tiles once. Every strip of
+    // pass 1 lies inside its tile's block, so it takes its puffs from the block's list (the
+    // same list bit for bit as from the tiles) instead of merging two to four tiles' lists
+    // again for each of the tile's kTile / kCell strips.
+    constexpr int kTile = PlumeScreenBins::kTile;
+    const int blocksX = (cellsX * kCell + kTile - 1) / kTile;
+    const int blocksY = (cellsY * kCell + kTile - 1) / kTile;
+    std::vector<PlumeScreenBins::List>& blocks = lease.buffers->blocks;
+    if (blocks.size() < size_t(blocksX) * size_t(blocksY))
+        blocks.resize(size_t(blocksX) * size_t(blocksY));
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, blocksY, 1),
+        [&](const tbb::blocked_range<int>& r) {
+            for (int by = r.begin(); by != r.end(); ++by)
+                for (int bx = 0; bx < blocksX; ++bx)
+                    bins.Gather(bx * kTile, by * kTile, (bx + 1) * kTile + 1, (by + 1) * kTile + 1,
+                                float(kCell), false,
+                                blocks[size_t(by) * size_t(blocksX) + size_t(bx)]);
+        },
+        tbb::simple_partitioner());
+
+    // Pass 1, the cells' lists and which cells lie wholly behind surfaces in front of their
+    // puffs; one task per row of cells (simple_partitioner): the rows' costs differ by orders
+    // of magnitude (most have no plume), so coarser chunks leave one thread idle at the end.
     tbb::parallel_for(
         tbb::blocked_range<int>(0, cellsY, 1),
         [&](const tbb::blocked_range<int>& r) {
@@ -366,10 +407,13 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                     // The cells of one tile column take their puffs from the list of the strip of
                     // the tile that the row crosses (a cell reaches one pixel beyond itself): fewer
                     // puffs looked at than in the tiles' whole lists.
-                    constexpr int kCellsPerTile = PlumeScreenBins::kTile / kCell;
-                    static_assert(PlumeScreenBins::kTile % kCell == 0);
+                    constexpr int kCellsPerTile = kTile / kCell;
+                    static_assert(kTile % kCell == 0);
                     if (cx % kCellsPerTile == 0) {
-                        bins.Gather(cx * kCell, cy * kCell, cx * kCell + PlumeScreenBins::kTile + 1,
+                        const PlumeScreenBins::List& block =
+                            blocks[size_t(cy / kCellsPerTile) * size_t(blocksX) +
+                                   size_t(cx / kCellsPerTile)];
+                        bins.Gather(block, cx * kCell, cy * kCell, cx * kCell + kTile + 1,
                                     cy * kCell + kCell + 1, float(kCell), false, strip);
                         bins.GatherRow(strip, cx * kCell, cy * kCell, cy * kCell + kCell + 1, kCell,
                                        kCell + 1, std::min(kCellsPerTile, cellsX - cx),
@@ -494,6 +538,20 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                                    uint64_t(std::min(H, (cy + 1) * kCell) - cy * kCell);
                         continue;
                     }
+                    // The next cell's radiance, fetched while this one is worked on (its
+                    // sample rows lie a whole image row apart, which the hardware's stream
+                    // prefetch does not follow from cell to cell).
+                    if (cx + 1 < cellsX)
+                        for (int sy = cy * rowSamples;
+                             sy < std::min((cy + 1) * rowSamples, radiance.height); ++sy) {
+                            const int sx0 = (cx + 1) * rowSamples;
+                            const int sx1 = std::min(sx0 + rowSamples, radiance.width) - 1;
+                            if (sx0 > sx1) break;
+                            _mm_prefetch(reinterpret_cast<const char*>(radiance.At(sx0, sy)),
+                                         _MM_HINT_T0);
+                            _mm_prefetch(reinterpret_cast<const char*>(radiance.At(sx1, sy)),
+                                         _MM_HINT_T0);
+                        }
                     TakeList(row, cx, list);
                     // The ranges where the cell's puffs can matter.
                     const float dNear = list.near_m, dFar = list.far_m;
@@ -527,13 +585,12 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                         subTraced[(k / 2) * 2][(k % 2) * 2] = true;
                     }
                     const bool subFine = list.halfSmallOpticalDepth > kInterpolationTolerance;
-                    // Counts `rays` rays about to be traced in one pass over the cell's list. The
-                    // list's data is gathered into contiguous arrays for its second pass on:
-                    // for one pass, copying costs about what it saves (the traces are the same
-                    // bit for bit either way).
-                    int passes = 0;
+                    // Counts `rays` rays about to be traced in one pass over the cell's list,
+                    // whose data is gathered into contiguous arrays before its first pass (the
+                    // traces are the same bit for bit either way; a trace over the list's
+                    // indices cost more than the copy even for one pass, measured by perf).
                     const auto Count = [&](int rays) {
-                        if (++passes == 2) bins.Copy(list);
+                        bins.Copy(list);
                         traces += uint64_t(rays);
                         tests += list.size();
                     };
