@@ -1,6 +1,7 @@
 // Tests of plume compositing: transmittance of one puff against the analytic line integral,
 // the apparent temperature of an optically thick flame, identity outside the plumes, the
-// Henyey–Greenstein normalisation and thread-count independence.
+// Henyey–Greenstein normalisation, thread-count independence and independence of earlier
+// frames.
 #include "channels/plume/plume_composite.h"
 
 #include <gtest/gtest.h>
@@ -10,6 +11,7 @@
 #include <cmath>
 #include <cstring>
 #include <numbers>
+#include <thread>
 
 #include "radiometry/bands/builtin_bands.h"
 #include "radiometry/planck/planck.h"
@@ -280,6 +282,76 @@ TEST(PlumeComposite, CommittedPlumesSameImageForAnyThreadCount) {
                 << threads << " threads, visible " << visible;
         }
     }
+}
+
+// CompositePlumes keeps its frame buffers (grid nodes, cell lists) on the calling thread from
+// one call to the next. A frame composited after another, bigger frame whose puffs covered the
+// whole view is the same bit for bit as the same frame composited on a fresh thread (fresh
+// buffers): nothing the earlier frame left behind shows, including the clear nodes of cells
+// without puffs next to cells with puffs.
+TEST(PlumeComposite, SameImageAfterAnotherFrameOnTheSameThread) {
+    const glm::dvec3 eye{0.0, 0.0, 10.0};
+    // The earlier frame: a wall of puffs across the whole view of a bigger camera.
+    const ChannelCamera bigCam = NorthCamera(eye, 200, 150, 2);
+    std::vector<scene::Puff> wall;
+    for (int i = 0; i < 30; ++i)
+        for (int j = 0; j < 12; ++j) {
+            scene::Puff p;
+            p.centre_m = {-180.0 + 12.5 * i, 300.0, -40.0 + 10.0 * j};
+            p.sigmaH_m = 6.0;
+            p.sigmaZ_m = 5.0;
+            p.mass_kg = 0.02;
+            p.temperature_K = 900.0;
+            wall.push_back(p);
+        }
+    const scene::PlumeField wallField = OnePlume(scene::PlumeKind::Flame, 0.2, wall);
+    // The frame compared: a few puffs in one corner of a smaller view over sky and sea.
+    const ChannelCamera cam = NorthCamera(eye, 150, 100, 2);
+    VisibilityBuffer vis = SkyOnly(cam);
+    for (int y = 0; y < cam.SampleHeight(); ++y)
+        for (int x = 0; x < cam.SampleWidth(); ++x) {
+            const glm::dvec3 d = cam.SampleDirection(x, y);
+            if (d.z >= -1e-3) continue;
+            vis.primitive[vis.Index(x, y)] = 0;
+            vis.depth[vis.Index(x, y)] = float(cam.near_m / (eye.z / -d.z * d.y));
+        }
+    std::vector<scene::Puff> puffs;
+    for (int i = 0; i < 40; ++i) {
+        scene::Puff p;
+        p.centre_m = {-60.0 + 1.0 * i, 250.0 + 2.0 * i, 8.0 + 0.3 * i};
+        p.sigmaH_m = 1.0 + 0.2 * i;
+        p.sigmaZ_m = 0.8 + 0.15 * i;
+        p.mass_kg = 0.004;
+        p.temperature_K = 300.0 + 20.0 * i;
+        puffs.push_back(p);
+    }
+    const scene::PlumeField field = OnePlume(scene::PlumeKind::Flame, 0.3, puffs);
+    const BlackbodyGlowTable glow;
+    PlumeLighting light;
+    light.sunDirection = glm::normalize(glm::vec3(0.3f, 1.0f, 0.2f));
+    light.sunIlluminance = glm::vec3(5000.0f);
+    light.ambientRgb = glm::vec3(200.0f);
+    light.glow = &glow;
+    // One thread per arena: every buffer the call uses is the calling thread's.
+    const auto render = [&](const scene::PlumeField& f, const ChannelCamera& c,
+                            const VisibilityBuffer& v) {
+        Image image(c.SampleWidth(), c.SampleHeight(), 3);
+        std::fill(image.pixels.begin(), image.pixels.end(), 10.0f);
+        tbb::task_arena arena(1);
+        arena.execute([&] { CompositePlumes(f, c, v, light, image); });
+        return image;
+    };
+    Image fresh;
+    std::thread([&] { fresh = render(field, cam, vis); }).join();
+    const Image earlier = render(wallField, bigCam, SkyOnly(bigCam));
+    EXPECT_GT(std::count_if(earlier.pixels.begin(), earlier.pixels.end(),
+                            [](float v) { return v != 10.0f; }),
+              ptrdiff_t(earlier.pixels.size() / 2));
+    const Image after = render(field, cam, vis);
+    EXPECT_GT(
+        std::count_if(fresh.pixels.begin(), fresh.pixels.end(), [](float v) { return v != 10.0f; }),
+        300);
+    EXPECT_EQ(std::memcmp(fresh.pixels.data(), after.pixels.data(), fresh.pixels.size() * 4), 0);
 }
 
 // Pixels whose trace comes from the interpolation grid stay within 0.02 in transmittance (the
