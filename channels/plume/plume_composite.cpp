@@ -234,6 +234,24 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     const auto Apply = [&](const BandTrace& t, const glm::vec3& dir, int px, int py,
                            const float* range, float rMin, float rMax, const BandTrace* far) {
         if (!(t.opticalDepth > 0.0f) && !(far && far->opticalDepth > 0.0f)) return;
+        if (!far) {
+            // One trace for every sample: each sample row's N·channels values are contiguous.
+            const float T = std::exp(-t.opticalDepth);
+            float S[3];
+            if (visible) {
+                const glm::vec3 Svis = VisibleSource(t, -dir, light);
+                S[0] = Svis[0], S[1] = Svis[1], S[2] = Svis[2];
+            } else {
+                S[0] = InfraredSource(t, light);
+            }
+            const int channels = visible ? 3 : 1;
+            for (int j = 0; j < N; ++j) {
+                float* o = radiance.At(px * N, py * N + j);
+                for (int i = 0; i < N; ++i, o += channels)
+                    for (int c = 0; c < channels; ++c) o[c] = CompositeThroughPlume(o[c], T, S[c]);
+            }
+            return;
+        }
         const BandTrace* traces[2] = {&t, far ? far : &t};
         float T[2], Sir[2] = {0.0f, 0.0f};
         glm::vec3 Svis[2];
