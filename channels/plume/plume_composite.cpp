@@ -2,14 +2,15 @@
 // source functions of scattered and emitted light.
 #include "channels/plume/plume_composite.h"
 
+#include <emmintrin.h>
 #include <tbb/blocked_range.h>
-#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <numbers>
 
 #include "channels/flir/flir_channel.h"
@@ -104,6 +105,65 @@ float InfraredSource(const BandTrace& t, const PlumeLighting& light) {
                                    });
 }
 
+// One row of cells' lists: cell cx has index[start[cx], start[cx + 1]) (padded to 4).
+struct CellRow {
+    std::vector<uint32_t> index, start, count;
+    std::vector<float> near_m, far_m;
+    std::vector<float> smallOpticalDepth, halfSmallOpticalDepth;
+    // Whether every surface of the cell lies in front of its puffs (the cell is skipped).
+    std::vector<uint8_t> inFront;
+};
+
+// A frame's buffers, kept by the calling thread from one frame to the next: allocating and
+// zeroing them anew every frame cost page faults and memset (~0.5 MB of grid nodes at
+// 640×480). Every value is written in the frame before it is read, so what an earlier frame
+// left in them never shows.
+struct FrameBuffers {
+    std::vector<CellRow> cellRows;
+    std::vector<BandTrace> nodes;
+    std::vector<float> nodeT;
+    std::vector<PlumeScreenBins::List> blocks;
+    bool busy = false;
+};
+
+// The calling thread's FrameBuffers for one CompositePlumes call; a fresh set when they are in
+// use already (a call nested in another on the same thread, e.g. from a task the thread took
+// while it waited inside a parallel loop).
+class FrameBuffersLease {
+  public:
+    FrameBuffersLease() {
+        thread_local FrameBuffers kept;
+        if (kept.busy) {
+            own_ = std::make_unique<FrameBuffers>();
+            buffers = own_.get();
+        } else {
+            buffers = &kept;
+        }
+        buffers->busy = true;
+    }
+    ~FrameBuffersLease() { buffers->busy = false; }
+    FrameBuffersLease(const FrameBuffersLease&) = delete;
+    FrameBuffersLease& operator=(const FrameBuffersLease&) = delete;
+    FrameBuffers* buffers = nullptr;
+
+  private:
+    std::unique_ptr<FrameBuffers> own_;
+};
+
+// Scratch space of one worker thread, kept from task to task and frame to frame (the results
+// never depend on which thread's scratch a row used: every value is written before it is
+// read). A task uses it from start to end without running other tasks in between (no nested
+// parallelism), so no two users share it.
+struct Scratch {
+    PlumeScreenBins::List strip, list;
+    std::vector<PlumeScreenBins::List> cellLists{PlumeScreenBins::kTile / kCell};
+    std::vector<float> range, depthRows;
+};
+Scratch& LocalScratch() {
+    thread_local Scratch scratch;
+    return scratch;
+}
+
 }  // namespace
 
 float HenyeyGreensteinPhase(float cosTheta, float g) {
@@ -174,6 +234,24 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     const auto Apply = [&](const BandTrace& t, const glm::vec3& dir, int px, int py,
                            const float* range, float rMin, float rMax, const BandTrace* far) {
         if (!(t.opticalDepth > 0.0f) && !(far && far->opticalDepth > 0.0f)) return;
+        if (!far) {
+            // One trace for every sample: each sample row's N·channels values are contiguous.
+            const float T = std::exp(-t.opticalDepth);
+            float S[3];
+            if (visible) {
+                const glm::vec3 Svis = VisibleSource(t, -dir, light);
+                S[0] = Svis[0], S[1] = Svis[1], S[2] = Svis[2];
+            } else {
+                S[0] = InfraredSource(t, light);
+            }
+            const int channels = visible ? 3 : 1;
+            for (int j = 0; j < N; ++j) {
+                float* o = radiance.At(px * N, py * N + j);
+                for (int i = 0; i < N; ++i, o += channels)
+                    for (int c = 0; c < channels; ++c) o[c] = CompositeThroughPlume(o[c], T, S[c]);
+            }
+            return;
+        }
         const BandTrace* traces[2] = {&t, far ? far : &t};
         float T[2], Sir[2] = {0.0f, 0.0f};
         glm::vec3 Svis[2];
@@ -204,15 +282,9 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     // rectangles overlap its pixels or its far corner node, gathered once (pass 1) and kept
     // for pass 2; a cell with none is left alone (every puff adds at most the bins' per-puff
     // tolerance there).
-    // One row of cells' lists: cell cx has index[start[cx], start[cx + 1]) (padded to 4).
-    struct CellRow {
-        std::vector<uint32_t> index, start, count;
-        std::vector<float> near_m, far_m;
-        std::vector<float> smallOpticalDepth, halfSmallOpticalDepth;
-        // Whether every surface of the cell lies in front of its puffs (the cell is skipped).
-        std::vector<uint8_t> inFront;
-    };
-    std::vector<CellRow> cellRows{size_t(cellsY)};
+    FrameBuffersLease lease;
+    std::vector<CellRow>& cellRows = lease.buffers->cellRows;
+    if (cellRows.size() < size_t(cellsY)) cellRows.resize(size_t(cellsY));
     // Cell cx's list of row (not copied).
     const auto TakeList = [](const CellRow& row, int cx, PlumeScreenBins::List& list) {
         list.count = row.count[size_t(cx)];
@@ -235,7 +307,8 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             const uint32_t* primitive = vis.primitive.data() + idx0;
             float* o = out + size_t(j) * size_t(vis.width);
             for (int cx = 0; cx < cellsX; ++cx) {
-                if (row.count[size_t(cx)] == 0) continue;
+                // Pass 2 never reads the depths of cells without puffs or in front of them.
+                if (row.count[size_t(cx)] == 0 || row.inFront[size_t(cx)]) continue;
                 for (int sx = cx * rowSamples; sx < std::min((cx + 1) * rowSamples, vis.width);
                      ++sx) {
                     // Both tests evaluated (no short circuit), so that the loop vectorises.
@@ -251,11 +324,28 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     const auto AllDepthsAtLeast = [&](int cx, int cy, float least) {
         const int rowSamples = kCell * N, sy0 = cy * rowSamples, sx0 = cx * rowSamples;
         const int sx1 = std::min(sx0 + rowSamples, vis.width);
+        // Four samples at a time (SSE2), the same test per lane, one branch per row.
+        const __m128 leastV = _mm_set1_ps(least), zero = _mm_setzero_ps();
+        const __m128 skyDepth = _mm_set1_ps(-1.0f);
+        const __m128i none = _mm_set1_epi32(int32_t(kNoPrimitive));
         for (int j = 0; j < std::min(rowSamples, vis.height - sy0); ++j) {
             const size_t idx0 = vis.Index(0, sy0 + j);
-            for (int sx = sx0; sx < sx1; ++sx) {
-                const float d = vis.depth[idx0 + size_t(sx)];
-                const bool sky = (vis.primitive[idx0 + size_t(sx)] == kNoPrimitive) | (d <= 0.0f);
+            const float* depth = vis.depth.data() + idx0;
+            const uint32_t* primitive = vis.primitive.data() + idx0;
+            int sx = sx0;
+            __m128 ok = _mm_castsi128_ps(_mm_set1_epi32(-1));
+            for (; sx + 4 <= sx1; sx += 4) {
+                const __m128 d = _mm_loadu_ps(depth + sx);
+                const __m128i p = _mm_loadu_si128(reinterpret_cast<const __m128i*>(primitive + sx));
+                const __m128 sky =
+                    _mm_or_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(p, none)), _mm_cmple_ps(d, zero));
+                const __m128 v = _mm_or_ps(_mm_and_ps(sky, skyDepth), _mm_andnot_ps(sky, d));
+                ok = _mm_and_ps(ok, _mm_cmpge_ps(v, leastV));
+            }
+            if (_mm_movemask_ps(ok) != 0xf) return false;
+            for (; sx < sx1; ++sx) {
+                const float d = depth[sx];
+                const bool sky = (primitive[sx] == kNoPrimitive) | (d <= 0.0f);
                 if (!((sky ? -1.0f : d) >= least)) return false;
             }
         }
@@ -267,42 +357,64 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     // so depth ≥ near / (cosMin · dNear) gives r ≤ dNear. The 1e-4 margin covers the float
     // rounding of the per-pixel range (a few ulp), so a pixel skipped by it is one the test
     // rMax ≤ dNear of pass 2 skips: the image is unchanged.
+    // The largest a² over each column of cells and b² over each row (made once, not per cell).
+    std::vector<double> cellA2(size_t(cellsX), 0.0), cellB2(size_t(cellsY), 0.0);
+    for (int cx = 0; cx < cellsX; ++cx)
+        for (int px = cx * kCell; px < std::min(W, (cx + 1) * kCell); ++px)
+            cellA2[size_t(cx)] =
+                std::max(cellA2[size_t(cx)], double(colA[size_t(px)]) * colA[size_t(px)]);
+    for (int cy = 0; cy < cellsY; ++cy)
+        for (int py = cy * kCell; py < std::min(H, (cy + 1) * kCell); ++py)
+            cellB2[size_t(cy)] =
+                std::max(cellB2[size_t(cy)], double(rowB[size_t(py)]) * rowB[size_t(py)]);
     const auto DepthInFront = [&](int cx, int cy, float dNear) {
         if (!(dNear > 0.0f)) return std::numeric_limits<float>::infinity();
-        double a2 = 0.0, b2 = 0.0;
-        for (int px = cx * kCell; px < std::min(W, (cx + 1) * kCell); ++px)
-            a2 = std::max(a2, double(colA[size_t(px)]) * colA[size_t(px)]);
-        for (int py = cy * kCell; py < std::min(H, (cy + 1) * kCell); ++py)
-            b2 = std::max(b2, double(rowB[size_t(py)]) * rowB[size_t(py)]);
-        const double cosMin = 1.0 / std::sqrt(1.0 + a2 + b2);
+        const double cosMin = 1.0 / std::sqrt(1.0 + cellA2[size_t(cx)] + cellB2[size_t(cy)]);
         return float(double(nearM) / (cosMin * double(dNear)) * 1.0001);
     };
 
-    // Pass 1, the cells' lists and which cells lie wholly behind surfaces in front of their puffs.
-    std::vector<BandTrace> nodes(size_t(nodesX) * size_t(nodesY));
+    // The grid nodes' sky traces and their transmittances e^(−τ) (for the smoothness test of
+    // the four cells around each); every node a cell reads is written in pass 1b.
+    std::vector<BandTrace>& nodes = lease.buffers->nodes;
+    std::vector<float>& nodeT = lease.buffers->nodeT;
+    nodes.resize(size_t(nodesX) * size_t(nodesY));
+    nodeT.resize(nodes.size());
     std::vector<uint64_t> rowCovered(size_t(cellsY), 0), rowTraces(size_t(cellsY), 0),
         rowTests(size_t(cellsY), 0);
-    // The nodes' transmittances e^(−τ), for the smoothness test of the four cells around each.
-    std::vector<float> nodeT(nodes.size(), 1.0f);
-    // Scratch space per worker thread, made once per frame rather than once per task (the
-    // results never depend on which thread's scratch a row used: every value is written
-    // before it is read).
-    struct Scratch {
-        PlumeScreenBins::List strip, list;
-        std::vector<PlumeScreenBins::List> cellLists{PlumeScreenBins::kTile / kCell};
-        std::vector<float> range, depthRows;
-    };
-    tbb::enumerable_thread_specific<Scratch> scratch;
-    // One task per row of cells (simple_partitioner): the rows' costs differ by orders of
-    // magnitude (most have no plume), so coarser chunks leave one thread idle at the end.
+    // Pass 0, the puffs of each tile's block: the tile and the one pixel beyond its right and
+    // bottom edges that its last cells reach, gathered from the tiles once. Every strip of
+    // pass 1 lies inside its tile's block, so it takes its puffs from the block's list (the
+    // same list bit for bit as from the tiles) instead of merging two to four tiles' lists
+    // again for each of the tile's kTile / kCell strips.
+    constexpr int kTile = PlumeScreenBins::kTile;
+    const int blocksX = (cellsX * kCell + kTile - 1) / kTile;
+    const int blocksY = (cellsY * kCell + kTile - 1) / kTile;
+    std::vector<PlumeScreenBins::List>& blocks = lease.buffers->blocks;
+    if (blocks.size() < size_t(blocksX) * size_t(blocksY))
+        blocks.resize(size_t(blocksX) * size_t(blocksY));
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, blocksY, 1),
+        [&](const tbb::blocked_range<int>& r) {
+            for (int by = r.begin(); by != r.end(); ++by)
+                for (int bx = 0; bx < blocksX; ++bx)
+                    bins.Gather(bx * kTile, by * kTile, (bx + 1) * kTile + 1, (by + 1) * kTile + 1,
+                                float(kCell), false,
+                                blocks[size_t(by) * size_t(blocksX) + size_t(bx)]);
+        },
+        tbb::simple_partitioner());
+
+    // Pass 1, the cells' lists and which cells lie wholly behind surfaces in front of their
+    // puffs; one task per row of cells (simple_partitioner): the rows' costs differ by orders
+    // of magnitude (most have no plume), so coarser chunks leave one thread idle at the end.
     tbb::parallel_for(
         tbb::blocked_range<int>(0, cellsY, 1),
         [&](const tbb::blocked_range<int>& r) {
-            Scratch& local = scratch.local();
+            Scratch& local = LocalScratch();
             PlumeScreenBins::List& strip = local.strip;
             std::span<PlumeScreenBins::List> cellLists(local.cellLists);
             for (int cy = r.begin(); cy != r.end(); ++cy) {
                 CellRow& row = cellRows[size_t(cy)];
+                row.index.clear();
                 row.start.assign(size_t(cellsX) + 1, 0);
                 row.count.assign(size_t(cellsX), 0);
                 row.near_m.assign(size_t(cellsX), 0.0f);
@@ -313,10 +425,13 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                     // The cells of one tile column take their puffs from the list of the strip of
                     // the tile that the row crosses (a cell reaches one pixel beyond itself): fewer
                     // puffs looked at than in the tiles' whole lists.
-                    constexpr int kCellsPerTile = PlumeScreenBins::kTile / kCell;
-                    static_assert(PlumeScreenBins::kTile % kCell == 0);
+                    constexpr int kCellsPerTile = kTile / kCell;
+                    static_assert(kTile % kCell == 0);
                     if (cx % kCellsPerTile == 0) {
-                        bins.Gather(cx * kCell, cy * kCell, cx * kCell + PlumeScreenBins::kTile + 1,
+                        const PlumeScreenBins::List& block =
+                            blocks[size_t(cy / kCellsPerTile) * size_t(blocksX) +
+                                   size_t(cx / kCellsPerTile)];
+                        bins.Gather(block, cx * kCell, cy * kCell, cx * kCell + kTile + 1,
                                     cy * kCell + kCell + 1, float(kCell), false, strip);
                         bins.GatherRow(strip, cx * kCell, cy * kCell, cy * kCell + kCell + 1, kCell,
                                        kCell + 1, std::min(kCellsPerTile, cellsX - cx),
@@ -357,7 +472,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     tbb::parallel_for(
         tbb::blocked_range<int>(0, nodesY, 1),
         [&](const tbb::blocked_range<int>& r) {
-            PlumeScreenBins::List& list = scratch.local().list;
+            PlumeScreenBins::List& list = LocalScratch().list;
             for (int ny = r.begin(); ny != r.end(); ++ny) {
                 // The row's counts, kept in registers (the rows' slots share cache lines).
                 uint64_t traces = 0, tests = 0;
@@ -365,12 +480,18 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                 const CellRow& row = cellRows[size_t(cy)];
                 for (int nx = 0; nx < nodesX; ++nx) {
                     const int cx = std::min(nx, cellsX - 1);
-                    if (row.count[size_t(cx)] == 0) continue;
+                    const size_t n = size_t(ny) * size_t(nodesX) + size_t(nx);
+                    // No puff reaches the node's cell, so none reaches the node: a clear sky
+                    // (the buffers are reused from frame to frame, so this is written).
+                    if (row.count[size_t(cx)] == 0) {
+                        nodes[n] = BandTrace{};
+                        nodeT[n] = 1.0f;
+                        continue;
+                    }
                     if (!Used(nx - 1, ny - 1) && !Used(nx, ny - 1) && !Used(nx - 1, ny) &&
                         !Used(nx, ny))
                         continue;
                     TakeList(row, cx, list);
-                    const size_t n = size_t(ny) * size_t(nodesX) + size_t(nx);
                     nodes[n] =
                         bins.Trace(list, PixelDirection(nx * kCell, ny * kCell), kPlumeSkyRange_m);
                     nodeT[n] = std::exp(-nodes[n].opticalDepth);
@@ -412,7 +533,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     tbb::parallel_for(
         tbb::blocked_range<int>(0, cellsY, 1),
         [&](const tbb::blocked_range<int>& rows) {
-            Scratch& local = scratch.local();
+            Scratch& local = LocalScratch();
             std::vector<float>& range = local.range;
             range.resize(samples);
             PlumeScreenBins::List& list = local.list;
@@ -435,6 +556,20 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                                    uint64_t(std::min(H, (cy + 1) * kCell) - cy * kCell);
                         continue;
                     }
+                    // The next cell's radiance, fetched while this one is worked on (its
+                    // sample rows lie a whole image row apart, which the hardware's stream
+                    // prefetch does not follow from cell to cell).
+                    if (cx + 1 < cellsX)
+                        for (int sy = cy * rowSamples;
+                             sy < std::min((cy + 1) * rowSamples, radiance.height); ++sy) {
+                            const int sx0 = (cx + 1) * rowSamples;
+                            const int sx1 = std::min(sx0 + rowSamples, radiance.width) - 1;
+                            if (sx0 > sx1) break;
+                            _mm_prefetch(reinterpret_cast<const char*>(radiance.At(sx0, sy)),
+                                         _MM_HINT_T0);
+                            _mm_prefetch(reinterpret_cast<const char*>(radiance.At(sx1, sy)),
+                                         _MM_HINT_T0);
+                        }
                     TakeList(row, cx, list);
                     // The ranges where the cell's puffs can matter.
                     const float dNear = list.near_m, dFar = list.far_m;
@@ -451,41 +586,52 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                         Smooth(corner, cornerT, list.smallOpticalDepth > kInterpolationTolerance,
                                clearSky);
                     // Where the cell is not smooth, its sky pixels are refined on 2 × 2-pixel
-                    // sub-cells: sky traces at the 3 × 3 nodes every 2 pixels (made when
-                    // the first sky pixel needs them), the same criteria with the puffs
-                    // smaller than a sub-cell, and the pixels of a sub-cell that is not smooth
-                    // traced one by one (the nodes' pixels take their node's trace).
-                    bool refined = false;
+                    // sub-cells: sky traces at the 3 × 3 nodes every 2 pixels, the same
+                    // criteria with the puffs smaller than a sub-cell, and the pixels of a
+                    // sub-cell that is not smooth traced one by one (the nodes' pixels take their
+                    // node's trace). Each sub-cell is refined when its first sky pixel needs it,
+                    // and each node traced when its first sub-cell or pixel needs it (a trace
+                    // depends only on the cell's list and the node's direction, so the values
+                    // are the same whenever they are made).
                     BandTrace sub[3][3];
                     float subT[3][3];
-                    bool subSmooth[2][2], subClear[2][2];
-                    const auto Refine = [&] {
-                        refined = true;
+                    bool subTraced[3][3] = {};
+                    bool subRefined[2][2] = {}, subSmooth[2][2], subClear[2][2];
+                    for (int k = 0; k < 4; ++k) {
+                        sub[(k / 2) * 2][(k % 2) * 2] = *corner[k];
+                        subT[(k / 2) * 2][(k % 2) * 2] = cornerT[k];
+                        subTraced[(k / 2) * 2][(k % 2) * 2] = true;
+                    }
+                    const bool subFine = list.halfSmallOpticalDepth > kInterpolationTolerance;
+                    // Counts `rays` rays about to be traced in one pass over the cell's list,
+                    // whose data is gathered into contiguous arrays before its first pass (the
+                    // traces are the same bit for bit either way; a trace over the list's
+                    // indices cost more than the copy even for one pass, measured by perf).
+                    const auto Count = [&](int rays) {
                         bins.Copy(list);
-                        for (int b = 0; b < 3; ++b)
-                            for (int a = 0; a < 3; ++a) {
-                                if (a % 2 == 0 && b % 2 == 0) {
-                                    sub[b][a] = *corner[(b / 2) * 2 + a / 2];
-                                    subT[b][a] = cornerT[(b / 2) * 2 + a / 2];
-                                    continue;
-                                }
-                                const int nx = cx * kCell + a * (kCell / 2),
-                                          ny = cy * kCell + b * (kCell / 2);
-                                sub[b][a] =
-                                    bins.Trace(list, PixelDirection(nx, ny), kPlumeSkyRange_m);
-                                subT[b][a] = std::exp(-sub[b][a].opticalDepth);
-                                ++traces;
-                                tests += list.size();
-                            }
-                        const bool subFine = list.halfSmallOpticalDepth > kInterpolationTolerance;
-                        for (int sb = 0; sb < 2; ++sb)
-                            for (int sa = 0; sa < 2; ++sa) {
-                                const BandTrace* c[4] = {&sub[sb][sa], &sub[sb][sa + 1],
-                                                         &sub[sb + 1][sa], &sub[sb + 1][sa + 1]};
-                                const float cT[4] = {subT[sb][sa], subT[sb][sa + 1],
-                                                     subT[sb + 1][sa], subT[sb + 1][sa + 1]};
-                                subSmooth[sb][sa] = Smooth(c, cT, subFine, subClear[sb][sa]);
-                            }
+                        traces += uint64_t(rays);
+                        tests += list.size();
+                    };
+                    const auto SubNode = [&](int a, int b) -> const BandTrace& {
+                        if (!subTraced[b][a]) {
+                            subTraced[b][a] = true;
+                            Count(1);
+                            sub[b][a] = bins.Trace(list,
+                                                   PixelDirection(cx * kCell + a * (kCell / 2),
+                                                                  cy * kCell + b * (kCell / 2)),
+                                                   kPlumeSkyRange_m);
+                            subT[b][a] = std::exp(-sub[b][a].opticalDepth);
+                        }
+                        return sub[b][a];
+                    };
+                    const auto RefineSubCell = [&](int sa, int sb) {
+                        if (subRefined[sb][sa]) return;
+                        subRefined[sb][sa] = true;
+                        const BandTrace* c[4] = {&SubNode(sa, sb), &SubNode(sa + 1, sb),
+                                                 &SubNode(sa, sb + 1), &SubNode(sa + 1, sb + 1)};
+                        const float cT[4] = {subT[sb][sa], subT[sb][sa + 1], subT[sb + 1][sa],
+                                             subT[sb + 1][sa + 1]};
+                        subSmooth[sb][sa] = Smooth(c, cT, subFine, subClear[sb][sa]);
                     };
                     for (int py = cy * kCell; py < std::min(H, (cy + 1) * kCell); ++py) {
                         for (int px = cx * kCell; px < std::min(W, (cx + 1) * kCell); ++px) {
@@ -534,15 +680,17 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                                           rMax, nullptr);
                                     continue;
                                 }
-                                if (!refined) Refine();
                                 const int lx = px - cx * kCell, ly = py - cy * kCell;
                                 constexpr int kHalf = kCell / 2;
                                 const int sa = lx / kHalf, sb = ly / kHalf;
                                 const int ix = lx - sa * kHalf, iy = ly - sb * kHalf;
                                 if (ix == 0 && iy == 0) {
-                                    Apply(sub[sb][sa], dir, px, py, range.data(), rMin, rMax,
+                                    Apply(SubNode(sa, sb), dir, px, py, range.data(), rMin, rMax,
                                           nullptr);
-                                } else if (subSmooth[sb][sa]) {
+                                    continue;
+                                }
+                                RefineSubCell(sa, sb);
+                                if (subSmooth[sb][sa]) {
                                     if (subClear[sb][sa]) continue;
                                     const BandTrace* c[4] = {&sub[sb][sa], &sub[sb][sa + 1],
                                                              &sub[sb + 1][sa],
@@ -550,8 +698,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                                     Apply(Bilinear(c, float(ix) / kHalf, float(iy) / kHalf), dir,
                                           px, py, range.data(), rMin, rMax, nullptr);
                                 } else {
-                                    ++traces;
-                                    tests += list.size();
+                                    Count(1);
                                     Apply(bins.Trace(list, dir, kPlumeSkyRange_m), dir, px, py,
                                           range.data(), rMin, rMax, nullptr);
                                 }
@@ -560,16 +707,13 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                             // One ray to the nearest surface and, at a depth edge, one to the
                             // farthest (the far samples see what lies beyond the near surface),
                             // in one pass over the puffs.
-                            bins.Copy(list);
                             if (rMax > rMin * kDepthEdgeRatio) {
                                 BandTrace nearTrace, farTrace;
+                                Count(2);
                                 bins.Trace2(list, dir, rMin, rMax, nearTrace, farTrace);
-                                traces += 2;
-                                tests += list.size();
                                 Apply(nearTrace, dir, px, py, range.data(), rMin, rMax, &farTrace);
                             } else {
-                                ++traces;
-                                tests += list.size();
+                                Count(1);
                                 Apply(bins.Trace(list, dir, rMin), dir, px, py, range.data(), rMin,
                                       rMax, nullptr);
                             }

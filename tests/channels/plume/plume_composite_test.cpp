@@ -1,6 +1,7 @@
 // Tests of plume compositing: transmittance of one puff against the analytic line integral,
 // the apparent temperature of an optically thick flame, identity outside the plumes, the
-// Henyey–Greenstein normalisation and thread-count independence.
+// Henyey–Greenstein normalisation, thread-count independence and independence of earlier
+// frames.
 #include "channels/plume/plume_composite.h"
 
 #include <gtest/gtest.h>
@@ -10,6 +11,8 @@
 #include <cmath>
 #include <cstring>
 #include <numbers>
+#include <thread>
+#include <utility>
 
 #include "radiometry/bands/builtin_bands.h"
 #include "radiometry/planck/planck.h"
@@ -36,6 +39,51 @@ scene::PlumeField OnePlume(scene::PlumeKind kind, double albedo,
 PlumeLighting Dark() {
     PlumeLighting light;
     light.kind = PlumeLighting::Kind::Visible;
+    return light;
+}
+
+// Committed plumes (fire with flame, funnel, steam; ~1000 puffs) 1.2–1.8 km north.
+scene::PlumeField CommittedFourPlumes() {
+    const std::pair<scene::PlumeKind, glm::dvec3> sources[] = {
+        {scene::PlumeKind::Smoke, {-150.0, 1500.0, 0.0}},
+        {scene::PlumeKind::Flame, {-150.0, 1500.0, 0.0}},
+        {scene::PlumeKind::Exhaust, {50.0, 1200.0, 20.0}},
+        {scene::PlumeKind::Steam, {200.0, 1800.0, 10.0}}};
+    scene::PlumesSettings settings;
+    for (const auto& [kind, position_m] : sources) {
+        settings.sources.push_back(scene::DefaultPlumeSource(kind));
+        settings.sources.back().position_m = position_m;
+        settings.sources.back().seed = uint64_t(settings.sources.size());
+    }
+    scene::PlumeAmbient ambient;
+    ambient.windSpeed_mps = 5.0;
+    ambient.windDirection_rad = std::numbers::pi / 2;
+    const scene::PlumeSystem system(settings, ambient);
+    scene::PlumeField field = system.MakeField();
+    system.Commit(200.0, field);
+    return field;
+}
+
+// Sky above the horizon and below it a level sea at eye.z below the eye of cam (looking north).
+VisibilityBuffer SkyAndLevelSea(const ChannelCamera& cam, const glm::dvec3& eye) {
+    VisibilityBuffer vis = SkyOnly(cam);
+    for (int y = 0; y < cam.SampleHeight(); ++y)
+        for (int x = 0; x < cam.SampleWidth(); ++x) {
+            const glm::dvec3 d = cam.SampleDirection(x, y);
+            if (d.z >= -1e-3) continue;
+            vis.primitive[vis.Index(x, y)] = 0;
+            vis.depth[vis.Index(x, y)] = float(cam.near_m / (eye.z / -d.z * d.y));
+        }
+    return vis;
+}
+
+// Sunlight from the north-east, ambient light and the blackbody glow.
+PlumeLighting Sunlit(const BlackbodyGlowTable& glow) {
+    PlumeLighting light;
+    light.sunDirection = glm::normalize(glm::vec3(0.3f, 1.0f, 0.2f));
+    light.sunIlluminance = glm::vec3(5000.0f);
+    light.ambientRgb = glm::vec3(200.0f);
+    light.glow = &glow;
     return light;
 }
 
@@ -218,45 +266,19 @@ TEST(PlumeComposite, SameImageForOneAndTwoThreads) {
 // Committed plumes (fire with flame, funnel, steam; ~1000 puffs) over sky and sea in the
 // visible and in LWIR: bit-identical images at one, two and three threads.
 TEST(PlumeComposite, CommittedPlumesSameImageForAnyThreadCount) {
-    scene::PlumesSettings settings;
-    const auto add = [&](scene::PlumeKind kind, glm::dvec3 position_m) {
-        scene::PlumeSourceSettings s = scene::DefaultPlumeSource(kind);
-        s.position_m = position_m;
-        s.seed = uint64_t(settings.sources.size() + 1);
-        settings.sources.push_back(s);
-    };
-    add(scene::PlumeKind::Smoke, {-150.0, 1500.0, 0.0});
-    add(scene::PlumeKind::Flame, {-150.0, 1500.0, 0.0});
-    add(scene::PlumeKind::Exhaust, {50.0, 1200.0, 20.0});
-    add(scene::PlumeKind::Steam, {200.0, 1800.0, 10.0});
-    scene::PlumeAmbient ambient;
-    ambient.windSpeed_mps = 5.0;
-    ambient.windDirection_rad = std::numbers::pi / 2;
-    const scene::PlumeSystem system(settings, ambient);
-    scene::PlumeField field = system.MakeField();
-    system.Commit(200.0, field);
+    const scene::PlumeField field = CommittedFourPlumes();
     ASSERT_GT(field.PuffCount(), 300u);
 
     const glm::dvec3 eye{0.0, 0.0, 10.0};
     const ChannelCamera cam = NorthCamera(eye, 150, 100, 2);
-    VisibilityBuffer vis = SkyOnly(cam);
-    for (int y = 0; y < cam.SampleHeight(); ++y)
-        for (int x = 0; x < cam.SampleWidth(); ++x) {
-            const glm::dvec3 d = cam.SampleDirection(x, y);
-            if (d.z >= -1e-3) continue;
-            vis.primitive[vis.Index(x, y)] = 0;
-            vis.depth[vis.Index(x, y)] = float(cam.near_m / (eye.z / -d.z * d.y));
-        }
+    const VisibilityBuffer vis = SkyAndLevelSea(cam, eye);
     const BlackbodyGlowTable glow;
     const radiometry::Band lwir = radiometry::BuiltinBand("LWIR");
     const radiometry::BandRadianceTable table(lwir);
     for (const bool visible : {true, false}) {
         PlumeLighting light;
         if (visible) {
-            light.sunDirection = glm::normalize(glm::vec3(0.3f, 1.0f, 0.2f));
-            light.sunIlluminance = glm::vec3(5000.0f);
-            light.ambientRgb = glm::vec3(200.0f);
-            light.glow = &glow;
+            light = Sunlit(glow);
         } else {
             light.kind = PlumeLighting::Kind::Infrared;
             light.band = ObscurantBand::Lwir;
@@ -280,6 +302,55 @@ TEST(PlumeComposite, CommittedPlumesSameImageForAnyThreadCount) {
                 << threads << " threads, visible " << visible;
         }
     }
+}
+
+// CompositePlumes keeps its frame buffers (grid nodes, cell lists) on the calling thread from
+// one call to the next. A frame composited after another, bigger frame whose puffs covered the
+// whole view is the same bit for bit as the same frame composited on a fresh thread (fresh
+// buffers): nothing the earlier frame left behind shows, including the clear nodes of cells
+// without puffs next to cells with puffs.
+TEST(PlumeComposite, SameImageAfterAnotherFrameOnTheSameThread) {
+    const glm::dvec3 eye{0.0, 0.0, 10.0};
+    // The earlier frame: a wall of puffs 300 m away across the whole view of a bigger camera.
+    const ChannelCamera bigCam = NorthCamera(eye, 200, 150, 2);
+    std::vector<scene::Puff> wall;
+    for (int i = 0; i < 30; ++i)
+        for (int j = 0; j < 16; ++j) {
+            scene::Puff p;
+            p.centre_m = {-180.0 + 12.5 * i, 300.0, -70.0 + 10.0 * j};
+            p.sigmaH_m = 6.0;
+            p.sigmaZ_m = 5.0;
+            p.mass_kg = 0.02;
+            p.temperature_K = 900.0;
+            wall.push_back(p);
+        }
+    const scene::PlumeField wallField = OnePlume(scene::PlumeKind::Flame, 0.2, wall);
+    // The frame compared: committed plumes over sky and sea in a smaller view.
+    const scene::PlumeField field = CommittedFourPlumes();
+    const ChannelCamera cam = NorthCamera(eye, 150, 100, 2);
+    const VisibilityBuffer vis = SkyAndLevelSea(cam, eye);
+    const BlackbodyGlowTable glow;
+    const PlumeLighting light = Sunlit(glow);
+    // One thread per arena: every buffer the call uses is the calling thread's.
+    const auto render = [&](const scene::PlumeField& f, const ChannelCamera& c,
+                            const VisibilityBuffer& v) {
+        Image image(c.SampleWidth(), c.SampleHeight(), 3);
+        std::fill(image.pixels.begin(), image.pixels.end(), 10.0f);
+        tbb::task_arena arena(1);
+        arena.execute([&] { CompositePlumes(f, c, v, light, image); });
+        return image;
+    };
+    Image fresh;
+    std::thread([&] { fresh = render(field, cam, vis); }).join();
+    const Image earlier = render(wallField, bigCam, SkyOnly(bigCam));
+    EXPECT_GT(std::count_if(earlier.pixels.begin(), earlier.pixels.end(),
+                            [](float v) { return v != 10.0f; }),
+              ptrdiff_t(earlier.pixels.size() / 2));
+    const Image after = render(field, cam, vis);
+    EXPECT_GT(
+        std::count_if(fresh.pixels.begin(), fresh.pixels.end(), [](float v) { return v != 10.0f; }),
+        1000);
+    EXPECT_EQ(std::memcmp(fresh.pixels.data(), after.pixels.data(), fresh.pixels.size() * 4), 0);
 }
 
 // Pixels whose trace comes from the interpolation grid stay within 0.02 in transmittance (the
