@@ -221,11 +221,6 @@ struct SeaShading {
         // Reciprocals of the frame's constants: multiplications in the loop, not divisions.
         const F4 minusInvSlopeVar = Set4(-1.0f / slopeVar);
         const F4 invGlintNorm = Set4(1.0f / (float(M_PI) * slopeVar));
-        // Columns at least this deep return no light in any channel (OpaqueColumn_m): their
-        // transmittance T is 0 without its path factor and exponentials, as computed.
-        const F4 opaqueColumn =
-            Set4(std::max({OpaqueColumn_m(shore[0].K_perm), OpaqueColumn_m(shore[1].K_perm),
-                           OpaqueColumn_m(shore[2].K_perm)}));
         for (size_t i = 0; i < count; i += 4) {
             const F4 F = _mm_load_ps(ch.F + i), oneMinusF = _mm_sub_ps(one, F);
             const F4 cosV = _mm_load_ps(ch.cosV + i), cos2 = _mm_load_ps(ch.cos2 + i);
@@ -251,10 +246,8 @@ struct SeaShading {
             const size_t lanes = std::min<size_t>(4, count - i);
             const F4 d = LoadLanes(depth + i, lanes, kDeepColumn_m);
             const F4 w = LoadLanes(wet + i, lanes, 0.0f), c = LoadLanes(foam + i, lanes, 0.0f);
-            const bool opaque = _mm_movemask_ps(_mm_cmpge_ps(d, opaqueColumn)) == 0xf;
-            // The water path factor 1 + 1/cos θ_t (only T needs it).
-            const F4 path =
-                opaque ? zero : WaterPathFactor4(cosV, float(radiometry::kSeaWaterIndexVisible));
+            // The water path factor 1 + 1/cos θ_t, from cos θ_v as stored above.
+            const F4 path = WaterPathFactor4(cosV, float(radiometry::kSeaWaterIndexVisible));
             const F4 keyLit = _mm_mul_ps(_mm_load_ps(ch.keyCos + i), sunVis);
             const auto channel = [&](const ShoreChannel& sh, const float* skyC, const float* horC,
                                      const float* ambC, float dw, float sunEC, float* outC) {
@@ -263,8 +256,7 @@ struct SeaShading {
                     R = Select4(glint,
                                 _mm_add_ps(R, _mm_mul_ps(_mm_mul_ps(Set4(sunEC), g), sunVis)), R);
                 const F4 E = _mm_add_ps(_mm_load_ps(ambC + i), _mm_mul_ps(Set4(sunEC), keyLit));
-                const F4 T = opaque ? zero : ShoreTransmittance4(sh, d, path);
-                F4 L = ShoreRadianceT4(sh, R, oneMinusF, T, d, w, c, E, Set4(dw));
+                F4 L = ShoreRadiance4(sh, R, oneMinusF, path, d, w, c, E, Set4(dw));
                 L = _mm_add_ps(_mm_mul_ps(L, t), _mm_mul_ps(_mm_load_ps(horC + i), oneMinusT));
                 _mm_store_ps(outC + i, L);
             };

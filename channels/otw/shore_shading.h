@@ -3,7 +3,6 @@
 #pragma once
 
 #include <cmath>
-#include <limits>
 
 #include "scene/core/simd4.h"
 
@@ -57,36 +56,22 @@ inline simd4::F4 WaterPathFactor4(simd4::F4 cosV, float n) {
     return _mm_add_ps(Set4(1.0f), _mm_div_ps(Set4(1.0f), cosT));
 }
 
-// T = e^{−K d (1 + 1/cos θ_t)}: the share of the light that crosses the column of depth d
-// down and back up (pathFactor from WaterPathFactor4).
-inline simd4::F4 ShoreTransmittance4(const ShoreChannel& c, simd4::F4 depth, simd4::F4 pathFactor) {
-    using namespace simd4;
-    return ExpNonPositive4(_mm_mul_ps(Set4(-c.K_perm), _mm_mul_ps(depth, pathFactor)));
-}
-
-// A water column at least this deep (m) returns no light through ShoreTransmittance4 for
-// attenuation K_perm at any view angle: T is exactly 0 there, so it need not be computed.
-// Why: 1 + 1/cos θ_t ≥ 2 (cos θ_t ≤ 1; ≥ 1.99 with the rounding of a unit normal's n·v), so
-// the exponent is ≤ −1.99·50 < −87, where ExpNonPositive4 returns exactly 0 (tested).
-inline float OpaqueColumn_m(float K_perm) {
-    return K_perm > 0.0f ? 50.0f / K_perm : std::numeric_limits<float>::infinity();
-}
-
 // Radiance (cd/m², one channel) of a surf-zone point before fog:
 //   water:  reflected + (1 − F)·[ρ_wet E/π · T + R_rs E_d · (1 − T)],  T = e^{−K d (1 + 1/cos θ_t)}
 //   sand:   ρ_sand E/π,  ρ_sand from dry to wet by wetness
 //   surface = sand + (water − sand)·min(d / kSwashFilm_m, 1);  result = surface + (foam −
 //   surface)·c
 // reflected = F·L_sky + glint (the surface's specular part), oneMinusF the Fresnel
-// transmittance, T from ShoreTransmittance4, depth the column d (m), wet in [0, 1], foam
+// transmittance, pathFactor from WaterPathFactor4, depth the column d (m), wet in [0, 1], foam
 // coverage c in [0, 1], E the irradiance on the surface (Lambertian: key, fill and sky, lx),
 // Ed the downwelling irradiance on a level surface (lx).
-inline simd4::F4 ShoreRadianceT4(const ShoreChannel& c, simd4::F4 reflected, simd4::F4 oneMinusF,
-                                 simd4::F4 T, simd4::F4 depth, simd4::F4 wet, simd4::F4 foam,
-                                 simd4::F4 E, simd4::F4 Ed) {
+inline simd4::F4 ShoreRadiance4(const ShoreChannel& c, simd4::F4 reflected, simd4::F4 oneMinusF,
+                                simd4::F4 pathFactor, simd4::F4 depth, simd4::F4 wet,
+                                simd4::F4 foam, simd4::F4 E, simd4::F4 Ed) {
     using namespace simd4;
     const F4 invPi = Set4(float(1.0 / M_PI));
     const F4 lambert = _mm_mul_ps(E, invPi);
+    const F4 T = ExpNonPositive4(_mm_mul_ps(Set4(-c.K_perm), _mm_mul_ps(depth, pathFactor)));
     const F4 bottom = _mm_mul_ps(Set4(c.rhoWet), lambert);
     const F4 deep = _mm_mul_ps(Set4(c.rrs), Ed);
     const F4 water = _mm_add_ps(
@@ -98,14 +83,6 @@ inline simd4::F4 ShoreRadianceT4(const ShoreChannel& c, simd4::F4 reflected, sim
     const F4 surface = _mm_add_ps(sand, _mm_mul_ps(_mm_sub_ps(water, sand), film));
     const F4 white = _mm_mul_ps(Set4(c.rhoFoam), lambert);
     return _mm_add_ps(surface, _mm_mul_ps(_mm_sub_ps(white, surface), foam));
-}
-
-// As ShoreRadianceT4 with T from the path factor (WaterPathFactor4).
-inline simd4::F4 ShoreRadiance4(const ShoreChannel& c, simd4::F4 reflected, simd4::F4 oneMinusF,
-                                simd4::F4 pathFactor, simd4::F4 depth, simd4::F4 wet,
-                                simd4::F4 foam, simd4::F4 E, simd4::F4 Ed) {
-    return ShoreRadianceT4(c, reflected, oneMinusF, ShoreTransmittance4(c, depth, pathFactor),
-                           depth, wet, foam, E, Ed);
 }
 
 }  // namespace seasense::channels

@@ -84,36 +84,5 @@ TEST(ShoreShading, FoamIsLambertianLayer) {
     EXPECT_NEAR(half, 0.5f * (water + 0.55f * E / float(M_PI)), 1e-4f * E);
 }
 
-// The sea pass skips T's exponentials for columns of at least OpaqueColumn_m: there T must be
-// exactly 0 at every view angle (cos θ_v from grazing 1e-3 to a unit normal's rounding just
-// above 1), so that the skip leaves the radiance unchanged bit for bit.
-TEST(ShoreShading, OpaqueColumnTransmitsExactlyNothing) {
-    for (float K : {0.02f, 0.1f, 0.13f, 0.28f, 1.0f, 3.0f}) {
-        ShoreChannel c = kChannel;
-        c.K_perm = K;
-        c.rrs = 0.003f;
-        const float opaque = OpaqueColumn_m(K);
-        for (float d : {opaque, 1.5f * opaque, kDeepColumn_m}) {
-            for (float cosV = 1e-3f; cosV <= 1.000002f; cosV += 1e-4f) {
-                const F4 path = WaterPathFactor4(Set4(cosV), 1.341f);
-                const F4 T = ShoreTransmittance4(c, Set4(d), path);
-                ASSERT_EQ(_mm_movemask_epi8(_mm_castps_si128(T)), 0)
-                    << K << " " << d << " " << cosV;
-                const F4 full = ShoreRadiance4(c, Set4(20.0f), Set4(0.9f), path, Set4(d),
-                                               Set4(0.3f), Set4(0.1f), Set4(4e4f), Set4(3e4f));
-                const F4 skipped =
-                    ShoreRadianceT4(c, Set4(20.0f), Set4(0.9f), _mm_setzero_ps(), Set4(d),
-                                    Set4(0.3f), Set4(0.1f), Set4(4e4f), Set4(3e4f));
-                ASSERT_EQ(Lane0(full), Lane0(skipped));
-            }
-        }
-        // Not vacuous: a tenth of that column still lets light through at normal incidence.
-        EXPECT_GT(Lane0(ShoreTransmittance4(c, Set4(0.1f * opaque),
-                                            WaterPathFactor4(Set4(1.0f), 1.341f))),
-                  0.0f);
-    }
-    EXPECT_TRUE(std::isinf(OpaqueColumn_m(0.0f)));
-}
-
 }  // namespace
 }  // namespace seasense::channels
