@@ -135,8 +135,8 @@ struct SeaChunk {
     alignas(16) float horR[kChunk], horG[kChunk], horB[kChunk];
     alignas(16) float outR[kChunk], outG[kChunk], outB[kChunk];
     // Surf zone: Lambertian irradiance without the key light, cos of the key light on the normal
-    // (≥ 0), the water path factor 1 + 1/cos θ_t.
-    alignas(16) float ambR[kChunk], ambG[kChunk], ambB[kChunk], keyCos[kChunk], path[kChunk];
+    // (≥ 0).
+    alignas(16) float ambR[kChunk], ambG[kChunk], ambB[kChunk], keyCos[kChunk];
 };
 
 // Sea radiance: Fresnel-weighted sky reflection plus water-leaving radiance, Cox–Munk glint of
@@ -210,8 +210,6 @@ struct SeaShading {
             _mm_store_ps(ch.ambG + i, aG);
             _mm_store_ps(ch.ambB + i, aB);
             _mm_store_ps(ch.keyCos + i, Max4(_mm_load_ps(ch.cosS + i), _mm_setzero_ps()));
-            _mm_store_ps(ch.path + i, WaterPathFactor4(Max4(ndv, Set4(1e-3f)),
-                                                       float(radiometry::kSeaWaterIndexVisible)));
         }
         sky.LookUp(count, ch.rx, ch.ry, ch.rz, ch.skyR, ch.skyG, ch.skyB);
         sky.HorizonLookUp(count, ch.mvx, ch.mvy, ch.horR, ch.horG, ch.horB);
@@ -233,24 +231,30 @@ struct SeaShading {
             const F4 glint = _mm_and_ps(_mm_and_ps(_mm_cmpgt_ps(_mm_load_ps(ch.cosS + i), zero),
                                                    _mm_cmpgt_ps(sunVis, zero)),
                                         _mm_cmplt_ps(tan2, glintLimit));
-            const F4 p =
-                _mm_mul_ps(ExpNonPositive4(_mm_mul_ps(tan2, minusInvSlopeVar)), invGlintNorm);
-            const F4 g =
-                _mm_div_ps(_mm_mul_ps(_mm_load_ps(ch.Fs + i), p),
-                           _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(Set4(4.0f), cosV), cos2), cos2));
+            // Lanes without glint drop g (Select4 below): skipped when no lane has it.
+            const bool anyGlint = _mm_movemask_ps(glint) != 0;
+            F4 g = zero;
+            if (anyGlint) {
+                const F4 p =
+                    _mm_mul_ps(ExpNonPositive4(_mm_mul_ps(tan2, minusInvSlopeVar)), invGlintNorm);
+                g = _mm_div_ps(_mm_mul_ps(_mm_load_ps(ch.Fs + i), p),
+                               _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(Set4(4.0f), cosV), cos2), cos2));
+            }
             // Koschmieder: the horizon sky is the airlight a long path converges to.
             const F4 t = ExpNonPositive4(_mm_mul_ps(Set4(-beta), _mm_load_ps(ch.range + i)));
             const F4 oneMinusT = _mm_sub_ps(one, t);
             const size_t lanes = std::min<size_t>(4, count - i);
             const F4 d = LoadLanes(depth + i, lanes, kDeepColumn_m);
             const F4 w = LoadLanes(wet + i, lanes, 0.0f), c = LoadLanes(foam + i, lanes, 0.0f);
-            const F4 path = _mm_load_ps(ch.path + i);
+            // The water path factor 1 + 1/cos θ_t, from cos θ_v as stored above.
+            const F4 path = WaterPathFactor4(cosV, float(radiometry::kSeaWaterIndexVisible));
             const F4 keyLit = _mm_mul_ps(_mm_load_ps(ch.keyCos + i), sunVis);
             const auto channel = [&](const ShoreChannel& sh, const float* skyC, const float* horC,
                                      const float* ambC, float dw, float sunEC, float* outC) {
                 F4 R = _mm_mul_ps(F, _mm_load_ps(skyC + i));
-                R = Select4(glint, _mm_add_ps(R, _mm_mul_ps(_mm_mul_ps(Set4(sunEC), g), sunVis)),
-                            R);
+                if (anyGlint)
+                    R = Select4(glint,
+                                _mm_add_ps(R, _mm_mul_ps(_mm_mul_ps(Set4(sunEC), g), sunVis)), R);
                 const F4 E = _mm_add_ps(_mm_load_ps(ambC + i), _mm_mul_ps(Set4(sunEC), keyLit));
                 F4 L = ShoreRadiance4(sh, R, oneMinusF, path, d, w, c, E, Set4(dw));
                 L = _mm_add_ps(_mm_mul_ps(L, t), _mm_mul_ps(_mm_load_ps(horC + i), oneMinusT));
@@ -749,6 +753,16 @@ void Splat(float* out, uint32_t k, int sampleWidth, int n, float r, float g, flo
         return;
     }
     k &= ~kPixelEntry;
+    if (n == 2) {
+        // The default 2×2: each sample row's six floats (r g b r g b) in two stores.
+        const F4 rgbr = _mm_setr_ps(r, g, b, r), gb = _mm_setr_ps(g, b, 0.0f, 0.0f);
+        for (int j = 0; j < 2; ++j) {
+            float* o = out + 3 * (size_t(k) + size_t(j) * size_t(sampleWidth));
+            _mm_storeu_ps(o, rgbr);
+            _mm_storel_pi(reinterpret_cast<__m64*>(o + 4), gb);
+        }
+        return;
+    }
     for (int j = 0; j < n; ++j) {
         float* o = out + 3 * (size_t(k) + size_t(j) * size_t(sampleWidth));
         for (int i = 0; i < n; ++i) o[3 * i] = r, o[3 * i + 1] = g, o[3 * i + 2] = b;

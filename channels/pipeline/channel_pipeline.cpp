@@ -12,6 +12,7 @@
 
 #include "scene/core/error.h"
 #include "sensors/detector/detector.h"
+#include "sensors/display/display_lut.h"
 #include "sensors/output/image_writer.h"
 #include "sensors/thermal/thermal_output.h"
 
@@ -257,11 +258,20 @@ std::vector<uint8_t> ChannelPipeline::PreviewRgb8(int width, int height) {
     if (!previewLut_) previewLut_ = std::make_unique<sensors::DisplayLut>(*display_);
     if (width == pixels_.width && height == pixels_.height)
         return previewLut_->ToDisplay8(pixels_, float(std::exp2(ev_)));
-    Image small(width, height, 3);
-    const cv::Mat src(pixels_.height, pixels_.width, CV_32FC3,
-                      const_cast<float*>(pixels_.pixels.data()));
-    cv::Mat dst(height, width, CV_32FC3, small.pixels.data());
-    cv::resize(src, dst, dst.size(), 0, 0, cv::INTER_AREA);
+    // Kept between frames: a fresh 0.9 MB image each frame is zero-filled (and page-faulted)
+    // only to be overwritten by the resize.
+    Image& small = previewSmall_;
+    if (small.width != width || small.height != height || small.channels != 3)
+        small = Image(width, height, 3);
+    if (pixels_.width == 2 * width && pixels_.height == 2 * height) {
+        sensors::HalveRgb(pixels_, small);  // the five-channel run's 640×480 → 320×240
+    } else {
+        const cv::Mat src(pixels_.height, pixels_.width, CV_32FC3,
+                          const_cast<float*>(pixels_.pixels.data()));
+        cv::Mat dst(height, width, CV_32FC3, small.pixels.data());
+        cv::resize(src, dst, dst.size(), 0, 0, cv::INTER_AREA);
+        CHECK(dst.data == reinterpret_cast<uchar*>(small.pixels.data()));  // written in place
+    }
     return previewLut_->ToDisplay8(small, float(std::exp2(ev_)));
 }
 

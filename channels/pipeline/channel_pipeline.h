@@ -104,6 +104,7 @@ class ChannelPipeline {
     std::vector<uint8_t> display8_;  // display transform of pixels_, when asked for
     bool displayValid_ = false;
     std::unique_ptr<sensors::DisplayLut> previewLut_;  // built on the first preview
+    Image previewSmall_;  // otw: pixels_ scaled to the preview size (kept between frames)
 };
 
 // The project's OCIO config: $SEASENSE_OCIO if set, else configs/ocio/config.ocio found

@@ -461,11 +461,28 @@ void RasterTile(int tile, const Context& ctx, const std::vector<Chunk>& chunks, 
             uint32_t* __restrict primitive = t.primitive + b;
             float* __restrict b1 = t.b1 + b;
             float* __restrict b2 = t.b2 + b;
-            for (size_t i = 0; i < n; ++i) {
-                depth[i] = 0.0f;
-                primitive[i] = kNoPrimitive;
-                b1[i] = 0.0f;
-                b2[i] = 0.0f;
+            // The compiler turned the plain loop into four memset calls per tile row (~77 k
+            // calls per 1280×960 frame). Stores of values it cannot see to be constant (the
+            // empty asm statement hides them) stay stores: four samples at a time with SSE2.
+            float zero = 0.0f;
+            uint32_t empty = kNoPrimitive;
+            asm("" : "+r"(zero), "+r"(empty));
+            size_t i = 0;
+#if defined(__SSE2__)
+            const __m128 zero4 = _mm_set1_ps(zero);
+            const __m128i empty4 = _mm_set1_epi32(int32_t(empty));
+            for (; i + 4 <= n; i += 4) {
+                _mm_storeu_ps(depth + i, zero4);
+                _mm_storeu_si128(reinterpret_cast<__m128i*>(primitive + i), empty4);
+                _mm_storeu_ps(b1 + i, zero4);
+                _mm_storeu_ps(b2 + i, zero4);
+            }
+#endif
+            for (; i < n; ++i) {
+                depth[i] = zero;
+                primitive[i] = empty;
+                b1[i] = zero;
+                b2[i] = zero;
             }
         }
     }

@@ -38,16 +38,29 @@ void DisplayLut::Apply(const float rgb[3], float out[3]) const {
         f[c] = u - float(i0[c]);
     }
     const size_t e = size_t(edge_);
+    const float* node = &table_[((size_t(i0[2]) * e + size_t(i0[1])) * e + size_t(i0[0])) * 3];
+    // Corner (dr, dg, db)'s weight is (w_r · w_g) · w_b, each w = f or 1 − f by the corner's
+    // offset: the eight products two registers at a time, corner = dr + 2 dg + 4 db per lane.
+    const __m128 wr = _mm_setr_ps(1.0f - f[0], f[0], 1.0f - f[0], f[0]);
+    const __m128 wg = _mm_setr_ps(1.0f - f[1], 1.0f - f[1], f[1], f[1]);
+    const __m128 rg = _mm_mul_ps(wr, wg);
+    const __m128 w[2] = {_mm_mul_ps(rg, _mm_set1_ps(1.0f - f[2])),
+                         _mm_mul_ps(rg, _mm_set1_ps(f[2]))};
+    const size_t dg = 3 * e, db = 3 * e * e;
+    const float* corner[2][4] = {{node, node + 3, node + dg, node + dg + 3},
+                                 {node + db, node + db + 3, node + db + dg, node + db + dg + 3}};
     // The three components in the lanes of one SSE register (the fourth lane is dropped): per
     // component the same products and sums, corner after corner, as a scalar loop.
     __m128 sum = _mm_setzero_ps();
-    for (int corner = 0; corner < 8; ++corner) {
-        const int dr = corner & 1, dg = (corner >> 1) & 1, db = corner >> 2;
-        const float w =
-            (dr ? f[0] : 1.0f - f[0]) * (dg ? f[1] : 1.0f - f[1]) * (db ? f[2] : 1.0f - f[2]);
-        const float* v =
-            &table_[((size_t(i0[2] + db) * e + size_t(i0[1] + dg)) * e + size_t(i0[0] + dr)) * 3];
-        sum = _mm_add_ps(sum, _mm_mul_ps(_mm_set1_ps(w), _mm_loadu_ps(v)));
+    for (int b = 0; b < 2; ++b) {
+        sum = _mm_add_ps(sum, _mm_mul_ps(_mm_shuffle_ps(w[b], w[b], _MM_SHUFFLE(0, 0, 0, 0)),
+                                         _mm_loadu_ps(corner[b][0])));
+        sum = _mm_add_ps(sum, _mm_mul_ps(_mm_shuffle_ps(w[b], w[b], _MM_SHUFFLE(1, 1, 1, 1)),
+                                         _mm_loadu_ps(corner[b][1])));
+        sum = _mm_add_ps(sum, _mm_mul_ps(_mm_shuffle_ps(w[b], w[b], _MM_SHUFFLE(2, 2, 2, 2)),
+                                         _mm_loadu_ps(corner[b][2])));
+        sum = _mm_add_ps(sum, _mm_mul_ps(_mm_shuffle_ps(w[b], w[b], _MM_SHUFFLE(3, 3, 3, 3)),
+                                         _mm_loadu_ps(corner[b][3])));
     }
     alignas(16) float lanes[4];
     _mm_store_ps(lanes, sum);
@@ -71,6 +84,33 @@ std::vector<std::uint8_t> DisplayLut::ToDisplay8(const Image& linear, float expo
                           }
                       });
     return codes;
+}
+
+// A pixel's three sums in one SSE2 register: its fourth lane, the next pixel's first value, is
+// overwritten by the next pixel, and the last pixel is summed without reading past the row.
+void HalveRgb(const Image& src, Image& dst) {
+    CHECK(src.channels == 3 && dst.channels == 3 && src.width == 2 * dst.width &&
+          src.height == 2 * dst.height);
+    tbb::parallel_for(0, dst.height, [&](int y) {
+        const float* r0 = src.At(0, 2 * y);
+        const float* r1 = src.At(0, 2 * y + 1);
+        float* out = dst.At(0, y);
+        const __m128 quarter = _mm_set1_ps(0.25f);
+        int x = 0;
+        for (; x + 1 < dst.width; ++x) {
+            const size_t i = size_t(6 * x);
+            const __m128 sum =
+                _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_loadu_ps(r0 + i), _mm_loadu_ps(r0 + i + 3)),
+                                      _mm_loadu_ps(r1 + i)),
+                           _mm_loadu_ps(r1 + i + 3));
+            _mm_storeu_ps(out + 3 * x, _mm_mul_ps(sum, quarter));
+        }
+        for (; x < dst.width; ++x)
+            for (int c = 0; c < 3; ++c) {
+                const size_t i = size_t(6 * x + c);
+                out[3 * x + c] = (((r0[i] + r0[i + 3]) + r1[i]) + r1[i + 3]) * 0.25f;
+            }
+    });
 }
 
 }  // namespace seasense::sensors

@@ -34,4 +34,10 @@ class DisplayLut {
     std::vector<float> table_;  // edge³ × 3, red fastest, and one float of padding
 };
 
+// dst = src (3 channels) halved in each direction, for previews: each value is ((a + b) + c) + d
+// times ¼ over its 2×2 source values, row by row — the sums, in their order, of OpenCV's
+// cv::resize INTER_AREA for an exact factor 2 (tested equal bit for bit), without OpenCV's
+// thread pool. Runs in the caller's oneTBB arena.
+void HalveRgb(const Image& src, Image& dst);
+
 }  // namespace seasense::sensors

@@ -24,14 +24,6 @@ namespace {
 // enough to give both cores work on a 640×480 frame.
 constexpr int kPixelsPerBlock = 16384;
 
-template <typename T>
-T QuantizeUnorm(float v) {
-    constexpr float kMax = float(std::numeric_limits<T>::max());
-    if (!(v > 0.0f)) return 0;  // also NaN
-    if (v >= 1.0f) return std::numeric_limits<T>::max();
-    return T(v * kMax + 0.5f);
-}
-
 std::string Quoted(const std::filesystem::path& path) { return "'" + path.string() + "'"; }
 
 // "sRGB: [ACES 1.0 - SDR Video, Raw]; ..." for error messages.
@@ -65,9 +57,6 @@ bool HasView(const OCIO::Config& config, const std::string& display, const std::
 }
 
 }  // namespace
-
-std::uint8_t QuantizeUnorm8(float v) { return QuantizeUnorm<std::uint8_t>(v); }
-std::uint16_t QuantizeUnorm16(float v) { return QuantizeUnorm<std::uint16_t>(v); }
 
 struct OcioDisplay::Impl {
     std::string display;

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -14,8 +15,16 @@ namespace seasense::sensors {
 // Nearest n-bit code value of a display value v (1.0 = full scale), clamped to the code range;
 // NaN maps to 0. The rule is OpenImageIO's float → unsigned conversion (v·max + 0.5,
 // truncated), so our 8/16-bit output matches what `ocioconvert` writes for the same floats.
-std::uint8_t QuantizeUnorm8(float v);
-std::uint16_t QuantizeUnorm16(float v);
+// Inline: the display LUT quantizes three values per pixel.
+template <typename T>
+inline T QuantizeUnorm(float v) {
+    constexpr float kMax = float(std::numeric_limits<T>::max());
+    if (!(v > 0.0f)) return 0;  // also NaN
+    if (v >= 1.0f) return std::numeric_limits<T>::max();
+    return T(v * kMax + 0.5f);
+}
+inline std::uint8_t QuantizeUnorm8(float v) { return QuantizeUnorm<std::uint8_t>(v); }
+inline std::uint16_t QuantizeUnorm16(float v) { return QuantizeUnorm<std::uint16_t>(v); }
 
 // One (display, view) pair of an OpenColorIO config, applied on the CPU. The input space is
 // the config's scene_linear role (for configs/ocio/config.ocio: linear Rec.709 primaries,

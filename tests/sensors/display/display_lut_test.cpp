@@ -5,6 +5,9 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
+#include <opencv2/imgproc.hpp>
+#include <utility>
 
 #include "scene/core/rng.h"
 
@@ -44,6 +47,25 @@ TEST(DisplayLut, WithinAFewCodeValuesOfTheExactTransform) {
     // Exposure scales the input exactly as for the exact transform.
     const std::vector<uint8_t> a2 = exact.ToDisplay8(img, 0.25f), b2 = lut.ToDisplay8(img, 0.25f);
     for (size_t k = 0; k < a2.size(); ++k) EXPECT_LE(std::abs(int(a2[k]) - int(b2[k])), 6) << k;
+}
+
+// The preview's 2× downscale is OpenCV's INTER_AREA bit for bit (the preview was made with
+// cv::resize before): random values over 40 octaves, the default preview size and an odd one.
+TEST(DisplayLut, HalveRgbEqualsOpenCvAreaResize) {
+    for (const auto& [w, h] : {std::pair{320, 240}, std::pair{17, 5}}) {
+        Image src(2 * w, 2 * h, 3), ours(w, h, 3), theirs(w, h, 3);
+        for (size_t i = 0; i < src.pixels.size(); ++i)
+            src.pixels[i] = float(std::exp2(-20.0 + 40.0 * scene::Uniform01(3, 0, i)));
+        HalveRgb(src, ours);
+        const cv::Mat in(src.height, src.width, CV_32FC3, src.pixels.data());
+        cv::Mat out(h, w, CV_32FC3, theirs.pixels.data());
+        cv::resize(in, out, out.size(), 0, 0, cv::INTER_AREA);
+        ASSERT_EQ(out.data, reinterpret_cast<uchar*>(theirs.pixels.data()));
+        size_t differ = 0;
+        for (size_t i = 0; i < ours.pixels.size(); ++i)
+            differ += std::memcmp(&ours.pixels[i], &theirs.pixels[i], sizeof(float)) != 0;
+        EXPECT_EQ(differ, 0u) << w << "x" << h;
+    }
 }
 
 }  // namespace
