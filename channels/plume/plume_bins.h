@@ -54,6 +54,8 @@ class PlumeScreenBins {
     // Per-puff optical-depth tolerance ε.
     float PuffTolerance() const { return puffTolerance_; }
     size_t KeptPuffs() const { return kept_.size(); }
+    // The field's index of the puff at kept position k (a list's index entries).
+    uint32_t FieldIndex(uint32_t k) const { return kept_[k]; }
     size_t BinEntries() const { return tileEntries_.size(); }
 
     // The puffs whose rectangles overlap the pixel rectangle [x0, x1) × [y0, y1) (at most 2 × 2
@@ -133,12 +135,26 @@ class PlumeScreenBins {
     };
     std::vector<float> data_[kFields];
     std::vector<uint32_t> kept_;
-    std::vector<Rect> rect_;
-    std::vector<float> far_, sigmaPixels_, tauMax_;
+    // What list building reads of a kept puff, in one record: its screen rectangle; the
+    // ellipse of its cutoff ellipsoid on the screen, (p − centre)ᵀ Q (p − centre) ≤ 1 in pixel
+    // coordinates (p = (px + ½, py + ½) the centre of pixel (px, py)), with √λmax(Q) (all zero
+    // where the rectangle alone decides: the ellipsoid reaches behind the near plane); the
+    // nearest and farthest range; σ in pixels at its distance; its largest optical depth.
+    struct Footprint {
+        Rect rect;
+        float centreX, centreY, qxx, qxy, qyy, sqrtLambdaMax;
+        float near_m, far_m, sigmaPixels, tauMax;
+    };
+    std::vector<Footprint> footprint_;
+    // Whether fp's ellipse can reach a pixel of [x0, x1) × [y0, y1) (conservative; rho: the
+    // rectangle's half diagonal, HalfDiagonal in plume_bins.cpp).
+    static bool EllipseReaches(const Footprint& fp, int x0, int y0, int x1, int y1, float rho);
     uint32_t inert_ = 0;
-    // Starts out's list for the rectangle and adds puff k to it if its rectangle overlaps.
+    // Starts out's list for the rectangle and adds puff k to it if its rectangle overlaps and
+    // its ellipse can reach (rho as for EllipseReaches).
     static void Begin(List& out);
-    void Take(uint32_t k, int x0, int y0, int x1, int y1, float smallPixels, List& out) const;
+    void Take(uint32_t k, int x0, int y0, int x1, int y1, float rho, float smallPixels,
+              List& out) const;
     void Finish(bool copy, List& out) const;
     bool wide_ = false;
     struct Accumulators;  // one trace's sums (plume_bins.cpp)
