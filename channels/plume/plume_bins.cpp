@@ -72,8 +72,6 @@ PlumeScreenBins::PlumeScreenBins(const scene::PlumeField& field, const ChannelCa
     tilesY_ = (height_ + kTile - 1) / kTile;
     const scene::PlumeField::PuffArrays puffs = field.Puffs();
     const size_t n = puffs.x.size();
-    puffTolerance_ = tolerance / float(std::max<size_t>(n, 1));
-    const double eps = puffTolerance_;
 
     const glm::dmat3 cameraFromWorld = glm::transpose(camera.worldFromCamera.worldFromBody);
     const glm::dvec3 eye = camera.worldFromCamera.position_m;
@@ -83,6 +81,63 @@ PlumeScreenBins::PlumeScreenBins(const scene::PlumeField& field, const ChannelCa
     const size_t b = size_t(band);
     const double sqrt2Pi = std::sqrt(2.0 * std::numbers::pi);
     const double halfSqrtPi = 0.5 * std::sqrt(std::numbers::pi);
+    const auto TauMax = [&](size_t i, double sh, double sz) {
+        // Line integral through the centre: peak √(2π/A), largest for A = 1/max(σ)².
+        return field.Optics(puffs.plume[i]).massExtinction_m2pkg[b] * double(puffs.peak_kgpm3[i]) *
+               sqrt2Pi * std::max(sh, sz);
+    };
+
+    // The tolerance is shared by the puffs that can reach the view. Every ray lies in the
+    // pyramid from the eye through the bin area, the intersection of five half-spaces
+    // nᵀ x ≥ 0 (x camera-frame, from the eye): in front of the eye and inside the four sides.
+    // Along any ray from the eye inside a half-space that the puff's centre lies outside of,
+    // at Mahalanobis distance m_H (= −nᵀx_c / √(nᵀ Σ n), Σ the puff's covariance), the
+    // squared Mahalanobis distance stays ≥ m_H², so the ray's optical depth is at most
+    // τ_max e^(−m_H²/2): the whole line's integral through its closest approach, at most
+    // τ_max e^(−m*²/2), if that lies on the ray (then m* ≥ m_H), else the tail beyond its
+    // start, ≤ (τ_max / 2) e^(−m(0)²/2) (the Gaussian tail bound ∫_a^∞ e^(−At²/2) dt ≤
+    // e^(−Aa²/2) √(π/2A)). A puff whose bound b over the five is at most 1e-3 tolerance / n
+    // is out of view: dropped, its b counted (in field order, in double precision); the rest
+    // of the tolerance is split among the n' others, ε = (tolerance − Σ b) / n'. So the
+    // out-of-view puffs add at most a thousandth of the tolerance and ε is about tolerance /
+    // n' instead of tolerance / n (the puffs behind the camera no longer count).
+    const double aMin = -tanH, aMax = (2.0 * width_ / W - 1.0) * tanH;
+    const double bMax = tanV, bMin = (1.0 - 2.0 * height_ / H) * tanV;
+    const glm::dvec3 sides[5] = {{0.0, 1.0, 0.0},
+                                 {1.0, -aMin, 0.0},
+                                 {-1.0, aMax, 0.0},
+                                 {0.0, bMax, -1.0},
+                                 {0.0, -bMin, 1.0}};
+    const double outOfView = 1e-3 * double(tolerance) / double(std::max<size_t>(n, 1));
+    std::vector<double> viewBound(n);
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t i = r.begin(); i != r.end(); ++i) {
+                const double sh = 1.0 / std::sqrt(double(puffs.invVarH[i]));
+                const double sz = 1.0 / std::sqrt(double(puffs.invVarZ[i]));
+                const glm::dvec3 xc =
+                    cameraFromWorld * (glm::dvec3(puffs.x[i], puffs.y[i], puffs.z[i]) - eye);
+                const glm::dvec3 var{sh * sh, sh * sh, sz * sz};
+                double mH = 0.0;
+                for (const glm::dvec3& side : sides) {
+                    // The side's normal in the world frame, where Σ is diagonal.
+                    const glm::dvec3 nw = glm::transpose(cameraFromWorld) * side;
+                    mH = std::max(mH, -glm::dot(side, xc) / std::sqrt(glm::dot(nw * nw, var)));
+                }
+                viewBound[i] = TauMax(i, sh, sz) * std::exp(-0.5 * mH * mH);
+            }
+        });
+    double outOfViewSum = 0.0;
+    size_t inView = 0;
+    for (size_t i = 0; i < n; ++i) {
+        if (viewBound[i] <= outOfView)
+            outOfViewSum += viewBound[i];
+        else
+            ++inView;
+    }
+    puffTolerance_ =
+        float((double(tolerance) - outOfViewSum) / double(std::max<size_t>(inView, 1)));
+    const double eps = puffTolerance_;
     // Each puff is projected on its own (in parallel, into its own slot), then the kept ones
     // are compacted in field order, so the bins are the same for any thread count.
     struct Projected {
@@ -92,12 +147,12 @@ PlumeScreenBins::PlumeScreenBins(const scene::PlumeField& field, const ChannelCa
     };
     std::vector<Projected> projected(n);
     const auto Project = [&](size_t i, Projected& out) {
+        if (viewBound[i] <= outOfView) return;
         const scene::ObscurantOptics& optics = field.Optics(puffs.plume[i]);
         const double alpha = optics.massExtinction_m2pkg[b];
         const double sh = 1.0 / std::sqrt(double(puffs.invVarH[i]));
         const double sz = 1.0 / std::sqrt(double(puffs.invVarZ[i]));
-        // Line integral through the centre: peak √(2π/A), largest for A = 1/max(σ)².
-        const double tauMax = alpha * double(puffs.peak_kgpm3[i]) * sqrt2Pi * std::max(sh, sz);
+        const double tauMax = TauMax(i, sh, sz);
         if (!(tauMax > eps)) return;
         const double r2 = 2.0 * std::log(tauMax / eps);
         const double r = std::sqrt(r2);

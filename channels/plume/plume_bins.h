@@ -30,19 +30,25 @@ struct BandTrace {
 inline constexpr float kPlumeTransmittanceTolerance = 1.0e-3f;
 
 // The puffs of a field projected through a camera (output pixels, ENU world). A puff whose
-// optical depth along any line stays at or below the per-puff tolerance ε = tolerance / (number
-// of puffs in the field) is dropped; any other puff i contributes at most ε to a ray that passes
-// outside its ellipsoid of Mahalanobis radius r_i, τ_max,i e^(−r_i²/2) = ε (τ_max,i its optical
-// depth through the centre along its longest axis; the part of any ray outside the ellipsoid
-// carries at most ε of it, because erfc x ≤ e^(−x²)). Each kept puff's ellipsoid bounds a box
-// whose screen rectangle (widened by a pixel; the whole screen if the box reaches behind the
-// near plane) is binned into kTile × kTile tiles. A ray through pixel (px, py) then loops only
-// over the puffs whose rectangles contain the pixel, and a puff whose box lies entirely beyond
-// the ray's end is skipped; everything skipped adds at most ε each, so the trace's optical depth
-// is within tolerance of the exact sum over all puffs and T within tolerance of e^(−τ_exact)
-// (|e^(−a) − e^(−b)| ≤ |a − b|), plus float rounding and the 1.5e-7 error of the erf
-// approximation. Pixel coordinates run over [0, width + kMargin) × [0, height + kMargin): the
-// extra columns and rows serve interpolation nodes beyond the far edges.
+// optical depth along every ray from the eye through the bin area is bounded by b ≤ 1e-3
+// tolerance / (number of puffs in the field) is out of view: dropped, b counted in Σb. The
+// others share the rest: one whose optical depth along any line stays at or below the
+// per-puff tolerance ε = (tolerance − Σb) / (number of puffs in view) is dropped; any other
+// puff i contributes at most ε to a ray that passes outside its ellipsoid of Mahalanobis
+// radius r_i, τ_max,i e^(−r_i²/2) = ε (τ_max,i its optical depth through the centre along its
+// longest axis; the part of any ray outside the ellipsoid carries at most ε of it, because
+// erfc x ≤ e^(−x²)). Each kept puff's ellipsoid bounds a box whose screen rectangle (the
+// ellipsoid's exact extent when it lies wholly in front of the eye, widened by a pixel; else
+// the box's; the whole screen if the box reaches behind the near plane) is binned into
+// kTile × kTile tiles; where the ellipsoid lies in front, the ellipse it projects to narrows
+// the lists further. A ray through pixel (px, py) then loops only over the puffs whose
+// footprints contain the pixel, and a puff whose box lies entirely beyond the ray's end is
+// skipped; everything skipped adds at most ε each (the out-of-view puffs Σb in all), so the
+// trace's optical depth is within tolerance of the exact sum over all puffs and T within
+// tolerance of e^(−τ_exact) (|e^(−a) − e^(−b)| ≤ |a − b|), plus float rounding and the 1.5e-7
+// error of the erf approximation. Pixel coordinates run over [0, width + kMargin) ×
+// [0, height + kMargin): the extra columns and rows serve interpolation nodes beyond the far
+// edges.
 class PlumeScreenBins {
   public:
     static constexpr int kTile = 32;   // pixels
@@ -51,7 +57,7 @@ class PlumeScreenBins {
     PlumeScreenBins(const scene::PlumeField& field, const ChannelCamera& camera,
                     scene::ObscurantBand band, float tolerance = kPlumeTransmittanceTolerance);
 
-    // Per-puff optical-depth tolerance ε.
+    // Per-puff optical-depth tolerance ε (the tolerance shared by the puffs in view).
     float PuffTolerance() const { return puffTolerance_; }
     size_t KeptPuffs() const { return kept_.size(); }
     // The field's index of the puff at kept position k (a list's index entries).

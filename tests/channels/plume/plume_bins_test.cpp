@@ -1,6 +1,7 @@
 // Tests of the screen-space puff bins: traces within the stated transmittance tolerance of the
 // exact sum over every puff (no cutoff, double-precision erf) for committed plumes and for a
-// thick flame puff, lists holding every puff whose cutoff ellipsoid their rays meet (and
+// thick flame puff and for a view of part of the plumes (whose puffs out of view no longer
+// share the tolerance), lists holding every puff whose cutoff ellipsoid their rays meet (and
 // little more), lists taken from larger lists (one rectangle or a row of them) equal to
 // lists from the tiles, eight-lane traces equal to four-lane ones, and the dropping of puffs
 // too thin to matter.
@@ -118,6 +119,22 @@ TEST(PlumeScreenBins, CommittedPlumesWithinToleranceOfTheExactSum) {
             }
         }
     }
+}
+
+// A narrow view of part of the plumes: the puffs out of view (bounded by their Mahalanobis
+// distance to the view's pyramid) no longer share the tolerance, so ε is larger than
+// tolerance / (puffs in the field), and traces stay within tolerance of the exact sum over
+// every puff, those out of view included.
+TEST(PlumeScreenBins, PuffsOutOfViewLeaveTheirToleranceToTheOthers) {
+    const scene::PlumeField field = CommittedPlumes();
+    const ChannelCamera cam = NorthCamera({0.0, 0.0, 20.0}, 64, 48, 8.0, 1.0);
+    const PlumeScreenBins bins(field, cam, ObscurantBand::Visible);
+    const double shared = double(kPlumeTransmittanceTolerance) / double(field.PuffCount());
+    EXPECT_GT(double(bins.PuffTolerance()), 1.5 * shared);
+    EXPECT_LT(bins.KeptPuffs(), field.PuffCount() / 2);
+    const Worst w = CompareWithExact(field, cam, ObscurantBand::Visible, kPlumeSkyRange_m);
+    EXPECT_LE(w.error, double(kPlumeTransmittanceTolerance));
+    EXPECT_GT(w.dark, 50) << w.dark;
 }
 
 // A cell's list taken from a larger rectangle's list is the list gathered from the tiles: the
