@@ -52,7 +52,13 @@ void FootprintEllipse(const glm::dmat3& cameraFromWorld, const glm::dvec3& q, do
     const double cx = -(pyy * gx - pxy * gy) / det, cy = -(pxx * gy - pxy * gx) / det;
     const double fc = L[2][2] + gx * cx + gy * cy;
     if (!(fc > 0.0)) return;
-    const double qxx = -pxx / fc, qxy = -pxy / fc, qyy = -pyy / fc;
+    // Q, shrunk (the ellipse widened) by more than its float rounding can change the form:
+    // |xᵀ ΔQ x| ≤ 2⁻²⁴ (√Q_xx |x| + √Q_yy |y|)² ≤ 2⁻²³ (Q_xx x² + Q_yy y²) ≤ 2⁻²³ xᵀ Q x / (1 − κ),
+    // κ = |Q_xy| / √(Q_xx Q_yy) < 1 (P is definite); 4× that plus 1e-6.
+    const double kappa = std::abs(pxy) / std::sqrt(pxx * pyy);
+    const double widen = 1.0 - 4.0 * 0x1p-23 / (1.0 - kappa) - 1e-6;
+    if (!(widen > 0.5)) return;
+    const double qxx = -pxx / fc * widen, qxy = -pxy / fc * widen, qyy = -pyy / fc * widen;
     const double halfTrace = 0.5 * (qxx + qyy);
     const double lambdaMax =
         halfTrace + std::sqrt(std::max(halfTrace * halfTrace - (qxx * qyy - qxy * qxy), 0.0));
@@ -109,6 +115,12 @@ PlumeScreenBins::PlumeScreenBins(const scene::PlumeField& field, const ChannelCa
                                  {0.0, bMax, -1.0},
                                  {0.0, -bMin, 1.0}};
     const double outOfView = 1e-3 * double(tolerance) / double(std::max<size_t>(n, 1));
+    // The sides' normals in the world frame, where Σ is diagonal: nᵀ Σ n = σh² h + σz² z.
+    double sideH[5], sideZ[5];
+    for (int j = 0; j < 5; ++j) {
+        const glm::dvec3 nw = glm::transpose(cameraFromWorld) * sides[j];
+        sideH[j] = nw.x * nw.x + nw.y * nw.y, sideZ[j] = nw.z * nw.z;
+    }
     std::vector<double> viewBound(n);
     tbb::parallel_for(
         tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& r) {
@@ -117,14 +129,15 @@ PlumeScreenBins::PlumeScreenBins(const scene::PlumeField& field, const ChannelCa
                 const double sz = 1.0 / std::sqrt(double(puffs.invVarZ[i]));
                 const glm::dvec3 xc =
                     cameraFromWorld * (glm::dvec3(puffs.x[i], puffs.y[i], puffs.z[i]) - eye);
-                const glm::dvec3 var{sh * sh, sh * sh, sz * sz};
                 double mH = 0.0;
-                for (const glm::dvec3& side : sides) {
-                    // The side's normal in the world frame, where Σ is diagonal.
-                    const glm::dvec3 nw = glm::transpose(cameraFromWorld) * side;
-                    mH = std::max(mH, -glm::dot(side, xc) / std::sqrt(glm::dot(nw * nw, var)));
+                for (int j = 0; j < 5; ++j) {
+                    const double out = -glm::dot(sides[j], xc);
+                    if (out > 0.0)
+                        mH = std::max(mH, out / std::sqrt(sh * sh * sideH[j] + sz * sz * sideZ[j]));
                 }
-                viewBound[i] = TauMax(i, sh, sz) * std::exp(-0.5 * mH * mH);
+                // (In view: any value above outOfView.)
+                viewBound[i] = mH > 0.0 ? TauMax(i, sh, sz) * std::exp(-0.5 * mH * mH)
+                                        : std::numeric_limits<double>::infinity();
             }
         });
     double outOfViewSum = 0.0;
@@ -303,24 +316,31 @@ void PlumeScreenBins::Begin(List& out) {
     out.halfSmallOpticalDepth = 0.0f;
 }
 
-// Whether the footprint ellipse can reach pixels [x0, x1) × [y0, y1), whose centres lie in
-// the square-cornered region [x0, x1] × [y0, y1] of pixel coordinates: that region lies in the
-// disc of radius ρ (its half diagonal) about its centre o, so if it meets the ellipse then
-// ‖Q^½ (o − centre)‖ ≤ 1 + ρ √λmax(Q) (the triangle inequality in the norm of Q^½). The
-// test keeps a margin for the float values of the footprint (a millionth of the form's
-// terms, a thousandth of a pixel), so it never drops a puff whose ellipse reaches a pixel.
-inline bool PlumeScreenBins::EllipseReaches(const Footprint& fp, int x0, int y0, int x1, int y1,
-                                            float rho) {
-    const float dx = 0.5f * float(x0 + x1) - fp.centreX, dy = 0.5f * float(y0 + y1) - fp.centreY;
-    const float xx = fp.qxx * dx * dx, xy = 2.0f * fp.qxy * dx * dy, yy = fp.qyy * dy * dy;
-    const float reach = 1.0f + rho * fp.sqrtLambdaMax;
-    // Float rounding: the form's few operations err by well under 1e-5 of its terms.
-    return xx + xy + yy - 1e-5f * (xx + std::abs(xy) + yy) <= reach * reach;
+// Where the footprint ellipse can reach pixels [x0, x1) × [y0, y1): their centres lie in the
+// square-cornered region [x0, x1] × [y0, y1] of pixel coordinates, inside the disc of radius
+// ρ (its half diagonal) about its centre o, so if one meets the ellipse then
+// ‖Q^½ (o − centre)‖ ≤ 1 + ρ √λmax(Q) (the triangle inequality in the norm of Q^½). For the
+// row of o (o_y = centreY) that is an interval of o_x, a quadratic inequality solved here
+// (false: none), so that a row of rectangles is tested with one root. The ellipse was widened
+// for the float rounding of Q (FootprintEllipse) and ρ for that of the centre, and the roots
+// in double precision err far less than that widening, so no puff whose ellipse reaches a
+// pixel is dropped.
+inline bool PlumeScreenBins::EllipseSpan(const Footprint& fp, float centreY, float rho, double& lo,
+                                         double& hi) {
+    const double dy = double(centreY) - double(fp.centreY);
+    const double reach = 1.0 + double(rho) * double(fp.sqrtLambdaMax);
+    // qxx dx² + 2 b dx + c ≤ 0.
+    const double a = fp.qxx, b = double(fp.qxy) * dy, c = double(fp.qyy) * dy * dy - reach * reach;
+    const double disc = b * b - a * c;
+    if (disc < 0.0) return false;
+    const double root = std::sqrt(disc);
+    lo = double(fp.centreX) + (-b - root) / a, hi = double(fp.centreX) + (-b + root) / a;
+    return true;
 }
 
 namespace {
 
-// EllipseReaches' ρ for a w × h rectangle: its half diagonal, plus a thousandth of a pixel for
+// EllipseSpan's ρ for a w × h rectangle: its half diagonal, plus a thousandth of a pixel for
 // the float centre (which errs by under 1e-4 pixel on screens below 4000 pixels).
 float HalfDiagonal(int w, int h) {
     return float(0.5 * std::sqrt(double(w) * double(w) + double(h) * double(h)) + 1e-3);
@@ -328,17 +348,29 @@ float HalfDiagonal(int w, int h) {
 
 }  // namespace
 
-inline void PlumeScreenBins::Take(uint32_t k, int x0, int y0, int x1, int y1, float rho,
-                                  float smallPixels, List& out) const {
+inline bool PlumeScreenBins::Reaches(uint32_t k, int x0, int y0, int x1, int y1, float rho) const {
     const Footprint& fp = footprint_[k];
     const Rect& r = fp.rect;
-    if (r.x1 <= x0 || r.x0 >= x1 || r.y1 <= y0 || r.y0 >= y1) return;
-    if (fp.sqrtLambdaMax != 0.0f && !EllipseReaches(fp, x0, y0, x1, y1, rho)) return;
+    if (r.x1 <= x0 || r.x0 >= x1 || r.y1 <= y0 || r.y0 >= y1) return false;
+    if (fp.sqrtLambdaMax == 0.0f) return true;
+    double lo, hi;
+    if (!EllipseSpan(fp, 0.5f * float(y0 + y1), rho, lo, hi)) return false;
+    const double cx = 0.5 * double(x0 + x1);
+    return cx >= lo && cx <= hi;
+}
+
+inline void PlumeScreenBins::Add(uint32_t k, float smallPixels, List& out) const {
+    const Footprint& fp = footprint_[k];
     out.index.push_back(k);
     out.near_m = std::min(out.near_m, fp.near_m);
     out.far_m = std::max(out.far_m, fp.far_m);
     if (fp.sigmaPixels < smallPixels) out.smallOpticalDepth += fp.tauMax;
     if (fp.sigmaPixels < 0.5f * smallPixels) out.halfSmallOpticalDepth += fp.tauMax;
+}
+
+inline void PlumeScreenBins::Take(uint32_t k, int x0, int y0, int x1, int y1, float rho,
+                                  float smallPixels, List& out) const {
+    if (Reaches(k, x0, y0, x1, y1, rho)) Add(k, smallPixels, out);
 }
 
 void PlumeScreenBins::Finish(bool copy, List& out) const {
@@ -411,20 +443,32 @@ void PlumeScreenBins::GatherRow(const List& from, int x0, int y0, int y1, int st
     const auto Right = [&](int c) { return std::min(x0 + c * step + width, width_); };
     if (y0 < y1 && cells > 0) {
         const float rho = HalfDiagonal(width, y1 - y0);
+        const float centreY = 0.5f * float(y0 + y1);
         for (size_t j = 0; j < from.count; ++j) {
             const uint32_t k = from.index[j];
-            const Rect& r = footprint_[k].rect;
+            const Footprint& fp = footprint_[k];
+            const Rect& r = fp.rect;
             if (r.y1 <= y0 || r.y0 >= y1) continue;
+            // The ellipse's span for the row's full-width rectangles, as Reaches finds it.
+            double spanLo = -std::numeric_limits<double>::infinity();
+            double spanHi = std::numeric_limits<double>::infinity();
+            if (fp.sqrtLambdaMax != 0.0f && !EllipseSpan(fp, centreY, rho, spanLo, spanHi))
+                continue;
             // The rectangles c with x0 + c·step < r.x1 and x0 + c·step + width > r.x0, widened
-            // by one on each side (Take decides exactly).
+            // by one on each side (the tests below decide exactly).
             const int lo = std::max((r.x0 - x0 - width) / step - 1, 0);
             const int hi = std::min((r.x1 - x0) / step + 1, cells - 1);
             for (int c = lo; c <= hi; ++c) {
                 const int cx0 = x0 + c * step, cx1 = Right(c);
-                if (cx0 < cx1)
-                    Take(k, cx0, y0, cx1, y1,
-                         cx1 - cx0 == width ? rho : HalfDiagonal(cx1 - cx0, y1 - y0), smallPixels,
+                if (cx0 >= cx1 || r.x1 <= cx0 || r.x0 >= cx1) continue;
+                if (cx1 - cx0 != width) {
+                    // Clipped at the bin area's edge: its own ρ.
+                    Take(k, cx0, y0, cx1, y1, HalfDiagonal(cx1 - cx0, y1 - y0), smallPixels,
                          out[size_t(c)]);
+                    continue;
+                }
+                const double cx = 0.5 * double(cx0 + cx1);
+                if (cx >= spanLo && cx <= spanHi) Add(k, smallPixels, out[size_t(c)]);
             }
         }
     }
@@ -729,7 +773,8 @@ void PlumeScreenBins::Trace2Impl(const List& l, const glm::vec3& dir, float rang
     const F4 end = _mm_set1_ps(std::max(range_m, range2_m));
     const F4 r1 = _mm_set1_ps(range_m), r2 = _mm_set1_ps(range2_m);
     const F4 zero = _mm_setzero_ps(), half = _mm_set1_ps(0.5f);
-    for (; k < l.index.size(); k += 4) {
+    // One group of four puffs from k on, into a1 (and a2).
+    const auto group = [&](size_t k, BandAccumulator& a1, BandAccumulator& a2) {
         const F4 qx = load(kQx, k), qy = load(kQy, k), qz = load(kQz, k);
         const F4 ivh = load(kIvh, k), ivz = load(kIvz, k);
         const F4 A = _mm_add_ps(_mm_mul_ps(dh2, ivh), _mm_mul_ps(dz2, ivz));
@@ -746,7 +791,7 @@ void PlumeScreenBins::Trace2Impl(const List& l, const glm::vec3& dir, float rang
                        _mm_mul_ps(_mm_mul_ps(rz, rz), ivz));
         const F4 use =
             _mm_and_ps(_mm_cmple_ps(m2, load(kCutoff2, k)), _mm_cmplt_ps(load(kNear, k), end));
-        if (_mm_movemask_ps(use) == 0) continue;
+        if (_mm_movemask_ps(use) == 0) return;
         const F4 scale = _mm_sqrt_ps(_mm_mul_ps(half, A));
         const F4 u0 = _mm_sub_ps(zero, _mm_mul_ps(sStar, scale));
         const F4 amplitude = _mm_div_ps(
@@ -755,15 +800,23 @@ void PlumeScreenBins::Trace2Impl(const List& l, const glm::vec3& dir, float rang
         const F4 e0 = ErfOrSign4(u0), e1 = ErfOrSign4(u1);
         const F4 w[5] = {load(kWs, k), load(kWAbsT, k), load(kWHot, k), load(kWHotT, k),
                          load(kWg, k)};
-        const size_t odd = (k / 4) % 2;
         const F4 tau1 = _mm_mul_ps(amplitude, _mm_sub_ps(e1, e0));
-        acc.first[odd].Add(w, _mm_and_ps(_mm_and_ps(use, _mm_cmpgt_ps(tau1, zero)), tau1));
+        a1.Add(w, _mm_and_ps(_mm_and_ps(use, _mm_cmpgt_ps(tau1, zero)), tau1));
         if constexpr (Two) {
             const F4 e2 = ErfOrSign4(_mm_add_ps(u0, _mm_mul_ps(r2, scale)));
             const F4 tau2 = _mm_mul_ps(amplitude, _mm_sub_ps(e2, e0));
-            acc.second[odd].Add(w, _mm_and_ps(_mm_and_ps(use, _mm_cmpgt_ps(tau2, zero)), tau2));
+            a2.Add(w, _mm_and_ps(_mm_and_ps(use, _mm_cmpgt_ps(tau2, zero)), tau2));
         }
+    };
+    // The even groups into the first accumulators, the odd ones into the second (k is a
+    // multiple of 8 here).
+    BandAccumulator even1 = acc.first[0], even2 = acc.second[0];
+    BandAccumulator odd1 = acc.first[1], odd2 = acc.second[1];
+    for (; k < l.index.size(); k += 8) {
+        group(k, even1, even2);
+        if (k + 4 < l.index.size()) group(k + 4, odd1, odd2);
     }
+    acc.first[0] = even1, acc.second[0] = even2, acc.first[1] = odd1, acc.second[1] = odd2;
     first = Result(acc.first[0], acc.first[1]);
     second = Two ? Result(acc.second[0], acc.second[1]) : first;
 }

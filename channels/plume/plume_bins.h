@@ -152,12 +152,16 @@ class PlumeScreenBins {
         float near_m, far_m, sigmaPixels, tauMax;
     };
     std::vector<Footprint> footprint_;
-    // Whether fp's ellipse can reach a pixel of [x0, x1) × [y0, y1) (conservative; rho: the
-    // rectangle's half diagonal, HalfDiagonal in plume_bins.cpp).
-    static bool EllipseReaches(const Footprint& fp, int x0, int y0, int x1, int y1, float rho);
+    // The centres o_x of the rectangles of half diagonal rho in the row of centre centreY that
+    // fp's ellipse can reach: [lo, hi] (conservative), or none (false).
+    static bool EllipseSpan(const Footprint& fp, float centreY, float rho, double& lo, double& hi);
+    // Whether puff k's rectangle overlaps [x0, x1) × [y0, y1) and its ellipse can reach it
+    // (rho: the rectangle's half diagonal, HalfDiagonal in plume_bins.cpp); Add puts it in a
+    // list.
+    bool Reaches(uint32_t k, int x0, int y0, int x1, int y1, float rho) const;
+    void Add(uint32_t k, float smallPixels, List& out) const;
     uint32_t inert_ = 0;
-    // Starts out's list for the rectangle and adds puff k to it if its rectangle overlaps and
-    // its ellipse can reach (rho as for EllipseReaches).
+    // Starts out's list for the rectangle and adds puff k to it if it Reaches the rectangle.
     static void Begin(List& out);
     void Take(uint32_t k, int x0, int y0, int x1, int y1, float rho, float smallPixels,
               List& out) const;
