@@ -528,9 +528,16 @@ inline float Sum4(F4 v) {
 }
 
 struct BandAccumulator {
-    F4 extinction = _mm_setzero_ps(), scattering = _mm_setzero_ps(), absorption = _mm_setzero_ps(),
-       absorptionT = _mm_setzero_ps(), hotAbsorption = _mm_setzero_ps(),
-       hotAbsorptionT = _mm_setzero_ps(), scatteringG = _mm_setzero_ps();
+    F4 extinction, scattering, absorption, absorptionT, hotAbsorption, hotAbsorptionT, scatteringG;
+
+    BandAccumulator() {
+        extinction = scattering = absorption = absorptionT = hotAbsorption = hotAbsorptionT =
+            scatteringG = _mm_setzero_ps();
+    }
+    // Left unset, for sums that are written before they are read (zeroing the trace's four
+    // accumulators in memory cost as much as a group of puffs).
+    struct Unset {};
+    explicit BandAccumulator(Unset) {}
 
     // Weights w[0..4]: scattering, absorption × T, hot absorption, hot absorption × T,
     // scattering × g per unit optical depth.
@@ -672,7 +679,10 @@ struct BandAccumulator8 {
 // Per range, the sums of the even groups of four puffs of the list (k = 0, 8, 16, …) and of
 // the odd ones (k = 4, 12, …), so that eight lanes add one group of eight at a time.
 struct PlumeScreenBins::Accumulators {
-    BandAccumulator first[2], second[2];
+    BandAccumulator first[2]{BandAccumulator(BandAccumulator::Unset{}),
+                             BandAccumulator(BandAccumulator::Unset{})};
+    BandAccumulator second[2]{BandAccumulator(BandAccumulator::Unset{}),
+                              BandAccumulator(BandAccumulator::Unset{})};
 };
 
 void PlumeScreenBins::UseWideTraces(bool on) {
@@ -735,7 +745,7 @@ __attribute__((target("avx2"))) size_t PlumeScreenBins::TraceWide(const List& l,
         }
     }
     first.Split(acc.first[0], acc.first[1]);
-    if constexpr (Two) second.Split(acc.second[0], acc.second[1]);
+    second.Split(acc.second[0], acc.second[1]);
     return k;
 }
 #endif
@@ -763,10 +773,15 @@ void PlumeScreenBins::Trace2Impl(const List& l, const glm::vec3& dir, float rang
     const auto load = [&](int f, size_t k) {
         return Load4<Copied>(l.data[f], data_[f].data(), l.index.data(), k);
     };
-    Accumulators acc;
+    // The sums, zero unless the eight-lane loop set them.
+    BandAccumulator even1, even2, odd1, odd2;
     size_t k = 0;
 #ifdef SEASENSE_PLUME_WIDE
-    if (wide_) k = TraceWide<Copied, Two>(l, dir, range_m, range2_m, acc);
+    if (wide_) {
+        Accumulators acc;
+        k = TraceWide<Copied, Two>(l, dir, range_m, range2_m, acc);
+        even1 = acc.first[0], even2 = acc.second[0], odd1 = acc.first[1], odd2 = acc.second[1];
+    }
 #endif
     const F4 dx = _mm_set1_ps(dir.x), dy = _mm_set1_ps(dir.y), dz = _mm_set1_ps(dir.z);
     const F4 dh2 = _mm_set1_ps(dir.x * dir.x + dir.y * dir.y), dz2 = _mm_set1_ps(dir.z * dir.z);
@@ -774,7 +789,8 @@ void PlumeScreenBins::Trace2Impl(const List& l, const glm::vec3& dir, float rang
     const F4 r1 = _mm_set1_ps(range_m), r2 = _mm_set1_ps(range2_m);
     const F4 zero = _mm_setzero_ps(), half = _mm_set1_ps(0.5f);
     // One group of four puffs from k on, into a1 (and a2).
-    const auto group = [&](size_t k, BandAccumulator& a1, BandAccumulator& a2) {
+    const auto group = [&](size_t k, BandAccumulator & a1, BandAccumulator & a2)
+        __attribute__((always_inline)) {
         const F4 qx = load(kQx, k), qy = load(kQy, k), qz = load(kQz, k);
         const F4 ivh = load(kIvh, k), ivz = load(kIvz, k);
         const F4 A = _mm_add_ps(_mm_mul_ps(dh2, ivh), _mm_mul_ps(dz2, ivz));
@@ -810,15 +826,12 @@ void PlumeScreenBins::Trace2Impl(const List& l, const glm::vec3& dir, float rang
     };
     // The even groups into the first accumulators, the odd ones into the second (k is a
     // multiple of 8 here).
-    BandAccumulator even1 = acc.first[0], even2 = acc.second[0];
-    BandAccumulator odd1 = acc.first[1], odd2 = acc.second[1];
     for (; k < l.index.size(); k += 8) {
         group(k, even1, even2);
         if (k + 4 < l.index.size()) group(k + 4, odd1, odd2);
     }
-    acc.first[0] = even1, acc.second[0] = even2, acc.first[1] = odd1, acc.second[1] = odd2;
-    first = Result(acc.first[0], acc.first[1]);
-    second = Two ? Result(acc.second[0], acc.second[1]) : first;
+    first = Result(even1, odd1);
+    second = Two ? Result(even2, odd2) : first;
 }
 
 BandTrace PlumeScreenBins::Trace(const List& list, const glm::vec3& dir, float range_m) const {
