@@ -534,11 +534,6 @@ struct BandAccumulator {
         extinction = scattering = absorption = absorptionT = hotAbsorption = hotAbsorptionT =
             scatteringG = _mm_setzero_ps();
     }
-    // Left unset, for sums that are written before they are read (zeroing the trace's four
-    // accumulators in memory cost as much as a group of puffs).
-    struct Unset {};
-    explicit BandAccumulator(Unset) {}
-
     // Weights w[0..4]: scattering, absorption × T, hot absorption, hot absorption × T,
     // scattering × g per unit optical depth.
     void Add(const F4 (&w)[5], F4 tau) {
@@ -602,13 +597,15 @@ __attribute__((target("avx2"))) inline F8 Exp8(F8 x) {
     return _mm256_mul_ps(p, scale);
 }
 
-// ErfOrSign4 on eight lanes (Erf4's operations lane for lane; the shortcut when all eight
-// saturate gives what Erf4 gives there, ±1).
-__attribute__((target("avx2"))) inline F8 ErfOrSign8(F8 x) {
+// ErfOrSign4 on eight lanes (Erf4's operations lane for lane; the shortcut, taken when every
+// lane that is used saturates, gives what Erf4 gives there, ±1; the unused lanes' values are
+// discarded).
+__attribute__((target("avx2"))) inline F8 ErfOrSign8(F8 x, F8 use) {
     const F8 sign = _mm256_and_ps(x, _mm256_set1_ps(-0.0f));
     const F8 ax = _mm256_andnot_ps(_mm256_set1_ps(-0.0f), x);
     const F8 saturated = _mm256_cmp_ps(ax, _mm256_set1_ps(3.9f), _CMP_GE_OS);
-    if (_mm256_movemask_ps(saturated) == 0xFF) return _mm256_or_ps(_mm256_set1_ps(1.0f), sign);
+    if ((_mm256_movemask_ps(saturated) | (~_mm256_movemask_ps(use) & 0xFF)) == 0xFF)
+        return _mm256_or_ps(_mm256_set1_ps(1.0f), sign);
     const F8 t = _mm256_div_ps(
         _mm256_set1_ps(1.0f),
         _mm256_add_ps(_mm256_set1_ps(1.0f), _mm256_mul_ps(_mm256_set1_ps(0.3275911f), ax)));
@@ -676,15 +673,6 @@ struct BandAccumulator8 {
 
 }  // namespace
 
-// Per range, the sums of the even groups of four puffs of the list (k = 0, 8, 16, …) and of
-// the odd ones (k = 4, 12, …), so that eight lanes add one group of eight at a time.
-struct PlumeScreenBins::Accumulators {
-    BandAccumulator first[2]{BandAccumulator(BandAccumulator::Unset{}),
-                             BandAccumulator(BandAccumulator::Unset{})};
-    BandAccumulator second[2]{BandAccumulator(BandAccumulator::Unset{}),
-                              BandAccumulator(BandAccumulator::Unset{})};
-};
-
 void PlumeScreenBins::UseWideTraces(bool on) {
 #ifdef SEASENSE_PLUME_WIDE
     wide_ = on && __builtin_cpu_supports("avx2");
@@ -698,13 +686,10 @@ void PlumeScreenBins::UseWideTraces(bool on) {
 // Trace2Impl's loop body on eight lanes, into the even and odd groups' sums, as the four-lane
 // loop adds them.
 template <bool Copied, bool Two>
-__attribute__((target("avx2"))) size_t PlumeScreenBins::TraceWide(const List& l,
-                                                                  const glm::vec3& dir,
-                                                                  float range_m, float range2_m,
-                                                                  Accumulators& acc) const {
-    const auto load = [&](int f, size_t k) __attribute__((target("avx2"))) {
-        return Load8<Copied>(l.data[f], data_[f].data(), l.index.data(), k);
-    };
+__attribute__((target("avx2"))) void PlumeScreenBins::TraceWide(const List& l, const glm::vec3& dir,
+                                                                float range_m, float range2_m,
+                                                                BandTrace& out1,
+                                                                BandTrace& out2) const {
     const F8 dx = _mm256_set1_ps(dir.x), dy = _mm256_set1_ps(dir.y), dz = _mm256_set1_ps(dir.z);
     const F8 dh2 = _mm256_set1_ps(dir.x * dir.x + dir.y * dir.y);
     const F8 dz2 = _mm256_set1_ps(dir.z * dir.z);
@@ -712,10 +697,10 @@ __attribute__((target("avx2"))) size_t PlumeScreenBins::TraceWide(const List& l,
     const F8 r1 = _mm256_set1_ps(range_m), r2 = _mm256_set1_ps(range2_m);
     const F8 zero = _mm256_setzero_ps(), half = _mm256_set1_ps(0.5f);
     BandAccumulator8 first, second;
-    size_t k = 0;
-    for (; k + 8 <= l.index.size(); k += 8) {
-        const F8 qx = load(kQx, k), qy = load(kQy, k), qz = load(kQz, k);
-        const F8 ivh = load(kIvh, k), ivz = load(kIvz, k);
+    // Eight puffs, their fields given by load(field).
+    const auto eight = [&](const auto& load) __attribute__((target("avx2"), always_inline)) {
+        const F8 qx = load(kQx), qy = load(kQy), qz = load(kQz);
+        const F8 ivh = load(kIvh), ivz = load(kIvz);
         const F8 A = _mm256_add_ps(_mm256_mul_ps(dh2, ivh), _mm256_mul_ps(dz2, ivz));
         const F8 B = _mm256_add_ps(
             _mm256_mul_ps(_mm256_add_ps(_mm256_mul_ps(dx, qx), _mm256_mul_ps(dy, qy)), ivh),
@@ -727,26 +712,44 @@ __attribute__((target("avx2"))) size_t PlumeScreenBins::TraceWide(const List& l,
         const F8 m2 = _mm256_add_ps(
             _mm256_mul_ps(_mm256_add_ps(_mm256_mul_ps(rx, rx), _mm256_mul_ps(ry, ry)), ivh),
             _mm256_mul_ps(_mm256_mul_ps(rz, rz), ivz));
-        const F8 use = _mm256_and_ps(_mm256_cmp_ps(m2, load(kCutoff2, k), _CMP_LE_OS),
-                                     _mm256_cmp_ps(load(kNear, k), end, _CMP_LT_OS));
-        if (_mm256_movemask_ps(use) == 0) continue;
+        const F8 use = _mm256_and_ps(_mm256_cmp_ps(m2, load(kCutoff2), _CMP_LE_OS),
+                                     _mm256_cmp_ps(load(kNear), end, _CMP_LT_OS));
+        if (_mm256_movemask_ps(use) == 0) return;
         const F8 scale = _mm256_sqrt_ps(_mm256_mul_ps(half, A));
         const F8 u0 = _mm256_sub_ps(zero, _mm256_mul_ps(sStar, scale));
         const F8 amplitude = _mm256_div_ps(
-            _mm256_mul_ps(load(kKappa, k), Exp8(_mm256_mul_ps(_mm256_set1_ps(-0.5f), m2))), scale);
-        const F8 e0 = ErfOrSign8(u0);
-        const F8 e1 = ErfOrSign8(_mm256_add_ps(u0, _mm256_mul_ps(r1, scale)));
-        const F8 w[5] = {load(kWs, k), load(kWAbsT, k), load(kWHot, k), load(kWHotT, k),
-                         load(kWg, k)};
+            _mm256_mul_ps(load(kKappa), Exp8(_mm256_mul_ps(_mm256_set1_ps(-0.5f), m2))), scale);
+        const F8 e0 = ErfOrSign8(u0, use);
+        const F8 e1 = ErfOrSign8(_mm256_add_ps(u0, _mm256_mul_ps(r1, scale)), use);
+        const F8 w[5] = {load(kWs), load(kWAbsT), load(kWHot), load(kWHotT), load(kWg)};
         first.Add(w, use, _mm256_mul_ps(amplitude, _mm256_sub_ps(e1, e0)));
         if constexpr (Two) {
-            const F8 e2 = ErfOrSign8(_mm256_add_ps(u0, _mm256_mul_ps(r2, scale)));
+            const F8 e2 = ErfOrSign8(_mm256_add_ps(u0, _mm256_mul_ps(r2, scale)), use);
             second.Add(w, use, _mm256_mul_ps(amplitude, _mm256_sub_ps(e2, e0)));
         }
+    };
+    size_t k = 0;
+    for (; k + 8 <= l.index.size(); k += 8)
+        eight([&](int f) __attribute__((target("avx2"))) {
+            return Load8<Copied>(l.data[f], data_[f].data(), l.index.data(), k);
+        });
+    // A last group of four (lists hold a multiple of four): in the low lanes, the inert puff
+    // in the high ones (unused, so they add zeros to the odd groups' sums).
+    if (k < l.index.size())
+        eight([&](int f) __attribute__((target("avx2"))) {
+            return _mm256_insertf128_ps(_mm256_castps128_ps256(Load4<Copied>(
+                                            l.data[f], data_[f].data(), l.index.data(), k)),
+                                        _mm_set1_ps(data_[f][inert_]), 1);
+        });
+    BandAccumulator lo, hi;
+    first.Split(lo, hi);
+    out1 = Result(lo, hi);
+    if constexpr (Two) {
+        second.Split(lo, hi);
+        out2 = Result(lo, hi);
+    } else {
+        out2 = out1;
     }
-    first.Split(acc.first[0], acc.first[1]);
-    second.Split(acc.second[0], acc.second[1]);
-    return k;
 }
 #endif
 
@@ -773,16 +776,15 @@ void PlumeScreenBins::Trace2Impl(const List& l, const glm::vec3& dir, float rang
     const auto load = [&](int f, size_t k) {
         return Load4<Copied>(l.data[f], data_[f].data(), l.index.data(), k);
     };
-    // The sums, zero unless the eight-lane loop set them.
-    BandAccumulator even1, even2, odd1, odd2;
-    size_t k = 0;
 #ifdef SEASENSE_PLUME_WIDE
     if (wide_) {
-        Accumulators acc;
-        k = TraceWide<Copied, Two>(l, dir, range_m, range2_m, acc);
-        even1 = acc.first[0], even2 = acc.second[0], odd1 = acc.first[1], odd2 = acc.second[1];
+        TraceWide<Copied, Two>(l, dir, range_m, range2_m, first, second);
+        return;
     }
 #endif
+    // The even groups' sums and the odd groups'.
+    BandAccumulator even1, even2, odd1, odd2;
+    size_t k = 0;
     const F4 dx = _mm_set1_ps(dir.x), dy = _mm_set1_ps(dir.y), dz = _mm_set1_ps(dir.z);
     const F4 dh2 = _mm_set1_ps(dir.x * dir.x + dir.y * dir.y), dz2 = _mm_set1_ps(dir.z * dir.z);
     const F4 end = _mm_set1_ps(std::max(range_m, range2_m));

@@ -167,12 +167,11 @@ class PlumeScreenBins {
               List& out) const;
     void Finish(bool copy, List& out) const;
     bool wide_ = false;
-    struct Accumulators;  // one trace's sums (plume_bins.cpp)
-    // Eight puffs at a time from the start of the list while eight remain; returns where the
-    // four-lane loop goes on.
+    // Trace2Impl where the CPU has AVX2: eight puffs at a time (a last four with the inert
+    // puff), summed as the four-lane loop sums them.
     template <bool Copied, bool Two>
-    size_t TraceWide(const List& list, const glm::vec3& dir, float range_m, float range2_m,
-                     Accumulators& acc) const;
+    void TraceWide(const List& list, const glm::vec3& dir, float range_m, float range2_m,
+                   BandTrace& first, BandTrace& second) const;
     // Two: the second range differs from the first (a separate loop without it keeps the
     // accumulators of one trace in registers).
     template <bool Copied, bool Two>
