@@ -405,6 +405,16 @@ void PlumeScreenBins::Gather(int x0, int y0, int x1, int y1, float smallPixels, 
         if (lists == 1) {
             for (const uint32_t* p = cur[0]; p != end[0]; ++p)
                 Take(*p, x0, y0, x1, y1, rho, smallPixels, out);
+        } else if (lists == 2) {
+            // Two tiles (a tile strip's usual case): a plain merge.
+            const uint32_t *a = cur[0], *b = cur[1];
+            while (a != end[0] && b != end[1]) {
+                const uint32_t k = std::min(*a, *b);
+                a += *a == k, b += *b == k;
+                Take(k, x0, y0, x1, y1, rho, smallPixels, out);
+            }
+            for (; a != end[0]; ++a) Take(*a, x0, y0, x1, y1, rho, smallPixels, out);
+            for (; b != end[1]; ++b) Take(*b, x0, y0, x1, y1, rho, smallPixels, out);
         } else {
             for (;;) {
                 uint32_t k = std::numeric_limits<uint32_t>::max();
