@@ -64,12 +64,15 @@ class PlumeScreenBins {
     uint32_t FieldIndex(uint32_t k) const { return kept_[k]; }
     size_t BinEntries() const { return tileEntries_.size(); }
 
-    // The puffs whose rectangles overlap the pixel rectangle [x0, x1) × [y0, y1) (at most 2 × 2
-    // tiles), in field order, padded with an inert puff to a multiple of 4; with the nearest
-    // and farthest range (m) where they can matter and the sum of the largest optical depths
-    // (through the centre along the longest axis) of those with σ under smallPixels pixels at
-    // their distance (and of those under half that). With copy, their data is also gathered into
-    // contiguous arrays (worth it when the list serves many rays).
+    // The puffs whose footprints reach the pixel rectangle [x0, x1) × [y0, y1) (at most 2 × 2
+    // tiles): their rectangles overlap it and, for those with a screen ellipse, the ellipse
+    // widened by the rectangle's half diagonal reaches its centre (so every puff whose cutoff
+    // ellipsoid a ray through one of its pixels meets is there), in field order, padded with an
+    // inert puff to a multiple of 4; with the nearest and farthest range (m) where they can matter
+    // and the sum of the largest optical depths (through the centre along the longest axis) of
+    // those with σ under smallPixels pixels at their distance (and of those under half that). With
+    // copy, their data is also gathered into contiguous arrays (worth it when the list serves many
+    // rays).
     struct List {
         size_t count = 0;  // puffs (index and the arrays hold count rounded up to 4)
         float near_m = 0.0f, far_m = 0.0f;
