@@ -15,6 +15,59 @@
 
 namespace seasense::channels {
 
+namespace {
+
+// The screen ellipse of a puff's cutoff ellipsoid wholly in front of the eye: the pixel
+// coordinates p = (x, y) whose rays meet the ellipsoid of Mahalanobis radius² r2, as
+// {p : (p − centre)ᵀ Q (p − centre) ≤ 1}; out = centre x, y, Q_xx, Q_xy, Q_yy, √λmax(Q), or
+// zeros when the conic is not a proper ellipse (then only the rectangle decides). q: eye −
+// centre (world); camera frame x right, y forward, z up; pixel x = (a / tanH + 1) W / 2,
+// y = (1 − b / tanV) H / 2 for the camera-frame direction (a, 1, b).
+// Along the ray eye + s·d the squared Mahalanobis distance to the centre is smallest,
+// m² = C − B²/A, at s = −B/A (A = dᵀMd, B = dᵀMq, C = qᵀMq, M = diag(σh⁻², σh⁻², σz⁻²)); so
+// the ray meets the ellipsoid iff B² − (C − r2) A ≥ 0, a quadratic form dᵀ K d in d, and in
+// the pixel coordinates, d = T (x, y, 1), a quadratic f(p) = pᵀ P p + 2 gᵀ p + h ≥ 0 (the
+// projected quadric's conic, Hartley & Zisserman, "Multiple View Geometry" (2004) §8.3),
+// with centre −P⁻¹ g, f(centre) = h + gᵀ centre and Q = −P / f(centre).
+void FootprintEllipse(const glm::dmat3& cameraFromWorld, const glm::dvec3& q, double sh, double sz,
+                      double r2, double W, double H, double tanH, double tanV, double (&out)[6]) {
+    const glm::dvec3 m{1.0 / (sh * sh), 1.0 / (sh * sh), 1.0 / (sz * sz)};
+    const glm::dvec3 mq = m * q;
+    const double G = glm::dot(q, mq) - r2;
+    if (!(G > 0.0)) return;
+    const glm::dvec3 pc = cameraFromWorld * mq;
+    const glm::dmat3 mc = cameraFromWorld *
+                          glm::dmat3(glm::dvec3(m.x, 0.0, 0.0), glm::dvec3(0.0, m.y, 0.0),
+                                     glm::dvec3(0.0, 0.0, m.z)) *
+                          glm::transpose(cameraFromWorld);
+    const glm::dmat3 K = glm::outerProduct(pc, pc) - G * mc;
+    // Columns: the direction's change per pixel in x, per pixel in y, and at pixel (0, 0).
+    const glm::dmat3 T(glm::dvec3(2.0 * tanH / W, 0.0, 0.0), glm::dvec3(0.0, 0.0, -2.0 * tanV / H),
+                       glm::dvec3(-tanH, 1.0, tanV));
+    const glm::dmat3 L = glm::transpose(T) * K * T;
+    const double pxx = L[0][0], pxy = L[1][0], pyy = L[1][1], gx = L[2][0], gy = L[2][1];
+    const double det = pxx * pyy - pxy * pxy;
+    if (!(pxx < 0.0 && det > 0.0)) return;
+    // centre = −P⁻¹ g.
+    const double cx = -(pyy * gx - pxy * gy) / det, cy = -(pxx * gy - pxy * gx) / det;
+    const double fc = L[2][2] + gx * cx + gy * cy;
+    if (!(fc > 0.0)) return;
+    // Q, shrunk (the ellipse widened) by more than its float rounding can change the form:
+    // |xᵀ ΔQ x| ≤ 2⁻²⁴ (√Q_xx |x| + √Q_yy |y|)² ≤ 2⁻²³ (Q_xx x² + Q_yy y²) ≤ 2⁻²³ xᵀ Q x / (1 − κ),
+    // κ = |Q_xy| / √(Q_xx Q_yy) < 1 (P is definite); 4× that plus 1e-6.
+    const double kappa = std::abs(pxy) / std::sqrt(pxx * pyy);
+    const double widen = 1.0 - 4.0 * 0x1p-23 / (1.0 - kappa) - 1e-6;
+    if (!(widen > 0.5)) return;
+    const double qxx = -pxx / fc * widen, qxy = -pxy / fc * widen, qyy = -pyy / fc * widen;
+    const double halfTrace = 0.5 * (qxx + qyy);
+    const double lambdaMax =
+        halfTrace + std::sqrt(std::max(halfTrace * halfTrace - (qxx * qyy - qxy * qxy), 0.0));
+    out[0] = cx, out[1] = cy, out[2] = qxx, out[3] = qxy, out[4] = qyy;
+    out[5] = std::sqrt(lambdaMax);
+}
+
+}  // namespace
+
 PlumeScreenBins::PlumeScreenBins(const scene::PlumeField& field, const ChannelCamera& camera,
                                  scene::ObscurantBand band, float tolerance) {
     CHECK(tolerance > 0.0f);
@@ -25,8 +78,6 @@ PlumeScreenBins::PlumeScreenBins(const scene::PlumeField& field, const ChannelCa
     tilesY_ = (height_ + kTile - 1) / kTile;
     const scene::PlumeField::PuffArrays puffs = field.Puffs();
     const size_t n = puffs.x.size();
-    puffTolerance_ = tolerance / float(std::max<size_t>(n, 1));
-    const double eps = puffTolerance_;
 
     const glm::dmat3 cameraFromWorld = glm::transpose(camera.worldFromCamera.worldFromBody);
     const glm::dvec3 eye = camera.worldFromCamera.position_m;
@@ -36,22 +87,85 @@ PlumeScreenBins::PlumeScreenBins(const scene::PlumeField& field, const ChannelCa
     const size_t b = size_t(band);
     const double sqrt2Pi = std::sqrt(2.0 * std::numbers::pi);
     const double halfSqrtPi = 0.5 * std::sqrt(std::numbers::pi);
+    const auto TauMax = [&](size_t i, double sh, double sz) {
+        // Line integral through the centre: peak √(2π/A), largest for A = 1/max(σ)².
+        return field.Optics(puffs.plume[i]).massExtinction_m2pkg[b] * double(puffs.peak_kgpm3[i]) *
+               sqrt2Pi * std::max(sh, sz);
+    };
+
+    // The tolerance is shared by the puffs that can reach the view. Every ray lies in the
+    // pyramid from the eye through the bin area, the intersection of five half-spaces
+    // nᵀ x ≥ 0 (x camera-frame, from the eye): in front of the eye and inside the four sides.
+    // Along any ray from the eye inside a half-space that the puff's centre lies outside of,
+    // at Mahalanobis distance m_H (= −nᵀx_c / √(nᵀ Σ n), Σ the puff's covariance), the
+    // squared Mahalanobis distance stays ≥ m_H², so the ray's optical depth is at most
+    // τ_max e^(−m_H²/2): the whole line's integral through its closest approach, at most
+    // τ_max e^(−m*²/2), if that lies on the ray (then m* ≥ m_H), else the tail beyond its
+    // start, ≤ (τ_max / 2) e^(−m(0)²/2) (the Gaussian tail bound ∫_a^∞ e^(−At²/2) dt ≤
+    // e^(−Aa²/2) √(π/2A)). A puff whose bound b over the five is at most 1e-3 tolerance / n
+    // is out of view: dropped, its b counted (in field order, in double precision); the rest
+    // of the tolerance is split among the n' others, ε = (tolerance − Σ b) / n'. So the
+    // out-of-view puffs add at most a thousandth of the tolerance and ε is about tolerance /
+    // n' instead of tolerance / n (the puffs behind the camera no longer count).
+    const double aMin = -tanH, aMax = (2.0 * width_ / W - 1.0) * tanH;
+    const double bMax = tanV, bMin = (1.0 - 2.0 * height_ / H) * tanV;
+    const glm::dvec3 sides[5] = {{0.0, 1.0, 0.0},
+                                 {1.0, -aMin, 0.0},
+                                 {-1.0, aMax, 0.0},
+                                 {0.0, bMax, -1.0},
+                                 {0.0, -bMin, 1.0}};
+    const double outOfView = 1e-3 * double(tolerance) / double(std::max<size_t>(n, 1));
+    // The sides' normals in the world frame, where Σ is diagonal: nᵀ Σ n = σh² h + σz² z.
+    double sideH[5], sideZ[5];
+    for (int j = 0; j < 5; ++j) {
+        const glm::dvec3 nw = glm::transpose(cameraFromWorld) * sides[j];
+        sideH[j] = nw.x * nw.x + nw.y * nw.y, sideZ[j] = nw.z * nw.z;
+    }
+    std::vector<double> viewBound(n);
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t i = r.begin(); i != r.end(); ++i) {
+                const double sh = 1.0 / std::sqrt(double(puffs.invVarH[i]));
+                const double sz = 1.0 / std::sqrt(double(puffs.invVarZ[i]));
+                const glm::dvec3 xc =
+                    cameraFromWorld * (glm::dvec3(puffs.x[i], puffs.y[i], puffs.z[i]) - eye);
+                double mH = 0.0;
+                for (int j = 0; j < 5; ++j) {
+                    const double out = -glm::dot(sides[j], xc);
+                    if (out > 0.0)
+                        mH = std::max(mH, out / std::sqrt(sh * sh * sideH[j] + sz * sz * sideZ[j]));
+                }
+                // (In view: any value above outOfView.)
+                viewBound[i] = mH > 0.0 ? TauMax(i, sh, sz) * std::exp(-0.5 * mH * mH)
+                                        : std::numeric_limits<double>::infinity();
+            }
+        });
+    double outOfViewSum = 0.0;
+    size_t inView = 0;
+    for (size_t i = 0; i < n; ++i) {
+        if (viewBound[i] <= outOfView)
+            outOfViewSum += viewBound[i];
+        else
+            ++inView;
+    }
+    puffTolerance_ =
+        float((double(tolerance) - outOfViewSum) / double(std::max<size_t>(inView, 1)));
+    const double eps = puffTolerance_;
     // Each puff is projected on its own (in parallel, into its own slot), then the kept ones
     // are compacted in field order, so the bins are the same for any thread count.
     struct Projected {
         bool kept = false;
-        Rect rect{};
         float values[kFields];
-        float far, sigmaPixels, tauMax;
+        Footprint footprint;
     };
     std::vector<Projected> projected(n);
     const auto Project = [&](size_t i, Projected& out) {
+        if (viewBound[i] <= outOfView) return;
         const scene::ObscurantOptics& optics = field.Optics(puffs.plume[i]);
         const double alpha = optics.massExtinction_m2pkg[b];
         const double sh = 1.0 / std::sqrt(double(puffs.invVarH[i]));
         const double sz = 1.0 / std::sqrt(double(puffs.invVarZ[i]));
-        // Line integral through the centre: peak √(2π/A), largest for A = 1/max(σ)².
-        const double tauMax = alpha * double(puffs.peak_kgpm3[i]) * sqrt2Pi * std::max(sh, sz);
+        const double tauMax = TauMax(i, sh, sz);
         if (!(tauMax > eps)) return;
         const double r2 = 2.0 * std::log(tauMax / eps);
         const double r = std::sqrt(r2);
@@ -76,6 +190,8 @@ PlumeScreenBins::PlumeScreenBins(const scene::PlumeField& field, const ChannelCa
         }
         if (behind == 8) return;
         Rect rect{0, 0, width_, height_};
+        // The footprint ellipse (zero: none, the rectangle decides).
+        double ellipse[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
         if (behind == 0) {
             // The ellipsoid itself projects inside the box's rectangle; when it lies wholly in
             // front of the eye its exact extent is tighter (the box's corners reach √3 r).
@@ -108,6 +224,7 @@ PlumeScreenBins::PlumeScreenBins(const scene::PlumeField& field, const ChannelCa
                 xMax = std::min(xMax, ((u1 + du) / tanH + 1.0) * 0.5 * W);
                 yMin = std::max(yMin, (1.0 - (v1 + dv) / tanV) * 0.5 * H);
                 yMax = std::min(yMax, (1.0 - (v0 - dv) / tanV) * 0.5 * H);
+                FootprintEllipse(cameraFromWorld, eye - c, sh, sz, r2, W, H, tanH, tanV, ellipse);
             }
             const auto clampX = [&](double v) { return int(std::clamp(v, 0.0, double(width_))); };
             const auto clampY = [&](double v) { return int(std::clamp(v, 0.0, double(height_))); };
@@ -124,7 +241,6 @@ PlumeScreenBins::PlumeScreenBins(const scene::PlumeField& field, const ChannelCa
         const double T = puffs.temperature_K[i];
         const double hot = T >= double(scene::kHotPuff_K) ? 1.0 - omega : 0.0;
         out.kept = true;
-        out.rect = rect;
         const float values[kFields] = {
             float(eye.x - c.x), float(eye.y - c.y), float(eye.z - c.z), puffs.invVarH[i],
             puffs.invVarZ[i], float(r2), float(alpha * double(puffs.peak_kgpm3[i]) * halfSqrtPi),
@@ -132,9 +248,17 @@ PlumeScreenBins::PlumeScreenBins(const scene::PlumeField& field, const ChannelCa
             float(nearest * 0.999), float(omega), float((1.0 - omega) * T), float(hot),
             float(hot * T), float(omega * optics.asymmetry)};
         std::copy(std::begin(values), std::end(values), out.values);
-        out.far = float(far * 1.001 + 1.0);
-        out.sigmaPixels = float(sigmaPixels);
-        out.tauMax = float(tauMax);
+        out.footprint = {rect,
+                         float(ellipse[0]),
+                         float(ellipse[1]),
+                         float(ellipse[2]),
+                         float(ellipse[3]),
+                         float(ellipse[4]),
+                         float(ellipse[5]),
+                         values[kNear],
+                         float(far * 1.001 + 1.0),
+                         float(sigmaPixels),
+                         float(tauMax)};
     };
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 64),
                       [&](const tbb::blocked_range<size_t>& r) {
@@ -143,18 +267,14 @@ PlumeScreenBins::PlumeScreenBins(const scene::PlumeField& field, const ChannelCa
     size_t keptCount = 0;
     for (const Projected& p : projected) keptCount += p.kept;
     kept_.reserve(keptCount);
-    rect_.reserve(keptCount);
-    far_.reserve(keptCount), sigmaPixels_.reserve(keptCount), tauMax_.reserve(keptCount);
+    footprint_.reserve(keptCount);
     for (int f = 0; f < kFields; ++f) data_[f].reserve(keptCount + 1);
     for (size_t i = 0; i < n; ++i) {
         const Projected& p = projected[i];
         if (!p.kept) continue;
         kept_.push_back(uint32_t(i));
-        rect_.push_back(p.rect);
+        footprint_.push_back(p.footprint);
         for (int f = 0; f < kFields; ++f) data_[f].push_back(p.values[f]);
-        far_.push_back(p.far);
-        sigmaPixels_.push_back(p.sigmaPixels);
-        tauMax_.push_back(p.tauMax);
     }
 
     // The inert puff: a unit sphere at the eye with a negative cutoff, beyond every range.
@@ -165,15 +285,17 @@ PlumeScreenBins::PlumeScreenBins(const scene::PlumeField& field, const ChannelCa
 
     // Counting sort of (tile, kept position) pairs: per tile in increasing kept position.
     tileStart_.assign(size_t(tilesX_) * size_t(tilesY_) + 1, 0);
-    for (const Rect& r : rect_)
+    for (const Footprint& fp : footprint_) {
+        const Rect& r = fp.rect;
         for (int ty = r.y0 / kTile; ty <= (r.y1 - 1) / kTile; ++ty)
             for (int tx = r.x0 / kTile; tx <= (r.x1 - 1) / kTile; ++tx)
                 ++tileStart_[size_t(ty) * size_t(tilesX_) + size_t(tx) + 1];
+    }
     for (size_t t = 1; t < tileStart_.size(); ++t) tileStart_[t] += tileStart_[t - 1];
     tileEntries_.resize(tileStart_.back());
     std::vector<uint32_t> fill(tileStart_.begin(), tileStart_.end() - 1);
-    for (size_t k = 0; k < rect_.size(); ++k) {
-        const Rect& r = rect_[k];
+    for (size_t k = 0; k < footprint_.size(); ++k) {
+        const Rect& r = footprint_[k].rect;
         for (int ty = r.y0 / kTile; ty <= (r.y1 - 1) / kTile; ++ty)
             for (int tx = r.x0 / kTile; tx <= (r.x1 - 1) / kTile; ++tx)
                 tileEntries_[fill[size_t(ty) * size_t(tilesX_) + size_t(tx)]++] = uint32_t(k);
@@ -194,15 +316,61 @@ void PlumeScreenBins::Begin(List& out) {
     out.halfSmallOpticalDepth = 0.0f;
 }
 
-inline void PlumeScreenBins::Take(uint32_t k, int x0, int y0, int x1, int y1, float smallPixels,
-                                  List& out) const {
-    const Rect& r = rect_[k];
-    if (r.x1 <= x0 || r.x0 >= x1 || r.y1 <= y0 || r.y0 >= y1) return;
+// Where the footprint ellipse can reach pixels [x0, x1) × [y0, y1): their centres lie in the
+// square-cornered region [x0, x1] × [y0, y1] of pixel coordinates, inside the disc of radius
+// ρ (its half diagonal) about its centre o, so if one meets the ellipse then
+// ‖Q^½ (o − centre)‖ ≤ 1 + ρ √λmax(Q) (the triangle inequality in the norm of Q^½). For the
+// row of o (o_y = centreY) that is an interval of o_x, a quadratic inequality solved here
+// (false: none), so that a row of rectangles is tested with one root. The ellipse was widened
+// for the float rounding of Q (FootprintEllipse) and ρ for that of the centre, and the roots
+// in double precision err far less than that widening, so no puff whose ellipse reaches a
+// pixel is dropped.
+inline bool PlumeScreenBins::EllipseSpan(const Footprint& fp, float centreY, float rho, double& lo,
+                                         double& hi) {
+    const double dy = double(centreY) - double(fp.centreY);
+    const double reach = 1.0 + double(rho) * double(fp.sqrtLambdaMax);
+    // qxx dx² + 2 b dx + c ≤ 0.
+    const double a = fp.qxx, b = double(fp.qxy) * dy, c = double(fp.qyy) * dy * dy - reach * reach;
+    const double disc = b * b - a * c;
+    if (disc < 0.0) return false;
+    const double root = std::sqrt(disc);
+    lo = double(fp.centreX) + (-b - root) / a, hi = double(fp.centreX) + (-b + root) / a;
+    return true;
+}
+
+namespace {
+
+// EllipseSpan's ρ for a w × h rectangle: its half diagonal, plus a thousandth of a pixel for
+// the float centre (which errs by under 1e-4 pixel on screens below 4000 pixels).
+float HalfDiagonal(int w, int h) {
+    return float(0.5 * std::sqrt(double(w) * double(w) + double(h) * double(h)) + 1e-3);
+}
+
+}  // namespace
+
+inline bool PlumeScreenBins::Reaches(uint32_t k, int x0, int y0, int x1, int y1, float rho) const {
+    const Footprint& fp = footprint_[k];
+    const Rect& r = fp.rect;
+    if (r.x1 <= x0 || r.x0 >= x1 || r.y1 <= y0 || r.y0 >= y1) return false;
+    if (fp.sqrtLambdaMax == 0.0f) return true;
+    double lo, hi;
+    if (!EllipseSpan(fp, 0.5f * float(y0 + y1), rho, lo, hi)) return false;
+    const double cx = 0.5 * double(x0 + x1);
+    return cx >= lo && cx <= hi;
+}
+
+inline void PlumeScreenBins::Add(uint32_t k, float smallPixels, List& out) const {
+    const Footprint& fp = footprint_[k];
     out.index.push_back(k);
-    out.near_m = std::min(out.near_m, data_[kNear][k]);
-    out.far_m = std::max(out.far_m, far_[k]);
-    if (sigmaPixels_[k] < smallPixels) out.smallOpticalDepth += tauMax_[k];
-    if (sigmaPixels_[k] < 0.5f * smallPixels) out.halfSmallOpticalDepth += tauMax_[k];
+    out.near_m = std::min(out.near_m, fp.near_m);
+    out.far_m = std::max(out.far_m, fp.far_m);
+    if (fp.sigmaPixels < smallPixels) out.smallOpticalDepth += fp.tauMax;
+    if (fp.sigmaPixels < 0.5f * smallPixels) out.halfSmallOpticalDepth += fp.tauMax;
+}
+
+inline void PlumeScreenBins::Take(uint32_t k, int x0, int y0, int x1, int y1, float rho,
+                                  float smallPixels, List& out) const {
+    if (Reaches(k, x0, y0, x1, y1, rho)) Add(k, smallPixels, out);
 }
 
 void PlumeScreenBins::Finish(bool copy, List& out) const {
@@ -223,6 +391,7 @@ void PlumeScreenBins::Gather(int x0, int y0, int x1, int y1, float smallPixels, 
         const int ty0 = y0 / kTile, ty1 = (y1 - 1) / kTile;
         constexpr int kMaxTiles = 4;
         CHECK_MSG((tx1 - tx0 + 1) * (ty1 - ty0 + 1) <= kMaxTiles, "gather over > 4 tiles");
+        const float rho = HalfDiagonal(x1 - x0, y1 - y0);
         const uint32_t* cur[kMaxTiles];
         const uint32_t* end[kMaxTiles];
         int lists = 0;
@@ -235,7 +404,17 @@ void PlumeScreenBins::Gather(int x0, int y0, int x1, int y1, float smallPixels, 
             }
         if (lists == 1) {
             for (const uint32_t* p = cur[0]; p != end[0]; ++p)
-                Take(*p, x0, y0, x1, y1, smallPixels, out);
+                Take(*p, x0, y0, x1, y1, rho, smallPixels, out);
+        } else if (lists == 2) {
+            // Two tiles (a tile strip's usual case): a plain merge.
+            const uint32_t *a = cur[0], *b = cur[1];
+            while (a != end[0] && b != end[1]) {
+                const uint32_t k = std::min(*a, *b);
+                a += *a == k, b += *b == k;
+                Take(k, x0, y0, x1, y1, rho, smallPixels, out);
+            }
+            for (; a != end[0]; ++a) Take(*a, x0, y0, x1, y1, rho, smallPixels, out);
+            for (; b != end[1]; ++b) Take(*b, x0, y0, x1, y1, rho, smallPixels, out);
         } else {
             for (;;) {
                 uint32_t k = std::numeric_limits<uint32_t>::max();
@@ -244,7 +423,7 @@ void PlumeScreenBins::Gather(int x0, int y0, int x1, int y1, float smallPixels, 
                 if (k == std::numeric_limits<uint32_t>::max()) break;
                 for (int l = 0; l < lists; ++l)
                     if (cur[l] != end[l] && *cur[l] == k) ++cur[l];
-                Take(k, x0, y0, x1, y1, smallPixels, out);
+                Take(k, x0, y0, x1, y1, rho, smallPixels, out);
             }
         }
     }
@@ -258,7 +437,7 @@ void PlumeScreenBins::Gather(const List& from, int x0, int y0, int x1, int y1, f
     x1 = std::min(x1, width_), y1 = std::min(y1, height_);
     if (x0 < x1 && y0 < y1)
         for (size_t j = 0; j < from.count; ++j)
-            Take(from.index[j], x0, y0, x1, y1, smallPixels, out);
+            Take(from.index[j], x0, y0, x1, y1, HalfDiagonal(x1 - x0, y1 - y0), smallPixels, out);
     Finish(copy, out);
 }
 
@@ -273,17 +452,33 @@ void PlumeScreenBins::GatherRow(const List& from, int x0, int y0, int y1, int st
     // Rectangle c clipped to the bin area as Gather clips it; empty ones get no puffs.
     const auto Right = [&](int c) { return std::min(x0 + c * step + width, width_); };
     if (y0 < y1 && cells > 0) {
+        const float rho = HalfDiagonal(width, y1 - y0);
+        const float centreY = 0.5f * float(y0 + y1);
         for (size_t j = 0; j < from.count; ++j) {
             const uint32_t k = from.index[j];
-            const Rect& r = rect_[k];
+            const Footprint& fp = footprint_[k];
+            const Rect& r = fp.rect;
             if (r.y1 <= y0 || r.y0 >= y1) continue;
+            // The ellipse's span for the row's full-width rectangles, as Reaches finds it.
+            double spanLo = -std::numeric_limits<double>::infinity();
+            double spanHi = std::numeric_limits<double>::infinity();
+            if (fp.sqrtLambdaMax != 0.0f && !EllipseSpan(fp, centreY, rho, spanLo, spanHi))
+                continue;
             // The rectangles c with x0 + c·step < r.x1 and x0 + c·step + width > r.x0, widened
-            // by one on each side (Take decides exactly).
+            // by one on each side (the tests below decide exactly).
             const int lo = std::max((r.x0 - x0 - width) / step - 1, 0);
             const int hi = std::min((r.x1 - x0) / step + 1, cells - 1);
             for (int c = lo; c <= hi; ++c) {
                 const int cx0 = x0 + c * step, cx1 = Right(c);
-                if (cx0 < cx1) Take(k, cx0, y0, cx1, y1, smallPixels, out[size_t(c)]);
+                if (cx0 >= cx1 || r.x1 <= cx0 || r.x0 >= cx1) continue;
+                if (cx1 - cx0 != width) {
+                    // Clipped at the bin area's edge: its own ρ.
+                    Take(k, cx0, y0, cx1, y1, HalfDiagonal(cx1 - cx0, y1 - y0), smallPixels,
+                         out[size_t(c)]);
+                    continue;
+                }
+                const double cx = 0.5 * double(cx0 + cx1);
+                if (cx >= spanLo && cx <= spanHi) Add(k, smallPixels, out[size_t(c)]);
             }
         }
     }
@@ -343,10 +538,12 @@ inline float Sum4(F4 v) {
 }
 
 struct BandAccumulator {
-    F4 extinction = _mm_setzero_ps(), scattering = _mm_setzero_ps(), absorption = _mm_setzero_ps(),
-       absorptionT = _mm_setzero_ps(), hotAbsorption = _mm_setzero_ps(),
-       hotAbsorptionT = _mm_setzero_ps(), scatteringG = _mm_setzero_ps();
+    F4 extinction, scattering, absorption, absorptionT, hotAbsorption, hotAbsorptionT, scatteringG;
 
+    BandAccumulator() {
+        extinction = scattering = absorption = absorptionT = hotAbsorption = hotAbsorptionT =
+            scatteringG = _mm_setzero_ps();
+    }
     // Weights w[0..4]: scattering, absorption × T, hot absorption, hot absorption × T,
     // scattering × g per unit optical depth.
     void Add(const F4 (&w)[5], F4 tau) {
@@ -359,20 +556,25 @@ struct BandAccumulator {
         hotAbsorptionT = _mm_add_ps(hotAbsorptionT, _mm_mul_ps(tau, w[3]));
         scatteringG = _mm_add_ps(scatteringG, _mm_mul_ps(tau, w[4]));
     }
-
-    BandTrace Result() const {
-        const float ext = Sum4(extinction), scat = Sum4(scattering), abs = Sum4(absorption);
-        const float hot = Sum4(hotAbsorption);
-        BandTrace t;
-        t.opticalDepth = ext;
-        t.albedo = ext > 0.0f ? scat / ext : 0.0f;
-        t.temperature_K = abs > 0.0f ? Sum4(absorptionT) / abs : 0.0f;
-        t.hotFraction = abs > 0.0f ? std::min(hot / abs, 1.0f) : 0.0f;
-        t.hotTemperature_K = hot > 0.0f ? Sum4(hotAbsorptionT) / hot : 0.0f;
-        t.asymmetry = scat > 0.0f ? Sum4(scatteringG) / scat : 0.0f;
-        return t;
-    }
 };
+
+// The trace from the sums of the lanes of the even (lo) and odd (hi) groups of four puffs,
+// lane by lane first, then across the lanes.
+inline BandTrace Result(const BandAccumulator& lo, const BandAccumulator& hi) {
+    const auto sum = [](F4 a, F4 b) { return Sum4(_mm_add_ps(a, b)); };
+    const float ext = sum(lo.extinction, hi.extinction);
+    const float scat = sum(lo.scattering, hi.scattering);
+    const float abs = sum(lo.absorption, hi.absorption);
+    const float hot = sum(lo.hotAbsorption, hi.hotAbsorption);
+    BandTrace t;
+    t.opticalDepth = ext;
+    t.albedo = ext > 0.0f ? scat / ext : 0.0f;
+    t.temperature_K = abs > 0.0f ? sum(lo.absorptionT, hi.absorptionT) / abs : 0.0f;
+    t.hotFraction = abs > 0.0f ? std::min(hot / abs, 1.0f) : 0.0f;
+    t.hotTemperature_K = hot > 0.0f ? sum(lo.hotAbsorptionT, hi.hotAbsorptionT) / hot : 0.0f;
+    t.asymmetry = scat > 0.0f ? sum(lo.scatteringG, hi.scatteringG) / scat : 0.0f;
+    return t;
+}
 
 // Four values of a field from k on: contiguous in a copied list, else gathered by index.
 template <bool Copied>
@@ -405,13 +607,15 @@ __attribute__((target("avx2"))) inline F8 Exp8(F8 x) {
     return _mm256_mul_ps(p, scale);
 }
 
-// ErfOrSign4 on eight lanes (Erf4's operations lane for lane; the shortcut when all eight
-// saturate gives what Erf4 gives there, ±1).
-__attribute__((target("avx2"))) inline F8 ErfOrSign8(F8 x) {
+// ErfOrSign4 on eight lanes (Erf4's operations lane for lane; the shortcut, taken when every
+// lane that is used saturates, gives what Erf4 gives there, ±1; the unused lanes' values are
+// discarded).
+__attribute__((target("avx2"))) inline F8 ErfOrSign8(F8 x, F8 use) {
     const F8 sign = _mm256_and_ps(x, _mm256_set1_ps(-0.0f));
     const F8 ax = _mm256_andnot_ps(_mm256_set1_ps(-0.0f), x);
     const F8 saturated = _mm256_cmp_ps(ax, _mm256_set1_ps(3.9f), _CMP_GE_OS);
-    if (_mm256_movemask_ps(saturated) == 0xFF) return _mm256_or_ps(_mm256_set1_ps(1.0f), sign);
+    if ((_mm256_movemask_ps(saturated) | (~_mm256_movemask_ps(use) & 0xFF)) == 0xFF)
+        return _mm256_or_ps(_mm256_set1_ps(1.0f), sign);
     const F8 t = _mm256_div_ps(
         _mm256_set1_ps(1.0f),
         _mm256_add_ps(_mm256_set1_ps(1.0f), _mm256_mul_ps(_mm256_set1_ps(0.3275911f), ax)));
@@ -440,22 +644,44 @@ __attribute__((target("avx2"))) inline F8 Load8(const std::vector<float>& copied
     }
 }
 
-// Adds eight optical depths (kept where use and τ > 0) to a, the low four lanes first, as the
-// four-lane loop adds two groups; w: each half's weights.
-__attribute__((target("avx2"))) inline void AddHalves(BandAccumulator& a, const F4 (&w)[2][5],
-                                                      F8 use, F8 tau) {
-    const F8 kept =
-        _mm256_and_ps(_mm256_and_ps(use, _mm256_cmp_ps(tau, _mm256_setzero_ps(), _CMP_GT_OS)), tau);
-    a.Add(w[0], _mm256_castps256_ps128(kept));
-    a.Add(w[1], _mm256_extractf128_ps(kept, 1));
-}
+// BandAccumulator on eight lanes: lanes 0–3 those of the even groups of four, 4–7 of the odd.
+struct BandAccumulator8 {
+    F8 extinction, scattering, absorption, absorptionT, hotAbsorption, hotAbsorptionT, scatteringG;
+
+    __attribute__((target("avx2"))) BandAccumulator8() {
+        extinction = scattering = absorption = absorptionT = hotAbsorption = hotAbsorptionT =
+            scatteringG = _mm256_setzero_ps();
+    }
+    // BandAccumulator::Add lane for lane, of the optical depths kept where use and τ > 0.
+    __attribute__((target("avx2"))) void Add(const F8 (&w)[5], F8 use, F8 tau) {
+        tau = _mm256_and_ps(_mm256_and_ps(use, _mm256_cmp_ps(tau, _mm256_setzero_ps(), _CMP_GT_OS)),
+                            tau);
+        extinction = _mm256_add_ps(extinction, tau);
+        const F8 scattered = _mm256_mul_ps(tau, w[0]);
+        scattering = _mm256_add_ps(scattering, scattered);
+        absorption = _mm256_add_ps(absorption, _mm256_sub_ps(tau, scattered));
+        absorptionT = _mm256_add_ps(absorptionT, _mm256_mul_ps(tau, w[1]));
+        hotAbsorption = _mm256_add_ps(hotAbsorption, _mm256_mul_ps(tau, w[2]));
+        hotAbsorptionT = _mm256_add_ps(hotAbsorptionT, _mm256_mul_ps(tau, w[3]));
+        scatteringG = _mm256_add_ps(scatteringG, _mm256_mul_ps(tau, w[4]));
+    }
+    // The even and odd groups' sums.
+    __attribute__((target("avx2"))) void Split(BandAccumulator& lo, BandAccumulator& hi) const {
+        const auto split = [](F8 v, F4 & l, F4 & h) __attribute__((target("avx2"))) {
+            l = _mm256_castps256_ps128(v), h = _mm256_extractf128_ps(v, 1);
+        };
+        split(extinction, lo.extinction, hi.extinction);
+        split(scattering, lo.scattering, hi.scattering);
+        split(absorption, lo.absorption, hi.absorption);
+        split(absorptionT, lo.absorptionT, hi.absorptionT);
+        split(hotAbsorption, lo.hotAbsorption, hi.hotAbsorption);
+        split(hotAbsorptionT, lo.hotAbsorptionT, hi.hotAbsorptionT);
+        split(scatteringG, lo.scatteringG, hi.scatteringG);
+    }
+};
 #endif
 
 }  // namespace
-
-struct PlumeScreenBins::Accumulators {
-    BandAccumulator first, second;
-};
 
 void PlumeScreenBins::UseWideTraces(bool on) {
 #ifdef SEASENSE_PLUME_WIDE
@@ -467,29 +693,24 @@ void PlumeScreenBins::UseWideTraces(bool on) {
 }
 
 #ifdef SEASENSE_PLUME_WIDE
-// Trace2Impl's loop body on eight lanes; each half's sums are added to the four-lane
-// accumulators in list order, as the four-lane loop adds them.
+// Trace2Impl's loop body on eight lanes, into the even and odd groups' sums, as the four-lane
+// loop adds them.
 template <bool Copied, bool Two>
-__attribute__((target("avx2"))) size_t PlumeScreenBins::TraceWide(const List& l,
-                                                                  const glm::vec3& dir,
-                                                                  float range_m, float range2_m,
-                                                                  Accumulators& acc) const {
-    const auto load = [&](int f, size_t k) __attribute__((target("avx2"))) {
-        return Load8<Copied>(l.data[f], data_[f].data(), l.index.data(), k);
-    };
-    const auto load4 = [&](int f, size_t k) {
-        return Load4<Copied>(l.data[f], data_[f].data(), l.index.data(), k);
-    };
+__attribute__((target("avx2"))) void PlumeScreenBins::TraceWide(const List& l, const glm::vec3& dir,
+                                                                float range_m, float range2_m,
+                                                                BandTrace& out1,
+                                                                BandTrace& out2) const {
     const F8 dx = _mm256_set1_ps(dir.x), dy = _mm256_set1_ps(dir.y), dz = _mm256_set1_ps(dir.z);
     const F8 dh2 = _mm256_set1_ps(dir.x * dir.x + dir.y * dir.y);
     const F8 dz2 = _mm256_set1_ps(dir.z * dir.z);
     const F8 end = _mm256_set1_ps(std::max(range_m, range2_m));
     const F8 r1 = _mm256_set1_ps(range_m), r2 = _mm256_set1_ps(range2_m);
     const F8 zero = _mm256_setzero_ps(), half = _mm256_set1_ps(0.5f);
-    size_t k = 0;
-    for (; k + 8 <= l.index.size(); k += 8) {
-        const F8 qx = load(kQx, k), qy = load(kQy, k), qz = load(kQz, k);
-        const F8 ivh = load(kIvh, k), ivz = load(kIvz, k);
+    BandAccumulator8 first, second;
+    // Eight puffs, their fields given by load(field).
+    const auto eight = [&](const auto& load) __attribute__((target("avx2"), always_inline)) {
+        const F8 qx = load(kQx), qy = load(kQy), qz = load(kQz);
+        const F8 ivh = load(kIvh), ivz = load(kIvz);
         const F8 A = _mm256_add_ps(_mm256_mul_ps(dh2, ivh), _mm256_mul_ps(dz2, ivz));
         const F8 B = _mm256_add_ps(
             _mm256_mul_ps(_mm256_add_ps(_mm256_mul_ps(dx, qx), _mm256_mul_ps(dy, qy)), ivh),
@@ -501,26 +722,44 @@ __attribute__((target("avx2"))) size_t PlumeScreenBins::TraceWide(const List& l,
         const F8 m2 = _mm256_add_ps(
             _mm256_mul_ps(_mm256_add_ps(_mm256_mul_ps(rx, rx), _mm256_mul_ps(ry, ry)), ivh),
             _mm256_mul_ps(_mm256_mul_ps(rz, rz), ivz));
-        const F8 use = _mm256_and_ps(_mm256_cmp_ps(m2, load(kCutoff2, k), _CMP_LE_OS),
-                                     _mm256_cmp_ps(load(kNear, k), end, _CMP_LT_OS));
-        if (_mm256_movemask_ps(use) == 0) continue;
+        const F8 use = _mm256_and_ps(_mm256_cmp_ps(m2, load(kCutoff2), _CMP_LE_OS),
+                                     _mm256_cmp_ps(load(kNear), end, _CMP_LT_OS));
+        if (_mm256_movemask_ps(use) == 0) return;
         const F8 scale = _mm256_sqrt_ps(_mm256_mul_ps(half, A));
         const F8 u0 = _mm256_sub_ps(zero, _mm256_mul_ps(sStar, scale));
         const F8 amplitude = _mm256_div_ps(
-            _mm256_mul_ps(load(kKappa, k), Exp8(_mm256_mul_ps(_mm256_set1_ps(-0.5f), m2))), scale);
-        const F8 e0 = ErfOrSign8(u0);
-        const F8 e1 = ErfOrSign8(_mm256_add_ps(u0, _mm256_mul_ps(r1, scale)));
-        const F4 w[2][5] = {
-            {load4(kWs, k), load4(kWAbsT, k), load4(kWHot, k), load4(kWHotT, k), load4(kWg, k)},
-            {load4(kWs, k + 4), load4(kWAbsT, k + 4), load4(kWHot, k + 4), load4(kWHotT, k + 4),
-             load4(kWg, k + 4)}};
-        AddHalves(acc.first, w, use, _mm256_mul_ps(amplitude, _mm256_sub_ps(e1, e0)));
+            _mm256_mul_ps(load(kKappa), Exp8(_mm256_mul_ps(_mm256_set1_ps(-0.5f), m2))), scale);
+        const F8 e0 = ErfOrSign8(u0, use);
+        const F8 e1 = ErfOrSign8(_mm256_add_ps(u0, _mm256_mul_ps(r1, scale)), use);
+        const F8 w[5] = {load(kWs), load(kWAbsT), load(kWHot), load(kWHotT), load(kWg)};
+        first.Add(w, use, _mm256_mul_ps(amplitude, _mm256_sub_ps(e1, e0)));
         if constexpr (Two) {
-            const F8 e2 = ErfOrSign8(_mm256_add_ps(u0, _mm256_mul_ps(r2, scale)));
-            AddHalves(acc.second, w, use, _mm256_mul_ps(amplitude, _mm256_sub_ps(e2, e0)));
+            const F8 e2 = ErfOrSign8(_mm256_add_ps(u0, _mm256_mul_ps(r2, scale)), use);
+            second.Add(w, use, _mm256_mul_ps(amplitude, _mm256_sub_ps(e2, e0)));
         }
+    };
+    size_t k = 0;
+    for (; k + 8 <= l.index.size(); k += 8)
+        eight([&](int f) __attribute__((target("avx2"))) {
+            return Load8<Copied>(l.data[f], data_[f].data(), l.index.data(), k);
+        });
+    // A last group of four (lists hold a multiple of four): in the low lanes, the inert puff
+    // in the high ones (unused, so they add zeros to the odd groups' sums).
+    if (k < l.index.size())
+        eight([&](int f) __attribute__((target("avx2"))) {
+            return _mm256_insertf128_ps(_mm256_castps128_ps256(Load4<Copied>(
+                                            l.data[f], data_[f].data(), l.index.data(), k)),
+                                        _mm_set1_ps(data_[f][inert_]), 1);
+        });
+    BandAccumulator lo, hi;
+    first.Split(lo, hi);
+    out1 = Result(lo, hi);
+    if constexpr (Two) {
+        second.Split(lo, hi);
+        out2 = Result(lo, hi);
+    } else {
+        out2 = out1;
     }
-    return k;
 }
 #endif
 
@@ -547,18 +786,23 @@ void PlumeScreenBins::Trace2Impl(const List& l, const glm::vec3& dir, float rang
     const auto load = [&](int f, size_t k) {
         return Load4<Copied>(l.data[f], data_[f].data(), l.index.data(), k);
     };
-    Accumulators acc;
-    BandAccumulator &a1 = acc.first, &a2 = acc.second;
-    size_t k = 0;
 #ifdef SEASENSE_PLUME_WIDE
-    if (wide_) k = TraceWide<Copied, Two>(l, dir, range_m, range2_m, acc);
+    if (wide_) {
+        TraceWide<Copied, Two>(l, dir, range_m, range2_m, first, second);
+        return;
+    }
 #endif
+    // The even groups' sums and the odd groups'.
+    BandAccumulator even1, even2, odd1, odd2;
+    size_t k = 0;
     const F4 dx = _mm_set1_ps(dir.x), dy = _mm_set1_ps(dir.y), dz = _mm_set1_ps(dir.z);
     const F4 dh2 = _mm_set1_ps(dir.x * dir.x + dir.y * dir.y), dz2 = _mm_set1_ps(dir.z * dir.z);
     const F4 end = _mm_set1_ps(std::max(range_m, range2_m));
     const F4 r1 = _mm_set1_ps(range_m), r2 = _mm_set1_ps(range2_m);
     const F4 zero = _mm_setzero_ps(), half = _mm_set1_ps(0.5f);
-    for (; k < l.index.size(); k += 4) {
+    // One group of four puffs from k on, into a1 (and a2).
+    const auto group = [&](size_t k, BandAccumulator & a1, BandAccumulator & a2)
+        __attribute__((always_inline)) {
         const F4 qx = load(kQx, k), qy = load(kQy, k), qz = load(kQz, k);
         const F4 ivh = load(kIvh, k), ivz = load(kIvz, k);
         const F4 A = _mm_add_ps(_mm_mul_ps(dh2, ivh), _mm_mul_ps(dz2, ivz));
@@ -575,7 +819,7 @@ void PlumeScreenBins::Trace2Impl(const List& l, const glm::vec3& dir, float rang
                        _mm_mul_ps(_mm_mul_ps(rz, rz), ivz));
         const F4 use =
             _mm_and_ps(_mm_cmple_ps(m2, load(kCutoff2, k)), _mm_cmplt_ps(load(kNear, k), end));
-        if (_mm_movemask_ps(use) == 0) continue;
+        if (_mm_movemask_ps(use) == 0) return;
         const F4 scale = _mm_sqrt_ps(_mm_mul_ps(half, A));
         const F4 u0 = _mm_sub_ps(zero, _mm_mul_ps(sStar, scale));
         const F4 amplitude = _mm_div_ps(
@@ -591,9 +835,15 @@ void PlumeScreenBins::Trace2Impl(const List& l, const glm::vec3& dir, float rang
             const F4 tau2 = _mm_mul_ps(amplitude, _mm_sub_ps(e2, e0));
             a2.Add(w, _mm_and_ps(_mm_and_ps(use, _mm_cmpgt_ps(tau2, zero)), tau2));
         }
+    };
+    // The even groups into the first accumulators, the odd ones into the second (k is a
+    // multiple of 8 here).
+    for (; k < l.index.size(); k += 8) {
+        group(k, even1, even2);
+        if (k + 4 < l.index.size()) group(k + 4, odd1, odd2);
     }
-    first = a1.Result();
-    second = Two ? a2.Result() : first;
+    first = Result(even1, odd1);
+    second = Two ? Result(even2, odd2) : first;
 }
 
 BandTrace PlumeScreenBins::Trace(const List& list, const glm::vec3& dir, float range_m) const {

@@ -30,19 +30,25 @@ struct BandTrace {
 inline constexpr float kPlumeTransmittanceTolerance = 1.0e-3f;
 
 // The puffs of a field projected through a camera (output pixels, ENU world). A puff whose
-// optical depth along any line stays at or below the per-puff tolerance ε = tolerance / (number
-// of puffs in the field) is dropped; any other puff i contributes at most ε to a ray that passes
-// outside its ellipsoid of Mahalanobis radius r_i, τ_max,i e^(−r_i²/2) = ε (τ_max,i its optical
-// depth through the centre along its longest axis; the part of any ray outside the ellipsoid
-// carries at most ε of it, because erfc x ≤ e^(−x²)). Each kept puff's ellipsoid bounds a box
-// whose screen rectangle (widened by a pixel; the whole screen if the box reaches behind the
-// near plane) is binned into kTile × kTile tiles. A ray through pixel (px, py) then loops only
-// over the puffs whose rectangles contain the pixel, and a puff whose box lies entirely beyond
-// the ray's end is skipped; everything skipped adds at most ε each, so the trace's optical depth
-// is within tolerance of the exact sum over all puffs and T within tolerance of e^(−τ_exact)
-// (|e^(−a) − e^(−b)| ≤ |a − b|), plus float rounding and the 1.5e-7 error of the erf
-// approximation. Pixel coordinates run over [0, width + kMargin) × [0, height + kMargin): the
-// extra columns and rows serve interpolation nodes beyond the far edges.
+// optical depth along every ray from the eye through the bin area is bounded by b ≤ 1e-3
+// tolerance / (number of puffs in the field) is out of view: dropped, b counted in Σb. The
+// others share the rest: one whose optical depth along any line stays at or below the
+// per-puff tolerance ε = (tolerance − Σb) / (number of puffs in view) is dropped; any other
+// puff i contributes at most ε to a ray that passes outside its ellipsoid of Mahalanobis
+// radius r_i, τ_max,i e^(−r_i²/2) = ε (τ_max,i its optical depth through the centre along its
+// longest axis; the part of any ray outside the ellipsoid carries at most ε of it, because
+// erfc x ≤ e^(−x²)). Each kept puff's ellipsoid bounds a box whose screen rectangle (the
+// ellipsoid's exact extent when it lies wholly in front of the eye, widened by a pixel; else
+// the box's; the whole screen if the box reaches behind the near plane) is binned into
+// kTile × kTile tiles; where the ellipsoid lies in front, the ellipse it projects to narrows
+// the lists further. A ray through pixel (px, py) then loops only over the puffs whose
+// footprints contain the pixel, and a puff whose box lies entirely beyond the ray's end is
+// skipped; everything skipped adds at most ε each (the out-of-view puffs Σb in all), so the
+// trace's optical depth is within tolerance of the exact sum over all puffs and T within
+// tolerance of e^(−τ_exact) (|e^(−a) − e^(−b)| ≤ |a − b|), plus float rounding and the 1.5e-7
+// error of the erf approximation. Pixel coordinates run over [0, width + kMargin) ×
+// [0, height + kMargin): the extra columns and rows serve interpolation nodes beyond the far
+// edges.
 class PlumeScreenBins {
   public:
     static constexpr int kTile = 32;   // pixels
@@ -51,17 +57,22 @@ class PlumeScreenBins {
     PlumeScreenBins(const scene::PlumeField& field, const ChannelCamera& camera,
                     scene::ObscurantBand band, float tolerance = kPlumeTransmittanceTolerance);
 
-    // Per-puff optical-depth tolerance ε.
+    // Per-puff optical-depth tolerance ε (the tolerance shared by the puffs in view).
     float PuffTolerance() const { return puffTolerance_; }
     size_t KeptPuffs() const { return kept_.size(); }
+    // The field's index of the puff at kept position k (a list's index entries).
+    uint32_t FieldIndex(uint32_t k) const { return kept_[k]; }
     size_t BinEntries() const { return tileEntries_.size(); }
 
-    // The puffs whose rectangles overlap the pixel rectangle [x0, x1) × [y0, y1) (at most 2 × 2
-    // tiles), in field order, padded with an inert puff to a multiple of 4; with the nearest
-    // and farthest range (m) where they can matter and the sum of the largest optical depths
-    // (through the centre along the longest axis) of those with σ under smallPixels pixels at
-    // their distance (and of those under half that). With copy, their data is also gathered into
-    // contiguous arrays (worth it when the list serves many rays).
+    // The puffs whose footprints reach the pixel rectangle [x0, x1) × [y0, y1) (at most 2 × 2
+    // tiles): their rectangles overlap it and, for those with a screen ellipse, the ellipse
+    // widened by the rectangle's half diagonal reaches its centre (so every puff whose cutoff
+    // ellipsoid a ray through one of its pixels meets is there), in field order, padded with an
+    // inert puff to a multiple of 4; with the nearest and farthest range (m) where they can matter
+    // and the sum of the largest optical depths (through the centre along the longest axis) of
+    // those with σ under smallPixels pixels at their distance (and of those under half that). With
+    // copy, their data is also gathered into contiguous arrays (worth it when the list serves many
+    // rays).
     struct List {
         size_t count = 0;  // puffs (index and the arrays hold count rounded up to 4)
         float near_m = 0.0f, far_m = 0.0f;
@@ -133,20 +144,37 @@ class PlumeScreenBins {
     };
     std::vector<float> data_[kFields];
     std::vector<uint32_t> kept_;
-    std::vector<Rect> rect_;
-    std::vector<float> far_, sigmaPixels_, tauMax_;
+    // What list building reads of a kept puff, in one record: its screen rectangle; the
+    // ellipse of its cutoff ellipsoid on the screen, (p − centre)ᵀ Q (p − centre) ≤ 1 in pixel
+    // coordinates (p = (px + ½, py + ½) the centre of pixel (px, py)), with √λmax(Q) (all zero
+    // where the rectangle alone decides: the ellipsoid reaches behind the near plane); the
+    // nearest and farthest range; σ in pixels at its distance; its largest optical depth.
+    struct Footprint {
+        Rect rect;
+        float centreX, centreY, qxx, qxy, qyy, sqrtLambdaMax;
+        float near_m, far_m, sigmaPixels, tauMax;
+    };
+    std::vector<Footprint> footprint_;
+    // The centres o_x of the rectangles of half diagonal rho in the row of centre centreY that
+    // fp's ellipse can reach: [lo, hi] (conservative), or none (false).
+    static bool EllipseSpan(const Footprint& fp, float centreY, float rho, double& lo, double& hi);
+    // Whether puff k's rectangle overlaps [x0, x1) × [y0, y1) and its ellipse can reach it
+    // (rho: the rectangle's half diagonal, HalfDiagonal in plume_bins.cpp); Add puts it in a
+    // list.
+    bool Reaches(uint32_t k, int x0, int y0, int x1, int y1, float rho) const;
+    void Add(uint32_t k, float smallPixels, List& out) const;
     uint32_t inert_ = 0;
-    // Starts out's list for the rectangle and adds puff k to it if its rectangle overlaps.
+    // Starts out's list for the rectangle and adds puff k to it if it Reaches the rectangle.
     static void Begin(List& out);
-    void Take(uint32_t k, int x0, int y0, int x1, int y1, float smallPixels, List& out) const;
+    void Take(uint32_t k, int x0, int y0, int x1, int y1, float rho, float smallPixels,
+              List& out) const;
     void Finish(bool copy, List& out) const;
     bool wide_ = false;
-    struct Accumulators;  // one trace's sums (plume_bins.cpp)
-    // Eight puffs at a time from the start of the list while eight remain; returns where the
-    // four-lane loop goes on.
+    // Trace2Impl where the CPU has AVX2: eight puffs at a time (a last four with the inert
+    // puff), summed as the four-lane loop sums them.
     template <bool Copied, bool Two>
-    size_t TraceWide(const List& list, const glm::vec3& dir, float range_m, float range2_m,
-                     Accumulators& acc) const;
+    void TraceWide(const List& list, const glm::vec3& dir, float range_m, float range2_m,
+                   BandTrace& first, BandTrace& second) const;
     // Two: the second range differs from the first (a separate loop without it keeps the
     // accumulators of one trace in registers).
     template <bool Copied, bool Two>

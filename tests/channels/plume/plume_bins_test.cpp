@@ -1,6 +1,8 @@
 // Tests of the screen-space puff bins: traces within the stated transmittance tolerance of the
 // exact sum over every puff (no cutoff, double-precision erf) for committed plumes and for a
-// thick flame puff, lists taken from larger lists (one rectangle or a row of them) equal to
+// thick flame puff and for a view of part of the plumes (whose puffs out of view no longer
+// share the tolerance), lists holding every puff whose cutoff ellipsoid their rays meet (and
+// little more), lists taken from larger lists (one rectangle or a row of them) equal to
 // lists from the tiles, eight-lane traces equal to four-lane ones, and the dropping of puffs
 // too thin to matter.
 #include "channels/plume/plume_bins.h"
@@ -119,6 +121,22 @@ TEST(PlumeScreenBins, CommittedPlumesWithinToleranceOfTheExactSum) {
     }
 }
 
+// A narrow view of part of the plumes: the puffs out of view (bounded by their Mahalanobis
+// distance to the view's pyramid) no longer share the tolerance, so ε is larger than
+// tolerance / (puffs in the field), and traces stay within tolerance of the exact sum over
+// every puff, those out of view included.
+TEST(PlumeScreenBins, PuffsOutOfViewLeaveTheirToleranceToTheOthers) {
+    const scene::PlumeField field = CommittedPlumes();
+    const ChannelCamera cam = NorthCamera({0.0, 0.0, 20.0}, 64, 48, 8.0, 1.0);
+    const PlumeScreenBins bins(field, cam, ObscurantBand::Visible);
+    const double shared = double(kPlumeTransmittanceTolerance) / double(field.PuffCount());
+    EXPECT_GT(double(bins.PuffTolerance()), 1.5 * shared);
+    EXPECT_LT(bins.KeptPuffs(), field.PuffCount() / 2);
+    const Worst w = CompareWithExact(field, cam, ObscurantBand::Visible, kPlumeSkyRange_m);
+    EXPECT_LE(w.error, double(kPlumeTransmittanceTolerance));
+    EXPECT_GT(w.dark, 50) << w.dark;
+}
+
 // A cell's list taken from a larger rectangle's list is the list gathered from the tiles: the
 // same puffs in the same order, ranges and small-puff sums bit for bit (CompositePlumes takes
 // each 4 × 4 cell's list from its tile strip's).
@@ -186,6 +204,70 @@ TEST(PlumeScreenBins, GatherRowEqualsGatherPerRectangle) {
     }
     EXPECT_GT(nonEmpty, 300u);
     EXPECT_GT(nonEmpty * 10, compared);  // the plumes fill a good part of the view
+}
+
+// A cell's list holds every puff whose cutoff ellipsoid (τ_max e^(−r²/2) = ε) a ray through
+// the cell meets: the squared Mahalanobis distance of the ray's closest approach, in double
+// precision, m² = min_s |q + s d|²_M ≤ r², checked for the rays through every pixel centre
+// of 5 × 5-pixel cells (as CompositePlumes gathers them) and through points 0.45 pixel from
+// them. And the lists are tight: the puffs they hold are at most 1.6 times the (puff, cell)
+// pairs where such a ray meets the ellipsoid (the screen rectangles alone, which also take
+// the corners between the ellipse and its bounding box, gave 1.77 times as many).
+TEST(PlumeScreenBins, ListsHoldEveryPuffWhoseCutoffEllipsoidARayMeets) {
+    const scene::PlumeField field = CommittedPlumes();
+    const ChannelCamera cam = NorthCamera({0.0, 0.0, 20.0}, 96, 72, 40.0, 3.0);
+    const PlumeScreenBins bins(field, cam, ObscurantBand::Visible);
+    const double eps = bins.PuffTolerance();
+    const glm::dvec3 eye = cam.worldFromCamera.position_m;
+    // Each puff's centre, inverse variances and r² (none when it is dropped: τ_max ≤ ε).
+    struct Ellipsoid {
+        glm::dvec3 q, m;
+        double r2 = -1.0;
+    };
+    std::vector<Ellipsoid> ellipsoid(field.PuffCount());
+    for (size_t i = 0; i < field.PuffCount(); ++i) {
+        const scene::Puff p = field.PuffAt(i);
+        const double alpha = field.Optics(p.plume).massExtinction_m2pkg[0];
+        const double sh = p.sigmaH_m, sz = p.sigmaZ_m;
+        const double peak = p.mass_kg / (std::pow(2.0 * std::numbers::pi, 1.5) * sh * sh * sz);
+        const double tauMax = alpha * peak * std::sqrt(2.0 * std::numbers::pi) * std::max(sh, sz);
+        ellipsoid[i].q = eye - p.centre_m;
+        ellipsoid[i].m = {1.0 / (sh * sh), 1.0 / (sh * sh), 1.0 / (sz * sz)};
+        if (tauMax > eps) ellipsoid[i].r2 = 2.0 * std::log(tauMax / eps);
+    }
+    const auto Meets = [&](const Ellipsoid& e, const glm::dvec3& d) {
+        const double s = -glm::dot(d, e.m * e.q) / glm::dot(d, e.m * d);
+        const glm::dvec3 r = e.q + s * d;
+        return glm::dot(r, e.m * r) <= e.r2;
+    };
+    PlumeScreenBins::List list;
+    size_t listed = 0, met = 0, cells = 0;
+    std::vector<uint8_t> inList(field.PuffCount());
+    for (int y0 = 0; y0 <= cam.height; y0 += 4) {
+        for (int x0 = 0; x0 <= cam.width; x0 += 4) {
+            bins.Gather(x0, y0, x0 + 5, y0 + 5, 4.0f, false, list);
+            std::fill(inList.begin(), inList.end(), 0);
+            for (size_t j = 0; j < list.size(); ++j) inList[bins.FieldIndex(list.index[j])] = 1;
+            listed += list.size();
+            ++cells;
+            for (size_t i = 0; i < field.PuffCount(); ++i) {
+                if (ellipsoid[i].r2 < 0.0) continue;
+                bool metHere = false;
+                for (int y = y0; y < y0 + 5; ++y)
+                    for (int x = x0; x < x0 + 5; ++x)
+                        for (const double jitter : {0.0, -0.45, 0.45}) {
+                            // SampleDirection(px, py) is the ray through pixel (px, py)'s centre.
+                            const glm::dvec3 d = cam.SampleDirection(x + jitter, y - jitter);
+                            if (!Meets(ellipsoid[i], d)) continue;
+                            EXPECT_TRUE(inList[i]) << "puff " << i << " pixel " << x << ", " << y;
+                            metHere |= jitter == 0.0;
+                        }
+                met += metHere;
+            }
+        }
+    }
+    EXPECT_GT(met, 5 * cells);  // a test with something in it
+    EXPECT_LE(double(listed), 1.6 * double(met)) << listed << " listed, " << met << " met";
 }
 
 // Eight puffs at a time (AVX2) or four (SSE2): the same traces bit for bit, gathered and
