@@ -230,11 +230,15 @@ void Intensifier::Process(const Image& samples, double time_s, int64_t frame) {
     lastTime_s_ = time_s;
 
     // Scintillation: S = F · Poisson(N/F), mean N, variance F·N (SNR √(N/F)); one hash of
-    // (seed, frame, pixel) per pixel.
+    // (seed, frame, pixel) per pixel inside the field stop (outside, N = 0: no electrons).
     const double F = s_.noiseFactor;
     const double scale = pePerRadiance_ * duty_ / F;
     tbb::parallel_for(0, h, [&](int y) {
-        for (int x = 0; x < w; ++x) {
+        const PixelSpan span = spans_[size_t(y)];
+        float* row = electrons_.At(0, y);
+        std::fill(row, row + span.begin, 0.0f);
+        std::fill(row + span.end, row + w, 0.0f);
+        for (int x = span.begin; x < span.end; ++x) {
             const size_t i = size_t(y) * size_t(w) + size_t(x);
             const uint64_t bits = scene::HashBits(s_.seed, uint64_t(frame), i);
             electrons_.pixels[i] =

@@ -43,8 +43,6 @@ class Intensifier {
     double Gain() const { return gain_; }
     double Duty() const { return duty_; }
     double MeanPhotoelectrons() const { return meanPe_; }
-    // The pixels inside the field stop per row (FieldStopSpans of the settings).
-    const std::vector<PixelSpan>& FieldSpans() const { return spans_; }
     // Whether pixel (x, y) lies inside the circular field stop.
     bool InField(int x, int y) const { return mask_[size_t(y) * size_t(s_.width_px) + size_t(x)]; }
     // Halo radius and tube-MTF Gaussian σ in pixels.
@@ -58,7 +56,7 @@ class Intensifier {
     double pePerRadiance_ = 0.0;
     double haloRadius_px_ = 0.0, mtfSigma_px_ = 0.0;
     std::vector<float> mtfKernel_;
-    std::vector<PixelSpan> spans_;
+    std::vector<PixelSpan> spans_;  // FieldStopSpans of the settings
     std::vector<uint8_t> mask_;
     size_t fieldCount_ = 0;  // pixels inside the field stop
     Image radiance_, electrons_, halo_, brightness_;
