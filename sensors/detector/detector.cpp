@@ -4,7 +4,10 @@
 #include <emmintrin.h>
 #include <tbb/parallel_for.h>
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
+#include <numbers>
 #include <vector>
 
 #include "radiometry/color/rec709.h"
@@ -71,13 +74,32 @@ double LogAverageLuminance(const Image& rgb) {
     // Row sums first, then a serial sum of rows: the same order for any thread count.
     std::vector<double> rowSums(size_t(rgb.height), 0.0);
     tbb::parallel_for(0, rgb.height, [&](int y) {
+        // Σ ln v = Σ_blocks ln(Π m) + (Σ e) ln 2 for v = m·2^e, m ∈ [1, 2): one logarithm per
+        // kBlock pixels instead of one per pixel (the logarithms were ~2.5 % of an OTW frame).
+        // v ≥ 1e-4 is a normal double, and a block's product of mantissas lies in [1, 2^16),
+        // so it neither overflows nor underflows; it differs from the sum of the logarithms
+        // by rounding only (~kBlock ulp of the block's product).
+        constexpr int kBlock = 16;
+        constexpr uint64_t kMantissa = (uint64_t(1) << 52) - 1, kExponentOne = uint64_t(1023) << 52;
         double s = 0.0;
-        for (int x = 0; x < rgb.width; ++x) {
-            const float* p = rgb.At(x, y);
-            const double Y = radiometry::LuminanceRec709({p[0], p[1], p[2]});
-            s += std::log(1e-4 + std::max(Y, 0.0));
+        int64_t exponents = 0;
+        for (int x0 = 0; x0 < rgb.width; x0 += kBlock) {
+            double product = 1.0;
+            for (int x = x0; x < std::min(rgb.width, x0 + kBlock); ++x) {
+                const float* p = rgb.At(x, y);
+                const double Y = radiometry::LuminanceRec709({p[0], p[1], p[2]});
+                const double v = 1e-4 + std::max(Y, 0.0);
+                const uint64_t bits = std::bit_cast<uint64_t>(v);
+                if ((bits >> 52) == 0x7ff) {  // inf or NaN: the sum is too, as Σ ln v would be
+                    product *= v;
+                    continue;
+                }
+                exponents += int64_t(bits >> 52) - 1023;  // the sign bit is 0
+                product *= std::bit_cast<double>((bits & kMantissa) | kExponentOne);
+            }
+            s += std::log(product);
         }
-        rowSums[size_t(y)] = s;
+        rowSums[size_t(y)] = s + double(exponents) * std::numbers::ln2;
     });
     double total = 0.0;
     for (double s : rowSums) total += s;

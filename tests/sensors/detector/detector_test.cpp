@@ -3,7 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace seasense::sensors {
 namespace {
@@ -57,6 +59,35 @@ TEST(Detector, AutoExposureMapsGeometricMeanLuminanceToKey) {
             for (int c = 0; c < 3; ++c) img.At(x, y)[c] = (x + y) % 2 ? 10.0f : 1000.0f;
     EXPECT_NEAR(LogAverageLuminance(img), 100.0, 1e-3);
     EXPECT_NEAR(AutoExposureEv(img, 0.18), std::log2(0.18 / 100.0), 1e-5);
+}
+
+TEST(Detector, LogAverageLuminanceIsTheGeometricMeanOverTwentyDecades) {
+    // Luminances from 1e-6 to 1e13 cd/m² (below δ, night sky, day, the sun's disc), with
+    // black and a row width that is not a multiple of the blocks LogAverageLuminance uses:
+    // exp of the mean of ln(δ + Y), summed here one logarithm per pixel in long double.
+    Image img(37, 5, 3);
+    long double sum = 0.0L;
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x) {
+            const int k = y * img.width + x;
+            const float Y =
+                k % 11 == 0 ? 0.0f : float(std::pow(10.0, -6.0 + 19.0 * (k % 97) / 96.0));
+            for (int c = 0; c < 3; ++c) img.At(x, y)[c] = Y;  // grey: luminance Y
+            sum += std::log(1e-4L + (long double)(img.At(x, y)[0]) * 0.2126L +
+                            (long double)(img.At(x, y)[1]) * 0.7152L +
+                            (long double)(img.At(x, y)[2]) * 0.0722L);
+        }
+    const double expected = double(std::exp(sum / (img.width * img.height)));
+    EXPECT_NEAR(LogAverageLuminance(img) / expected, 1.0, 1e-12);
+}
+
+TEST(Detector, LogAverageLuminanceOfANonFiniteImageIsNotFinite) {
+    Image img(20, 2, 3);
+    std::fill(img.pixels.begin(), img.pixels.end(), 5.0f);
+    img.At(17, 1)[1] = std::numeric_limits<float>::infinity();
+    EXPECT_TRUE(std::isinf(LogAverageLuminance(img)));
+    img.At(3, 0)[0] = std::numeric_limits<float>::quiet_NaN();
+    EXPECT_TRUE(std::isnan(LogAverageLuminance(img)));
 }
 
 TEST(Detector, AdaptedExposureKeepsNightDarkerThanDay) {
