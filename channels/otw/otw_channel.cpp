@@ -323,7 +323,7 @@ struct CachedTriangle {
 struct BlockScratch {
     std::vector<uint32_t> skyK, seaK, modelK;                     // see kPixelEntry
     std::vector<float> skyX, skyY, skyZ;                          // view directions of sky entries
-    std::vector<float> seaPx, seaPy, seaPz, seaNx, seaNy, seaNz;  // unit normals
+    std::vector<float> seaPx, seaPy, seaPz, seaNx, seaNy, seaNz;  // normals (unit once shaded)
     std::vector<float> seaDepth, seaWet, seaFoam;                 // OceanAttributes interpolated
     std::vector<float> seaLit;      // lit fraction of a sea entry's samples
     std::vector<uint8_t> seaUnlit;  // samples of a sea entry found in shadow
@@ -649,14 +649,13 @@ class BlockClassifier {
         return true;
     }
 
-    // A lit sea entry at position p with normal nSum (normalized here); returns its index.
+    // A lit sea entry at position p with normal nSum (unnormalized: ShadeSea normalizes the
+    // block's normals four at a time, off this loop's critical path); returns its index.
     size_t AddSea(uint32_t k, F4 p, F4 nSum, F4 attributes) {
-        // glm::normalize: v · (1 / √(v·v)).
-        const F4 inv = _mm_div_ss(Set4(1.0f), _mm_sqrt_ss(_mm_set_ss(Dot3(nSum, nSum))));
         alignas(16) float pf[4], nf[4], af[4];
         _mm_store_ps(pf, p);
         _mm_store_ps(af, attributes);
-        _mm_store_ps(nf, _mm_mul_ps(nSum, _mm_shuffle_ps(inv, inv, 0)));
+        _mm_store_ps(nf, nSum);
         const size_t e = sc_.seaCount++;
         sc_.seaK[e] = k;
         sc_.seaPx[e] = pf[0], sc_.seaPy[e] = pf[1], sc_.seaPz[e] = pf[2];
@@ -670,7 +669,10 @@ class BlockClassifier {
     // Shadow rays of sea entry e, one per sample at positions samples[0..count), offset along
     // the entry's normal.
     void SeaShadowRays(size_t e, const F4* samples, int count) {
-        const glm::vec3 nrm(sc_.seaNx[e], sc_.seaNy[e], sc_.seaNz[e]);
+        // The entry's unit normal as Normalize makes it for shading: glm::normalize's
+        // v · (1 / √(v·v)) with v·v summed (x + y) + z, the same operations lane for lane.
+        const glm::vec3 v(sc_.seaNx[e], sc_.seaNy[e], sc_.seaNz[e]);
+        const glm::vec3 nrm = v * (1.0f / std::sqrt((v.x * v.x + v.y * v.y) + v.z * v.z));
         for (int s = 0; s < count; ++s) {
             const glm::vec3 origin = ShadowRayOrigin(Store3(samples[s]), nrm);
             if (f_.casters.MayHit(origin) && f_.occlusion.MayOcclude(origin, f_.keyDir, 1e30f)) {
@@ -792,6 +794,7 @@ void ShadeSea(const FrameShading& f, const FrameGeometry& g, BlockScratch& sc, f
         const size_t count = std::min(kChunk, sc.seaCount - c);
         SeaChunk& ch = sc.chunk;
         std::copy_n(&sc.seaLit[c], count, ch.sunVis);
+        Normalize(count, &sc.seaNx[c], &sc.seaNy[c], &sc.seaNz[c]);
         f.sea.Shade(count, &sc.seaPx[c], &sc.seaPy[c], &sc.seaPz[c], &sc.seaNx[c], &sc.seaNy[c],
                     &sc.seaNz[c], &sc.seaDepth[c], &sc.seaWet[c], &sc.seaFoam[c], ch);
         for (size_t i = 0; i < count; ++i)
