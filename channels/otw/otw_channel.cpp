@@ -885,6 +885,7 @@ OtwChannel::OtwChannel(const scene::World& world, const scene::ChannelSettings& 
     for (const PixelSpan& span : renderSpans)
         CHECK(0 <= span.begin && span.begin <= span.end && span.end <= settings.width);
     renderSpans_ = std::move(renderSpans);
+    geometry_.SetRenderSpans(renderSpans_);
     basis_ = std::make_unique<OtwBandBasis>(basis);
     reflectance_ = basis.reflectance;
     for (int c = 0; c < 3; ++c) shore_[c] = basis.shore[c];

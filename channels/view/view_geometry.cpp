@@ -36,24 +36,33 @@ void ForEachFrustumBoundaryDirection(const ChannelCamera& cam, Fn&& fn) {
     }
 }
 
+// Whether the world direction dir lies inside the frustum.
+bool FrustumContains(const ChannelCamera& cam, const glm::dvec3& dir) {
+    const glm::dvec3 c = glm::transpose(cam.worldFromCamera.worldFromBody) * dir;
+    if (c.y <= 0.0) return false;  // behind the camera
+    return std::abs(c.x / c.y) <= cam.TanHalfH() && std::abs(c.z / c.y) <= cam.TanHalfV();
+}
+
 // Whether the straight-down direction lies inside the frustum (its boundary winds around it).
 bool FrustumContainsNadir(const ChannelCamera& cam) {
-    const glm::dvec3 down =
-        glm::transpose(cam.worldFromCamera.worldFromBody) * glm::dvec3(0, 0, -1);
-    if (down.y <= 0.0) return false;  // behind the camera
-    return std::abs(down.x / down.y) <= cam.TanHalfH() &&
-           std::abs(down.z / down.y) <= cam.TanHalfV();
+    return FrustumContains(cam, glm::dvec3(0, 0, -1));
 }
 
 }  // namespace
 
-void FrustumAzimuthSector(const ChannelCamera& cam, double margin, double& lo, double& hi) {
+namespace {
+
+// The azimuth sector of the directions forEach(fn) passes to fn (their boundary suffices: see
+// the callers), relative to the camera's axis, widened by margin; [0, 2π] when one lies close
+// to the zenith or nadir.
+template <class ForEach>
+void AzimuthSector(const ChannelCamera& cam, double margin, double& lo, double& hi,
+                   ForEach&& forEach) {
     const glm::dvec3 axis = cam.worldFromCamera.worldFromBody * glm::dvec3(0, 1, 0);
     const double centre = std::atan2(axis.x, axis.y);
     double minRel = 0.0, maxRel = 0.0;
     bool full = false;
-    // The azimuth extremes of a convex cone of directions lie on its boundary.
-    ForEachFrustumBoundaryDirection(cam, [&](const glm::dvec3& d) {
+    forEach([&](const glm::dvec3& d) {
         if (std::hypot(d.x, d.y) < 0.05) {
             full = true;  // within ~3° of the zenith or nadir: all azimuths are near
             return false;
@@ -70,6 +79,44 @@ void FrustumAzimuthSector(const ChannelCamera& cam, double margin, double& lo, d
     }
     lo = centre + minRel - margin;
     hi = centre + maxRel + margin;
+}
+
+}  // namespace
+
+void FrustumAzimuthSector(const ChannelCamera& cam, double margin, double& lo, double& hi) {
+    // A frustum holding the nadir or the zenith sees every azimuth (its boundary winds around
+    // the pole, which the extremes of its sampled azimuths need not show).
+    if (FrustumContainsNadir(cam) || FrustumContains(cam, glm::dvec3(0, 0, 1))) {
+        lo = 0.0;
+        hi = 2.0 * M_PI;
+        return;
+    }
+    // The azimuth extremes of a convex cone of directions lie on its boundary.
+    AzimuthSector(cam, margin, lo, hi,
+                  [&](const auto& fn) { ForEachFrustumBoundaryDirection(cam, fn); });
+}
+
+void SpansAzimuthSector(const ChannelCamera& cam, std::span<const PixelSpan> spans, double& lo,
+                        double& hi) {
+    CHECK(spans.size() == size_t(cam.height));
+    // Where the frustum's sector is all azimuths (a pole in it or near it), so is the spans'.
+    // Else no pole lies on any image row, so along a row the azimuth of the view direction changes
+    // monotonically and a row's span reaches its extremes at its end corners: the pixels'
+    // outer edges, at sample coordinate px·N − ½ (as the frustum's boundary), on the row's top
+    // and bottom edges; and the frustum's sector, which holds them all, spans less than 2π
+    // about the axis, so their azimuths relative to it do not wrap.
+    FrustumAzimuthSector(cam, 0.0, lo, hi);
+    if (hi - lo >= 2.0 * M_PI) return;
+    const double n = cam.supersampling;
+    AzimuthSector(cam, 0.0, lo, hi, [&](const auto& fn) {
+        for (int py = 0; py < cam.height; ++py) {
+            const PixelSpan& span = spans[size_t(py)];
+            if (span.begin >= span.end) continue;
+            for (const double sy : {py * n - 0.5, (py + 1) * n - 0.5})
+                for (const double sx : {span.begin * n - 0.5, span.end * n - 0.5})
+                    if (!fn(cam.SampleDirection(sx, sy))) return;
+        }
+    });
 }
 
 double NearestVisibleSeaRange_m(const ChannelCamera& cam, double crestHeight_m,
@@ -101,12 +148,17 @@ double NearestVisibleSeaRange_m(const ChannelCamera& cam, const scene::OceanSurf
 }
 
 scene::OceanMeshRequest SeaMeshRequest(const ChannelCamera& cam,
-                                       const scene::OceanSurfaceFrame& sea) {
+                                       const scene::OceanSurfaceFrame& sea,
+                                       std::span<const PixelSpan> renderSpans) {
     scene::OceanMeshRequest req;
     req.eye_m = cam.worldFromCamera.position_m;
     req.angularStep_rad = kOceanVertexSpacing_px * cam.hfov_rad / double(cam.width);
-    // The view's own sector; the mesh widens each band by what the waves can carry sideways.
-    FrustumAzimuthSector(cam, 0.0, req.azimuthMin_rad, req.azimuthMax_rad);
+    // The view's own sector (of the rendered pixels only, where the channel renders a part of
+    // the frame); the mesh widens each band by what the waves can carry sideways.
+    if (renderSpans.empty())
+        FrustumAzimuthSector(cam, 0.0, req.azimuthMin_rad, req.azimuthMax_rad);
+    else
+        SpansAzimuthSector(cam, renderSpans, req.azimuthMin_rad, req.azimuthMax_rad);
     req.widenByReach = true;
     req.minRange_m = NearestVisibleSeaRange_m(cam, sea, req.eye_m);
     return req;
@@ -123,6 +175,11 @@ ViewGeometry::ViewGeometry(const scene::World& world, const scene::ChannelSettin
     }
     occlusion_.Commit();
     UpdateCasterBounds();
+}
+
+void ViewGeometry::SetRenderSpans(std::vector<PixelSpan> spans) {
+    CHECK(spans.empty() || spans.size() == size_t(settings_.height));
+    renderSpans_ = std::move(spans);
 }
 
 void ViewGeometry::UpdateEntities(const scene::SceneState& state) {
@@ -209,7 +266,7 @@ void ViewGeometry::Update(const scene::SceneState& state) {
     oceanFrame_ = world_.Ocean().At(state.time_s);
     const scene::OceanSurfaceFrame& sea = *oceanFrame_;
     const Clock::time_point tSea = Clock::now();
-    scene::BuildOceanMesh(sea, SeaMeshRequest(cam, sea), ocean_);
+    scene::BuildOceanMesh(sea, SeaMeshRequest(cam, sea, renderSpans_), ocean_);
     UpdateOceanAttributes();
 
     std::vector<RasterMesh> meshes;

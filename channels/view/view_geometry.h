@@ -5,11 +5,13 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "channels/camera/channel_camera.h"
 #include "channels/occlusion/occlusion.h"
 #include "channels/raster/rasterizer.h"
+#include "scene/core/image.h"
 #include "scene/models/triangle_mesh.h"
 #include "scene/ocean/ocean_mesh.h"
 #include "scene/world/world.h"
@@ -34,6 +36,10 @@ class ViewGeometry {
     // to their poses (refit only when a pose changed), the sea mesh for the view and the
     // visibility buffer. Runs in the caller's oneTBB arena; deterministic.
     void Update(const scene::SceneState& state);
+    // Limits the sea mesh to the azimuths of the pixels in spans (one per pixel row; empty: the
+    // whole frame), the only pixels the channel renders (NVG field stop). Pixels outside them
+    // may then see no sea.
+    void SetRenderSpans(std::vector<PixelSpan> spans);
 
     const ChannelCamera& Camera() const { return camera_; }
     // The last frame's visibility buffer (supersampled grid): mesh 0 is the sea, mesh i ≥ 1
@@ -76,12 +82,17 @@ class ViewGeometry {
     std::shared_ptr<const scene::OceanSurfaceFrame> oceanFrame_;
     VisibilityBuffer vis_;
     ViewFrameStats stats_;
+    std::vector<PixelSpan> renderSpans_;  // empty: every pixel
 };
 
 // Azimuth sector [min, max] (radians, clockwise from north) that the camera's frustum covers,
 // widened by margin_rad; max − min = 2π when it looks close to straight up or down.
 void FrustumAzimuthSector(const ChannelCamera& camera, double margin_rad, double& min_rad,
                           double& max_rad);
+// The same for the pixels of spans (one per pixel row of the camera), e.g. an NVG channel's
+// field stop: no wider than FrustumAzimuthSector.
+void SpansAzimuthSector(const ChannelCamera& camera, std::span<const PixelSpan> spans,
+                        double& min_rad, double& max_rad);
 
 // Horizontal distance (m) inside which no sea can be seen by the camera: the steepest
 // downward view ray meets the plane of the highest crest, less a 20 % margin and the waves'
@@ -95,9 +106,11 @@ double NearestVisibleSeaRange_m(const ChannelCamera& camera, const scene::OceanS
                                 const glm::dvec3& eye_m);
 
 // The sea mesh a channel asks for (ViewGeometry, and the mesh benchmarks): vertices 6 pixels
-// apart on screen, the camera's own azimuth sector widened per band by the waves' reach
+// apart on screen, the camera's own azimuth sector (that of renderSpans when given, one per
+// pixel row: the pixels the channel renders) widened per band by the waves' reach
 // (OceanMeshRequest::widenByReach), starting at the nearest visible range of this frame's sea.
 scene::OceanMeshRequest SeaMeshRequest(const ChannelCamera& camera,
-                                       const scene::OceanSurfaceFrame& sea);
+                                       const scene::OceanSurfaceFrame& sea,
+                                       std::span<const PixelSpan> renderSpans = {});
 
 }  // namespace seasense::channels

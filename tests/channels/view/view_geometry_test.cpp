@@ -5,8 +5,11 @@
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <string>
+#include <vector>
 
 namespace seasense::channels {
 namespace {
@@ -40,15 +43,48 @@ scene::Scenario SpectralSea(double eyeHeight_m, double pitch_deg, double roll_de
     return sc;
 }
 
+// Samples of view's last frame (only those of the pixels in spans, one per pixel row, when
+// given) that look below the horizon of the highest crest by more than two samples: each must
+// meet the sea (a sphere of mean radius R whose surface lies within ±MaxHeight); one that sees
+// nothing looks through a crack. Returns how many it checked.
+int CheckNoGapBelowTheHorizon(const ViewGeometry& view, const std::vector<PixelSpan>& spans,
+                              const std::string& what) {
+    const ChannelCamera& cam = view.Camera();
+    const VisibilityBuffer& vis = view.Visibility();
+    const double crest = view.OceanFrame().MaxHeight_m();
+    const glm::dvec3 eye = cam.worldFromCamera.position_m;
+    const double h = eye.z;
+    // The eye is above the water (below it, the sea is seen from underneath: culled).
+    EXPECT_GT(h, view.OceanFrame().HeightAt(eye.x, eye.y) + 0.3) << what;
+    // Dip of the horizon of a point at height h + crest above a trough-level sphere.
+    const double dip = std::acos(scene::kEarthRadius_m / (scene::kEarthRadius_m + h + crest));
+    const double margin = 2.0 * cam.hfov_rad / cam.SampleWidth();  // two samples
+    const int n = cam.supersampling;
+    int checked = 0;
+    for (int y = 0; y < cam.SampleHeight(); ++y)
+        for (int x = 0; x < cam.SampleWidth(); ++x) {
+            if (!spans.empty() &&
+                (x / n < spans[size_t(y / n)].begin || x / n >= spans[size_t(y / n)].end))
+                continue;
+            const glm::dvec3 d = cam.SampleDirection(x, y);
+            if (d.z > -std::sin(dip + margin)) continue;
+            ++checked;
+            EXPECT_NE(vis.primitive[vis.Index(x, y)], kNoPrimitive)
+                << what << " sample " << x << "," << y;
+            if (vis.primitive[vis.Index(x, y)] == kNoPrimitive) return checked;
+        }
+    return checked;
+}
+
+struct ViewCase {
+    double height, pitch, roll;
+};
+constexpr ViewCase kViewCases[] = {
+    {2.0, -2.0, 0.0}, {2.0, -30.0, 25.0}, {40.0, -10.0, -40.0}, {300.0, -89.0, 0.0}};
+
 TEST(ViewGeometry, SeaMeshLeavesNoGapBelowTheHorizon) {
-    // A ray that dips below the horizon of the highest crest by more than a small margin must
-    // meet the sea (a sphere of mean radius R whose surface lies within ±MaxHeight): any sample
-    // there that sees nothing looks through a crack. Several attitudes, eye heights and frames.
-    struct Case {
-        double height, pitch, roll;
-    };
-    for (const Case c : {Case{2.0, -2.0, 0.0}, Case{2.0, -30.0, 25.0}, Case{40.0, -10.0, -40.0},
-                         Case{300.0, -89.0, 0.0}}) {
+    // Several attitudes, eye heights and frames.
+    for (const ViewCase c : kViewCases) {
         const scene::Scenario sc = SpectralSea(c.height, c.pitch, c.roll);
         const scene::World world(sc);
         ViewGeometry view(world, sc.channels[0]);
@@ -56,29 +92,81 @@ TEST(ViewGeometry, SeaMeshLeavesNoGapBelowTheHorizon) {
         int checked = 0;
         for (int64_t frame : {0, 17}) {
             arena.execute([&] { view.Update(world.State(frame)); });
-            const ChannelCamera& cam = view.Camera();
-            const VisibilityBuffer& vis = view.Visibility();
-            const double crest = view.OceanFrame().MaxHeight_m();
-            const glm::dvec3 eye = cam.worldFromCamera.position_m;
-            const double h = eye.z;
-            // The eye is above the water (below it, the sea is seen from underneath: culled).
-            ASSERT_GT(h, view.OceanFrame().HeightAt(eye.x, eye.y) + 0.3);
-            // Dip of the horizon of a point at height h + crest above a trough-level sphere.
-            const double dip =
-                std::acos(scene::kEarthRadius_m / (scene::kEarthRadius_m + h + crest));
-            const double margin = 2.0 * cam.hfov_rad / cam.SampleWidth();  // two samples
-            for (int y = 0; y < cam.SampleHeight(); ++y)
-                for (int x = 0; x < cam.SampleWidth(); ++x) {
-                    const glm::dvec3 d = cam.SampleDirection(x, y);
-                    if (d.z > -std::sin(dip + margin)) continue;
-                    ++checked;
-                    ASSERT_NE(vis.primitive[vis.Index(x, y)], kNoPrimitive)
-                        << "height " << c.height << " pitch " << c.pitch << " roll " << c.roll
-                        << " frame " << frame << " sample " << x << "," << y;
-                }
+            checked += CheckNoGapBelowTheHorizon(
+                view, {},
+                "height " + std::to_string(c.height) + " pitch " + std::to_string(c.pitch) +
+                    " roll " + std::to_string(c.roll) + " frame " + std::to_string(frame));
         }
         EXPECT_GT(checked, 10000) << c.height;
     }
+}
+
+// Pixels whose centres lie within radius_px of the image centre, row by row (an NVG channel's
+// circular field stop).
+std::vector<PixelSpan> DiscSpans(int width, int height, double radius_px) {
+    std::vector<PixelSpan> spans(static_cast<size_t>(height));
+    for (int y = 0; y < height; ++y) {
+        const double dy = y + 0.5 - 0.5 * height;
+        if (std::abs(dy) > radius_px) continue;
+        const double half = std::sqrt(radius_px * radius_px - dy * dy);
+        // Pixel x is inside when |x + ½ − width/2| ≤ half.
+        spans[size_t(y)].begin = std::max(0, int(std::ceil(0.5 * width - half - 0.5)));
+        spans[size_t(y)].end = std::min(width, int(std::floor(0.5 * width + half - 0.5)) + 1);
+    }
+    return spans;
+}
+
+TEST(ViewGeometry, SeaMeshLimitedToRenderSpansLeavesNoGapInThem) {
+    // A disc of pixels filling the frame's height (an NVG field stop): the sea mesh asked only
+    // for their azimuths still meets every ray through them that must meet the sea, in the
+    // attitudes above; and its sector is the disc's.
+    for (const ViewCase c : kViewCases) {
+        const scene::Scenario sc = SpectralSea(c.height, c.pitch, c.roll);
+        const scene::ChannelSettings& ch = sc.channels[0];
+        const std::vector<PixelSpan> spans = DiscSpans(ch.width, ch.height, 0.5 * ch.height);
+        const scene::World world(sc);
+        ViewGeometry view(world, ch);
+        view.SetRenderSpans(spans);
+        tbb::task_arena arena(2);
+        int checked = 0;
+        for (int64_t frame : {0, 17}) {
+            arena.execute([&] { view.Update(world.State(frame)); });
+            checked += CheckNoGapBelowTheHorizon(
+                view, spans,
+                "spans: height " + std::to_string(c.height) + " pitch " + std::to_string(c.pitch) +
+                    " roll " + std::to_string(c.roll) + " frame " + std::to_string(frame));
+        }
+        EXPECT_GT(checked, 5000) << c.height;
+    }
+}
+
+TEST(ViewGeometry, RenderSpansSectorOfALevelDiscIsItsAngularRadius) {
+    // A level camera (pitch 0, roll 0, heading 0.4 rad): the cone of directions within ρ of
+    // the axis reaches azimuths heading ± ρ exactly (at elevation 0); the disc of pixels within
+    // the radius r_px = (W/2) tan ρ / tan(hfov/2) of the centre reaches that within ½ pixel and
+    // the rounding of its rim (its outermost pixels' outer edges). A whole-frame span gives the
+    // frustum's sector.
+    scene::Scenario sc = SpectralSea(2.0, 0.0, 0.0);
+    const ChannelCamera cam = MakeChannelCamera(
+        scene::Pose{sc.eyepoint.position_m, scene::WorldFromBodyRotation(sc.eyepoint.attitude)},
+        sc.channels[0]);
+    const double rho = 20.0 * kRad;
+    const double tanPerPixel = std::tan(0.5 * cam.hfov_rad) / (0.5 * cam.width);
+    const std::vector<PixelSpan> spans =
+        DiscSpans(cam.width, cam.height, std::tan(rho) / tanPerPixel);
+    double lo = 0.0, hi = 0.0;
+    SpansAzimuthSector(cam, spans, lo, hi);
+    const double pixel = std::atan(tanPerPixel);
+    EXPECT_NEAR(0.5 * (lo + hi), 0.4, 1e-9);
+    EXPECT_GE(0.5 * (hi - lo), rho - 0.6 * pixel);
+    EXPECT_LE(0.5 * (hi - lo), rho + 0.6 * pixel);
+    std::vector<PixelSpan> all(size_t(cam.height), PixelSpan{0, cam.width});
+    double flo = 0.0, fhi = 0.0;
+    FrustumAzimuthSector(cam, 0.0, flo, fhi);
+    SpansAzimuthSector(cam, all, lo, hi);
+    EXPECT_NEAR(lo, flo, 1e-12);
+    EXPECT_NEAR(hi, fhi, 1e-12);
+    EXPECT_NEAR(0.5 * (fhi - flo), std::atan(std::tan(0.5 * cam.hfov_rad)), 1e-9);
 }
 
 TEST(ViewGeometry, ContiguousChannelsShareTheirSeaVertices) {
