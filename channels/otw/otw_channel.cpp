@@ -20,6 +20,7 @@
 #include "radiometry/surface/fresnel.h"
 #include "scene/core/check.h"
 #include "scene/core/simd4.h"
+#include "scene/core/simd_lanes.h"
 
 namespace seasense::channels {
 
@@ -158,107 +159,100 @@ struct SeaShading {
     void Shade(size_t count, const float* px, const float* py, const float* pz, const float* nx,
                const float* ny, const float* nz, const float* depth, const float* wet,
                const float* foam, SeaChunk& ch) const {
-        // Geometry: view vector v, reflected ray r, glint half vector h.
-        for (size_t i = 0; i < count; i += 4) {
-            const size_t lanes = std::min<size_t>(4, count - i);
-            const F4 Nx = LoadLanes(nx + i, lanes, 0.0f), Ny = LoadLanes(ny + i, lanes, 0.0f),
-                     Nz = LoadLanes(nz + i, lanes, 1.0f);
-            const F4 tx = _mm_sub_ps(Set4(eye.x), LoadLanes(px + i, lanes, 0.0f));
-            const F4 ty = _mm_sub_ps(Set4(eye.y), LoadLanes(py + i, lanes, 0.0f));
-            const F4 tz = _mm_sub_ps(Set4(eye.z), LoadLanes(pz + i, lanes, 0.0f));
-            const F4 range = _mm_sqrt_ps(Dot4(tx, ty, tz, tx, ty, tz));
+        // Geometry: view vector v, reflected ray r, glint half vector h; simd::kLanes entries at
+        // a time (the chunk's arrays hold kChunk, a multiple of kLanes: lanes past count are
+        // computed from padding, then dropped).
+        using namespace simd;
+        static_assert(kChunk % kLanes == 0);
+        for (size_t i = 0; i < count; i += kLanes) {
+            const size_t lanes = std::min(kLanes, count - i);
+            const VF Nx = Load(nx + i, lanes, 0.0f), Ny = Load(ny + i, lanes, 0.0f),
+                     Nz = Load(nz + i, lanes, 1.0f);
+            const VF tx = eye.x - Load(px + i, lanes, 0.0f);
+            const VF ty = eye.y - Load(py + i, lanes, 0.0f);
+            const VF tz = eye.z - Load(pz + i, lanes, 0.0f);
+            const VF range = Sqrt(Dot(tx, ty, tz, tx, ty, tz));
             // One division for the three components (differs from t / range by rounding).
-            const F4 invRange = _mm_div_ps(Set4(1.0f), range);
-            const F4 vx = _mm_mul_ps(tx, invRange), vy = _mm_mul_ps(ty, invRange),
-                     vz = _mm_mul_ps(tz, invRange);
-            const F4 ndv = Dot4(Nx, Ny, Nz, vx, vy, vz);
-            const F4 twoNdv = _mm_mul_ps(Set4(2.0f), ndv);
-            const F4 rz = _mm_sub_ps(_mm_mul_ps(twoNdv, Nz), vz);
+            const VF invRange = 1.0f / range;
+            const VF vx = tx * invRange, vy = ty * invRange, vz = tz * invRange;
+            const VF ndv = Dot(Nx, Ny, Nz, vx, vy, vz);
+            const VF twoNdv = 2.0f * ndv;
+            const VF rz = twoNdv * Nz - vz;
             // A ray reflected into the sea meets the next wave's sky.
-            _mm_store_ps(ch.rz + i, Select4(_mm_cmplt_ps(rz, _mm_setzero_ps()),
-                                            _mm_sub_ps(_mm_setzero_ps(), rz), rz));
-            _mm_store_ps(ch.rx + i, _mm_sub_ps(_mm_mul_ps(twoNdv, Nx), vx));
-            _mm_store_ps(ch.ry + i, _mm_sub_ps(_mm_mul_ps(twoNdv, Ny), vy));
-            _mm_store_ps(ch.mvx + i, _mm_sub_ps(_mm_setzero_ps(), vx));
-            _mm_store_ps(ch.mvy + i, _mm_sub_ps(_mm_setzero_ps(), vy));
-            _mm_store_ps(ch.range + i, range);
-            _mm_store_ps(ch.cosV + i, Max4(ndv, Set4(1e-3f)));
-            _mm_store_ps(ch.cosS + i,
-                         Dot4(Nx, Ny, Nz, Set4(keyDir.x), Set4(keyDir.y), Set4(keyDir.z)));
-            const F4 wx = _mm_add_ps(vx, Set4(keyDir.x)), wy = _mm_add_ps(vy, Set4(keyDir.y)),
-                     wz = _mm_add_ps(vz, Set4(keyDir.z));
-            const F4 inv = _mm_div_ps(Set4(1.0f), _mm_sqrt_ps(Dot4(wx, wy, wz, wx, wy, wz)));
-            const F4 hx = _mm_mul_ps(wx, inv), hy = _mm_mul_ps(wy, inv), hz = _mm_mul_ps(wz, inv);
-            const F4 cosB = Max4(Dot4(hx, hy, hz, Nx, Ny, Nz), Set4(1e-3f));
-            const F4 cos2 = _mm_mul_ps(cosB, cosB);
-            _mm_store_ps(ch.cos2 + i, cos2);
-            _mm_store_ps(ch.tan2 + i, _mm_div_ps(_mm_sub_ps(Set4(1.0f), cos2), cos2));
-            _mm_store_ps(ch.vh + i, Dot4(vx, vy, vz, hx, hy, hz));
+            Store(ch.rz + i, Select(rz < 0.0f, 0.0f - rz, rz));
+            Store(ch.rx + i, twoNdv * Nx - vx);
+            Store(ch.ry + i, twoNdv * Ny - vy);
+            Store(ch.mvx + i, 0.0f - vx);
+            Store(ch.mvy + i, 0.0f - vy);
+            Store(ch.range + i, range);
+            Store(ch.cosV + i, Max(ndv, Splat(1e-3f)));
+            const VF cosS = Dot(Nx, Ny, Nz, Splat(keyDir.x), Splat(keyDir.y), Splat(keyDir.z));
+            Store(ch.cosS + i, cosS);
+            const VF wx = vx + keyDir.x, wy = vy + keyDir.y, wz = vz + keyDir.z;
+            const VF inv = 1.0f / Sqrt(Dot(wx, wy, wz, wx, wy, wz));
+            const VF hx = wx * inv, hy = wy * inv, hz = wz * inv;
+            const VF cosB = Max(Dot(hx, hy, hz, Nx, Ny, Nz), Splat(1e-3f));
+            const VF cos2 = cosB * cosB;
+            Store(ch.cos2 + i, cos2);
+            Store(ch.tan2 + i, (1.0f - cos2) / cos2);
+            Store(ch.vh + i, Dot(vx, vy, vz, hx, hy, hz));
             // Lambertian irradiance of sand and foam: sky as on a plane tilted to the normal,
             // (1 + n_z)/2 of the level-surface sky irradiance, and the fill lights.
-            const F4 skyView = _mm_mul_ps(Set4(0.5f), _mm_add_ps(Set4(1.0f), Nz));
-            F4 aR = _mm_mul_ps(Set4(skyE.r), skyView), aG = _mm_mul_ps(Set4(skyE.g), skyView),
-               aB = _mm_mul_ps(Set4(skyE.b), skyView);
+            const VF skyView = 0.5f * (1.0f + Nz);
+            VF aR = skyE.r * skyView, aG = skyE.g * skyView, aB = skyE.b * skyView;
             for (const DirectionalLight& l : *fill) {
-                const F4 c = Max4(Dot4(Nx, Ny, Nz, Set4(l.dir.x), Set4(l.dir.y), Set4(l.dir.z)),
-                                  _mm_setzero_ps());
-                aR = _mm_add_ps(aR, _mm_mul_ps(Set4(l.E.r), c));
-                aG = _mm_add_ps(aG, _mm_mul_ps(Set4(l.E.g), c));
-                aB = _mm_add_ps(aB, _mm_mul_ps(Set4(l.E.b), c));
+                const VF c = Max(Dot(Nx, Ny, Nz, Splat(l.dir.x), Splat(l.dir.y), Splat(l.dir.z)),
+                                 Splat(0.0f));
+                aR = aR + l.E.r * c;
+                aG = aG + l.E.g * c;
+                aB = aB + l.E.b * c;
             }
-            _mm_store_ps(ch.ambR + i, aR);
-            _mm_store_ps(ch.ambG + i, aG);
-            _mm_store_ps(ch.ambB + i, aB);
-            _mm_store_ps(ch.keyCos + i, Max4(_mm_load_ps(ch.cosS + i), _mm_setzero_ps()));
+            Store(ch.ambR + i, aR);
+            Store(ch.ambG + i, aG);
+            Store(ch.ambB + i, aB);
+            Store(ch.keyCos + i, Max(cosS, Splat(0.0f)));
         }
         sky.LookUp(count, ch.rx, ch.ry, ch.rz, ch.skyR, ch.skyG, ch.skyB);
         sky.HorizonLookUp(count, ch.mvx, ch.mvy, ch.horR, ch.horG, ch.horB);
         fresnel(count, ch.cosV, ch.F);
         fresnel(count, ch.vh, ch.Fs);
 
-        const F4 zero = _mm_setzero_ps(), one = Set4(1.0f);
-        const F4 glintLimit = Set4(60.0f * slopeVar);
+        const VF glintLimit = Splat(60.0f * slopeVar);
         // Reciprocals of the frame's constants: multiplications in the loop, not divisions.
-        const F4 minusInvSlopeVar = Set4(-1.0f / slopeVar);
-        const F4 invGlintNorm = Set4(1.0f / (float(M_PI) * slopeVar));
-        for (size_t i = 0; i < count; i += 4) {
-            const F4 F = _mm_load_ps(ch.F + i), oneMinusF = _mm_sub_ps(one, F);
-            const F4 cosV = _mm_load_ps(ch.cosV + i), cos2 = _mm_load_ps(ch.cos2 + i);
-            const F4 tan2 = _mm_load_ps(ch.tan2 + i), sunVis = _mm_load_ps(ch.sunVis + i);
+        const float minusInvSlopeVar = -1.0f / slopeVar;
+        const float invGlintNorm = 1.0f / (float(M_PI) * slopeVar);
+        for (size_t i = 0; i < count; i += kLanes) {
+            const VF F = Load(ch.F + i), oneMinusF = 1.0f - F;
+            const VF cosV = Load(ch.cosV + i), cos2 = Load(ch.cos2 + i);
+            const VF tan2 = Load(ch.tan2 + i), sunVis = Load(ch.sunVis + i);
             // Cox–Munk glint: L = E_sun ρ(ω) p(β) / (4 cos θ_v cos⁴ β) (Cox & Munk 1954), β
             // the tilt of the reflecting facet from the local normal. Beyond e^-60 the glint
             // is below float precision next to the sky term.
-            const F4 glint = _mm_and_ps(_mm_and_ps(_mm_cmpgt_ps(_mm_load_ps(ch.cosS + i), zero),
-                                                   _mm_cmpgt_ps(sunVis, zero)),
-                                        _mm_cmplt_ps(tan2, glintLimit));
-            // Lanes without glint drop g (Select4 below): skipped when no lane has it.
-            const bool anyGlint = _mm_movemask_ps(glint) != 0;
-            F4 g = zero;
+            const VI glint = (Load(ch.cosS + i) > 0.0f) & (sunVis > 0.0f) & (tan2 < glintLimit);
+            // Lanes without glint drop g (Select below): skipped when no lane has it.
+            const bool anyGlint = Any(glint);
+            VF g = Splat(0.0f);
             if (anyGlint) {
-                const F4 p =
-                    _mm_mul_ps(ExpNonPositive4(_mm_mul_ps(tan2, minusInvSlopeVar)), invGlintNorm);
-                g = _mm_div_ps(_mm_mul_ps(_mm_load_ps(ch.Fs + i), p),
-                               _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(Set4(4.0f), cosV), cos2), cos2));
+                const VF p = ExpNonPositive(tan2 * minusInvSlopeVar) * invGlintNorm;
+                g = (Load(ch.Fs + i) * p) / (((4.0f * cosV) * cos2) * cos2);
             }
             // Koschmieder: the horizon sky is the airlight a long path converges to.
-            const F4 t = ExpNonPositive4(_mm_mul_ps(Set4(-beta), _mm_load_ps(ch.range + i)));
-            const F4 oneMinusT = _mm_sub_ps(one, t);
-            const size_t lanes = std::min<size_t>(4, count - i);
-            const F4 d = LoadLanes(depth + i, lanes, kDeepColumn_m);
-            const F4 w = LoadLanes(wet + i, lanes, 0.0f), c = LoadLanes(foam + i, lanes, 0.0f);
+            const VF t = ExpNonPositive(-beta * Load(ch.range + i));
+            const VF oneMinusT = 1.0f - t;
+            const size_t lanes = std::min(kLanes, count - i);
+            const VF d = Load(depth + i, lanes, kDeepColumn_m);
+            const VF w = Load(wet + i, lanes, 0.0f), c = Load(foam + i, lanes, 0.0f);
             // The water path factor 1 + 1/cos θ_t, from cos θ_v as stored above.
-            const F4 path = WaterPathFactor4(cosV, float(radiometry::kSeaWaterIndexVisible));
-            const F4 keyLit = _mm_mul_ps(_mm_load_ps(ch.keyCos + i), sunVis);
+            const VF path = WaterPathFactor(cosV, float(radiometry::kSeaWaterIndexVisible));
+            const VF keyLit = Load(ch.keyCos + i) * sunVis;
             const auto channel = [&](const ShoreChannel& sh, const float* skyC, const float* horC,
                                      const float* ambC, float dw, float sunEC, float* outC) {
-                F4 R = _mm_mul_ps(F, _mm_load_ps(skyC + i));
-                if (anyGlint)
-                    R = Select4(glint,
-                                _mm_add_ps(R, _mm_mul_ps(_mm_mul_ps(Set4(sunEC), g), sunVis)), R);
-                const F4 E = _mm_add_ps(_mm_load_ps(ambC + i), _mm_mul_ps(Set4(sunEC), keyLit));
-                F4 L = ShoreRadiance4(sh, R, oneMinusF, path, d, w, c, E, Set4(dw));
-                L = _mm_add_ps(_mm_mul_ps(L, t), _mm_mul_ps(_mm_load_ps(horC + i), oneMinusT));
-                _mm_store_ps(outC + i, L);
+                VF R = F * Load(skyC + i);
+                if (anyGlint) R = Select(glint, R + (sunEC * g) * sunVis, R);
+                const VF E = Load(ambC + i) + sunEC * keyLit;
+                VF L = ShoreRadiance(sh, R, oneMinusF, path, d, w, c, E, Splat(dw));
+                L = L * t + Load(horC + i) * oneMinusT;
+                Store(outC + i, L);
             };
             channel(shore[0], ch.skyR, ch.horR, ch.ambR, downwelling.r, keyE.r, ch.outR);
             channel(shore[1], ch.skyG, ch.horG, ch.ambG, downwelling.g, keyE.g, ch.outG);

@@ -1,10 +1,10 @@
-// Shading of the surf zone in OTW, four lanes at a time: sand where the sea lies on the beach,
+// Shading of the surf zone in OTW, simd::kLanes at a time: sand where the sea lies on the beach,
 // the seabed seen through shallow water, and a Lambertian foam layer.
 #pragma once
 
 #include <cmath>
 
-#include "scene/core/simd4.h"
+#include "scene/core/simd_lanes.h"
 
 namespace seasense::channels {
 
@@ -12,20 +12,19 @@ namespace seasense::channels {
 // reduction ("Software Manual for the Elementary Functions", 1980): x = k ln 2 + r with
 // |r| ≤ ln 2 / 2 and ln 2 split into a 16-bit head (k·head exact) and a tail; e^r from its
 // Taylor series to r⁷ (truncation < 1e-8 relative, below float precision); 2^k through the
-// exponent bits. Within a few ulp of std::exp, and four lanes wide where libm is scalar.
-inline simd4::F4 ExpNonPositive4(simd4::F4 x) {
-    using namespace simd4;
-    const F4 underflow = _mm_cmplt_ps(x, Set4(-87.0f));
-    x = Max4(x, Set4(-87.0f));
-    const I4 k = _mm_cvtps_epi32(_mm_mul_ps(x, Set4(1.44269504f)));  // round(x / ln 2)
-    const F4 kf = _mm_cvtepi32_ps(k);
-    const F4 r = _mm_sub_ps(_mm_sub_ps(x, _mm_mul_ps(kf, Set4(0.693145751953125f))),
-                            _mm_mul_ps(kf, Set4(1.428606765330187e-6f)));
-    F4 p = Set4(1.0f / 5040.0f);
+// exponent bits. Within a few ulp of std::exp, and simd::kLanes wide where libm is scalar.
+inline simd::VF ExpNonPositive(simd::VF x) {
+    using namespace simd;
+    const VI underflow = x < -87.0f;
+    x = Max(x, Splat(-87.0f));
+    const VI k = RoundToInt(x * 1.44269504f);  // round(x / ln 2)
+    const VF kf = __builtin_convertvector(k, VF);
+    const VF r = (x - kf * 0.693145751953125f) - kf * 1.428606765330187e-6f;
+    VF p = Splat(1.0f / 5040.0f);
     const float c[] = {1.0f / 720.0f, 1.0f / 120.0f, 1.0f / 24.0f, 1.0f / 6.0f, 0.5f, 1.0f, 1.0f};
-    for (float ci : c) p = _mm_add_ps(_mm_mul_ps(p, r), Set4(ci));
-    const F4 twoK = _mm_castsi128_ps(_mm_slli_epi32(_mm_add_epi32(k, _mm_set1_epi32(127)), 23));
-    return _mm_andnot_ps(underflow, _mm_mul_ps(p, twoK));
+    for (float ci : c) p = p * r + ci;
+    const VF twoK = (VF)((k + 127) << 23);
+    return Select(underflow, Splat(0.0f), p * twoK);
 }
 
 // Water column (m) given to sea vertices without a surf zone: deeper than any light returns
@@ -48,12 +47,11 @@ struct ShoreChannel {
 // 1 + 1/cos θ_t: the path through a column of depth d, down (d, the diffuse light) and back up
 // to the eye along the refracted view ray (d / cos θ_t), per unit depth. cos θ_t from Snell's
 // law for a view ray at cos θ_v = cosV to the surface normal, water index n.
-inline simd4::F4 WaterPathFactor4(simd4::F4 cosV, float n) {
-    using namespace simd4;
-    const F4 sin2T =
-        _mm_mul_ps(_mm_sub_ps(Set4(1.0f), _mm_mul_ps(cosV, cosV)), Set4(1.0f / (n * n)));
-    const F4 cosT = _mm_sqrt_ps(Max4(_mm_sub_ps(Set4(1.0f), sin2T), Set4(1e-6f)));
-    return _mm_add_ps(Set4(1.0f), _mm_div_ps(Set4(1.0f), cosT));
+inline simd::VF WaterPathFactor(simd::VF cosV, float n) {
+    using namespace simd;
+    const VF sin2T = (1.0f - cosV * cosV) * (1.0f / (n * n));
+    const VF cosT = Sqrt(Max(1.0f - sin2T, Splat(1e-6f)));
+    return 1.0f + 1.0f / cosT;
 }
 
 // Radiance (cd/m², one channel) of a surf-zone point before fog:
@@ -62,27 +60,24 @@ inline simd4::F4 WaterPathFactor4(simd4::F4 cosV, float n) {
 //   surface = sand + (water − sand)·min(d / kSwashFilm_m, 1);  result = surface + (foam −
 //   surface)·c
 // reflected = F·L_sky + glint (the surface's specular part), oneMinusF the Fresnel
-// transmittance, pathFactor from WaterPathFactor4, depth the column d (m), wet in [0, 1], foam
+// transmittance, pathFactor from WaterPathFactor, depth the column d (m), wet in [0, 1], foam
 // coverage c in [0, 1], E the irradiance on the surface (Lambertian: key, fill and sky, lx),
 // Ed the downwelling irradiance on a level surface (lx).
-inline simd4::F4 ShoreRadiance4(const ShoreChannel& c, simd4::F4 reflected, simd4::F4 oneMinusF,
-                                simd4::F4 pathFactor, simd4::F4 depth, simd4::F4 wet,
-                                simd4::F4 foam, simd4::F4 E, simd4::F4 Ed) {
-    using namespace simd4;
-    const F4 invPi = Set4(float(1.0 / M_PI));
-    const F4 lambert = _mm_mul_ps(E, invPi);
-    const F4 T = ExpNonPositive4(_mm_mul_ps(Set4(-c.K_perm), _mm_mul_ps(depth, pathFactor)));
-    const F4 bottom = _mm_mul_ps(Set4(c.rhoWet), lambert);
-    const F4 deep = _mm_mul_ps(Set4(c.rrs), Ed);
-    const F4 water = _mm_add_ps(
-        reflected,
-        _mm_mul_ps(oneMinusF, _mm_add_ps(deep, _mm_mul_ps(_mm_sub_ps(bottom, deep), T))));
-    const F4 rhoSand = _mm_add_ps(Set4(c.rhoDry), _mm_mul_ps(Set4(c.rhoWet - c.rhoDry), wet));
-    const F4 sand = _mm_mul_ps(rhoSand, lambert);
-    const F4 film = _mm_min_ps(_mm_mul_ps(depth, Set4(1.0f / kSwashFilm_m)), Set4(1.0f));
-    const F4 surface = _mm_add_ps(sand, _mm_mul_ps(_mm_sub_ps(water, sand), film));
-    const F4 white = _mm_mul_ps(Set4(c.rhoFoam), lambert);
-    return _mm_add_ps(surface, _mm_mul_ps(_mm_sub_ps(white, surface), foam));
+inline simd::VF ShoreRadiance(const ShoreChannel& c, simd::VF reflected, simd::VF oneMinusF,
+                              simd::VF pathFactor, simd::VF depth, simd::VF wet, simd::VF foam,
+                              simd::VF E, simd::VF Ed) {
+    using namespace simd;
+    const VF lambert = E * float(1.0 / M_PI);
+    const VF T = ExpNonPositive(-c.K_perm * (depth * pathFactor));
+    const VF bottom = c.rhoWet * lambert;
+    const VF deep = c.rrs * Ed;
+    const VF water = reflected + oneMinusF * (deep + (bottom - deep) * T);
+    const VF rhoSand = c.rhoDry + (c.rhoWet - c.rhoDry) * wet;
+    const VF sand = rhoSand * lambert;
+    const VF film = Min(Splat(1.0f), depth * (1.0f / kSwashFilm_m));  // _mm_min_ps(·, 1)
+    const VF surface = sand + (water - sand) * film;
+    const VF white = c.rhoFoam * lambert;
+    return surface + (white - surface) * foam;
 }
 
 }  // namespace seasense::channels

@@ -9,9 +9,9 @@
 namespace seasense::channels {
 namespace {
 
-using namespace simd4;
+using namespace simd;
 
-float Lane0(F4 v) { return _mm_cvtss_f32(v); }
+float Lane0(VF v) { return v[0]; }
 
 const ShoreChannel kChannel{0.0f, 0.2f, 0.25f, 0.40f, 0.55f};
 
@@ -22,21 +22,21 @@ TEST(ShoreShading, BottomAttenuationFollowsRefractedPath) {
     const double thetaV = 40.0 * M_PI / 180.0, n = 1.34;
     const double thetaT = std::asin(std::sin(thetaV) / n);
     const float E = 50000.0f, oneMinusF = 0.97f;
-    const F4 path = WaterPathFactor4(Set4(float(std::cos(thetaV))), float(n));
+    const VF path = WaterPathFactor(Splat(float(std::cos(thetaV))), float(n));
     for (double d : {0.5, 2.0, 5.0}) {
         const float L =
-            Lane0(ShoreRadiance4(kChannel, Set4(0.0f), Set4(oneMinusF), path, Set4(float(d)),
-                                 Set4(1.0f), Set4(0.0f), Set4(E), Set4(E)));
+            Lane0(ShoreRadiance(kChannel, Splat(0.0f), Splat(oneMinusF), path, Splat(float(d)),
+                                Splat(1.0f), Splat(0.0f), Splat(E), Splat(E)));
         const double expected =
             oneMinusF * 0.25 * E / M_PI * std::exp(-0.2 * (d + d / std::cos(thetaT)));
         EXPECT_NEAR(L / expected, 1.0, 0.01) << "depth " << d;
     }
     // Seen steeply the water is more transparent: the path is shorter.
-    const F4 steep = WaterPathFactor4(Set4(1.0f), float(n));
-    EXPECT_GT(Lane0(ShoreRadiance4(kChannel, Set4(0.0f), Set4(oneMinusF), steep, Set4(2.0f),
-                                   Set4(1.0f), Set4(0.0f), Set4(E), Set4(E))),
-              Lane0(ShoreRadiance4(kChannel, Set4(0.0f), Set4(oneMinusF), path, Set4(2.0f),
-                                   Set4(1.0f), Set4(0.0f), Set4(E), Set4(E))));
+    const VF steep = WaterPathFactor(Splat(1.0f), float(n));
+    EXPECT_GT(Lane0(ShoreRadiance(kChannel, Splat(0.0f), Splat(oneMinusF), steep, Splat(2.0f),
+                                  Splat(1.0f), Splat(0.0f), Splat(E), Splat(E))),
+              Lane0(ShoreRadiance(kChannel, Splat(0.0f), Splat(oneMinusF), path, Splat(2.0f),
+                                  Splat(1.0f), Splat(0.0f), Splat(E), Splat(E))));
 }
 
 // As the depth goes to 0 the water's radiance goes continuously to that of wet sand, ρ_wet E/π;
@@ -45,10 +45,10 @@ TEST(ShoreShading, ShallowWaterTendsToWetSandAndDeepWaterToSeaColour) {
     ShoreChannel c = kChannel;
     c.rrs = 0.002f;
     const float E = 30000.0f, Ed = 28000.0f, reflected = 40.0f, oneMinusF = 0.95f;
-    const F4 path = WaterPathFactor4(Set4(0.6f), 1.34f);
+    const VF path = WaterPathFactor(Splat(0.6f), 1.34f);
     const auto L = [&](float d) {
-        return Lane0(ShoreRadiance4(c, Set4(reflected), Set4(oneMinusF), path, Set4(d), Set4(1.0f),
-                                    Set4(0.0f), Set4(E), Set4(Ed)));
+        return Lane0(ShoreRadiance(c, Splat(reflected), Splat(oneMinusF), path, Splat(d),
+                                   Splat(1.0f), Splat(0.0f), Splat(E), Splat(Ed)));
     };
     const float wetSand = 0.25f * E / float(M_PI);
     EXPECT_NEAR(L(0.0f), wetSand, 1e-3f * wetSand);
@@ -60,8 +60,8 @@ TEST(ShoreShading, ShallowWaterTendsToWetSandAndDeepWaterToSeaColour) {
     }
     EXPECT_NEAR(L(kDeepColumn_m), reflected + oneMinusF * c.rrs * Ed, 1e-3f);
     // Dry sand (wetness 0) is brighter than wet sand under the same light.
-    EXPECT_NEAR(Lane0(ShoreRadiance4(c, Set4(0.0f), Set4(1.0f), path, Set4(0.0f), Set4(0.0f),
-                                     Set4(0.0f), Set4(E), Set4(Ed))),
+    EXPECT_NEAR(Lane0(ShoreRadiance(c, Splat(0.0f), Splat(1.0f), path, Splat(0.0f), Splat(0.0f),
+                                    Splat(0.0f), Splat(E), Splat(Ed))),
                 0.40f * E / float(M_PI), 1e-3f * E);
 }
 
@@ -69,18 +69,18 @@ TEST(ShoreShading, ShallowWaterTendsToWetSandAndDeepWaterToSeaColour) {
 // lies below; half coverage is the mean of foam and water.
 TEST(ShoreShading, FoamIsLambertianLayer) {
     const float E = 80000.0f;
-    const F4 path = WaterPathFactor4(Set4(0.8f), 1.34f);
+    const VF path = WaterPathFactor(Splat(0.8f), 1.34f);
     for (float d : {0.0f, 1.0f, kDeepColumn_m}) {
-        const float L = Lane0(ShoreRadiance4(kChannel, Set4(30.0f), Set4(0.97f), path, Set4(d),
-                                             Set4(1.0f), Set4(1.0f), Set4(E), Set4(E)));
+        const float L = Lane0(ShoreRadiance(kChannel, Splat(30.0f), Splat(0.97f), path, Splat(d),
+                                            Splat(1.0f), Splat(1.0f), Splat(E), Splat(E)));
         EXPECT_NEAR(L, 0.55f * E / float(M_PI), 1e-5f * E);
     }
     const float water =
-        Lane0(ShoreRadiance4(kChannel, Set4(30.0f), Set4(0.97f), path, Set4(kDeepColumn_m),
-                             Set4(1.0f), Set4(0.0f), Set4(E), Set4(E)));
+        Lane0(ShoreRadiance(kChannel, Splat(30.0f), Splat(0.97f), path, Splat(kDeepColumn_m),
+                            Splat(1.0f), Splat(0.0f), Splat(E), Splat(E)));
     const float half =
-        Lane0(ShoreRadiance4(kChannel, Set4(30.0f), Set4(0.97f), path, Set4(kDeepColumn_m),
-                             Set4(1.0f), Set4(0.5f), Set4(E), Set4(E)));
+        Lane0(ShoreRadiance(kChannel, Splat(30.0f), Splat(0.97f), path, Splat(kDeepColumn_m),
+                            Splat(1.0f), Splat(0.5f), Splat(E), Splat(E)));
     EXPECT_NEAR(half, 0.5f * (water + 0.55f * E / float(M_PI)), 1e-4f * E);
 }
 

@@ -1,0 +1,64 @@
+// Lane-generic float vectors (GCC vector extensions) for shading loops written once for the
+// widest vectors the build targets: eight lanes where it generates AVX, else four (SSE2). Each
+// operation is the IEEE operation per lane, so a loop gives the same bits at either width.
+#pragma once
+
+#include <immintrin.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+
+namespace seasense::simd {
+
+#if defined(__AVX__)
+inline constexpr size_t kLanes = 8;
+#else
+inline constexpr size_t kLanes = 4;
+#endif
+
+using VF = float __attribute__((vector_size(kLanes * sizeof(float))));
+using VI = int32_t __attribute__((vector_size(kLanes * sizeof(int32_t))));
+
+inline VF Splat(float v) { return VF{} + v; }
+
+// count ≤ kLanes lanes from p, the rest pad (a partial last group goes through the same code).
+inline VF Load(const float* p, size_t count = kLanes, float pad = 0.0f) {
+    VF v = Splat(pad);
+    std::memcpy(&v, p, (count < kLanes ? count : kLanes) * sizeof(float));
+    return v;
+}
+// Stores all kLanes lanes (the caller's arrays have room for them).
+inline void Store(float* p, VF v) { std::memcpy(p, &v, sizeof v); }
+
+// a where mask (a comparison's result) is set, else b.
+inline VF Select(VI mask, VF a, VF b) { return mask ? a : b; }
+// _mm_max_ps(b, a) / _mm_min_ps(b, a) lane for lane: a when either is NaN or both are zeros.
+inline VF Max(VF a, VF b) { return b > a ? b : a; }
+inline VF Min(VF a, VF b) { return b < a ? b : a; }
+// (x + y) + z, the order of glm::dot.
+inline VF Dot(VF ax, VF ay, VF az, VF bx, VF by, VF bz) { return (ax * bx + ay * by) + az * bz; }
+
+inline VF Sqrt(VF v) {
+#if defined(__AVX__)
+    return _mm256_sqrt_ps(v);
+#else
+    return _mm_sqrt_ps(v);
+#endif
+}
+
+// Whether any lane of a comparison's result is set.
+inline bool Any(VI mask) {
+    for (size_t i = 0; i < kLanes; ++i)
+        if (mask[i]) return true;
+    return false;
+}
+
+// Round to the nearest integer, ties to even (as cvtps2dq in the default rounding mode), for
+// |x| < 2^22: adding and subtracting 1.5·2^23 leaves x's integer part in the units place.
+inline VI RoundToInt(VF x) {
+    constexpr float kMagic = 12582912.0f;  // 1.5 · 2^23
+    return __builtin_convertvector((x + kMagic) - kMagic, VI);
+}
+
+}  // namespace seasense::simd
