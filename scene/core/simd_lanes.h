@@ -24,8 +24,13 @@ inline VF Splat(float v) { return VF{} + v; }
 
 // count ≤ kLanes lanes from p, the rest pad (a partial last group goes through the same code).
 inline VF Load(const float* p, size_t count = kLanes, float pad = 0.0f) {
-    VF v = Splat(pad);
-    std::memcpy(&v, p, (count < kLanes ? count : kLanes) * sizeof(float));
+    VF v;
+    if (count >= kLanes) {  // one unaligned vector load
+        std::memcpy(&v, p, sizeof v);
+        return v;
+    }
+    v = Splat(pad);
+    for (size_t i = 0; i < count; ++i) v[i] = p[i];
     return v;
 }
 // Stores all kLanes lanes (the caller's arrays have room for them).
@@ -49,9 +54,11 @@ inline VF Sqrt(VF v) {
 
 // Whether any lane of a comparison's result is set.
 inline bool Any(VI mask) {
-    for (size_t i = 0; i < kLanes; ++i)
-        if (mask[i]) return true;
-    return false;
+#if defined(__AVX__)
+    return _mm256_movemask_ps(reinterpret_cast<__m256>(mask)) != 0;
+#else
+    return _mm_movemask_ps(reinterpret_cast<__m128>(mask)) != 0;
+#endif
 }
 
 // Round to the nearest integer, ties to even (as cvtps2dq in the default rounding mode), for
