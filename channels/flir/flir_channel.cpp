@@ -208,8 +208,9 @@ FlirChannel::FlirChannel(const scene::World& world, const scene::ChannelSettings
                : radiometry::SeaSettings{}),
       table_(InfraredBandOf(settings.band)),
       atmosphere_(table_.GetBand(), air_, world.GetScenario().environment.visibility_m),
-      seaCurve_(radiometry::SeaEmissivityTable(radiometry::SeaSurfaceEmissivity(table_.GetBand()))
-                    .Curve(world.GetScenario().environment.windSpeed_mps)),
+      seaCurve_(radiometry::SeaEmissivityTable::CurveForWind(
+          radiometry::SeaSurfaceEmissivity(table_.GetBand()),
+          world.GetScenario().environment.windSpeed_mps)),
       plumes_(std::make_unique<ChannelPlumes>(world)) {
     const scene::Scenario& sc = world.GetScenario();
     if (!sc.materialTable)
