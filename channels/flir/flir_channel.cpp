@@ -41,6 +41,8 @@ constexpr double kMaxPathRange_m = 2.0e5;
 // Sample rows per parallel task, and samples per shading chunk (a chunk's arrays stay in L1).
 constexpr int kRowsPerBlock = 8;
 constexpr size_t kChunk = 256;
+// Sky samples in a row from which they are shaded as a run (ShadeSkyRun) rather than gathered.
+constexpr int kMinSkyRun = 8;
 
 // Shadow-ray offset along the normal: 1 mm plus 4e-6 of the largest coordinate (as the OTW
 // channel), clear of float self-intersection.
@@ -208,8 +210,9 @@ FlirChannel::FlirChannel(const scene::World& world, const scene::ChannelSettings
                : radiometry::SeaSettings{}),
       table_(InfraredBandOf(settings.band)),
       atmosphere_(table_.GetBand(), air_, world.GetScenario().environment.visibility_m),
-      seaCurve_(radiometry::SeaEmissivityTable(radiometry::SeaSurfaceEmissivity(table_.GetBand()))
-                    .Curve(world.GetScenario().environment.windSpeed_mps)),
+      seaCurve_(radiometry::SeaEmissivityTable::CurveForWind(
+          radiometry::SeaSurfaceEmissivity(table_.GetBand()),
+          world.GetScenario().environment.windSpeed_mps)),
       plumes_(std::make_unique<ChannelPlumes>(world)) {
     const scene::Scenario& sc = world.GetScenario();
     if (!sc.materialTable)
@@ -396,6 +399,30 @@ void FlirChannel::ShadeSky(ShadeBlock& sc, size_t count, float* out) const {
     for (size_t i = 0; i < count; ++i) out[sc.skyK[i]] = sc.b[i];
 }
 
+void FlirChannel::ShadeSkyRun(const FrameShading& f, const glm::vec3& rowBase, int x0, int x1,
+                              ShadeBlock& sc, float* rowOut) const {
+    // The view directions of the run four at a time, with glm's operations of the sample-by-sample
+    // path in the same order (d = rowBase + (x + ½) colStep, |d|² = (x² + y²) + z²), so the same
+    // bits; then L_sky(d_z / |d|) as ShadeSky.
+    const F4 baseX = Set4(rowBase.x), baseY = Set4(rowBase.y), baseZ = Set4(rowBase.z);
+    const F4 stepX = Set4(f.colStep.x), stepY = Set4(f.colStep.y), stepZ = Set4(f.colStep.z);
+    for (int start = x0; start < x1; start += int(kChunk)) {
+        const size_t count = size_t(std::min(x1 - start, int(kChunk)));
+        for (size_t i = 0; i < count; i += 4) {
+            const int x = start + int(i);
+            const F4 t =
+                _mm_add_ps(_mm_cvtepi32_ps(_mm_setr_epi32(x, x + 1, x + 2, x + 3)), Set4(0.5f));
+            const F4 dx = _mm_add_ps(baseX, _mm_mul_ps(t, stepX));
+            const F4 dy = _mm_add_ps(baseY, _mm_mul_ps(t, stepY));
+            const F4 dz = _mm_add_ps(baseZ, _mm_mul_ps(t, stepZ));
+            const F4 len2 =
+                _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+            _mm_store_ps(sc.a + i, _mm_div_ps(dz, _mm_sqrt_ps(len2)));
+        }
+        skyTable_(count, sc.a, rowOut + start);
+    }
+}
+
 void FlirChannel::ShadeSea(const FrameShading& f, ShadeBlock& sc, size_t count, float* out) const {
     // Emissivity at the local view angle (Masuda's wind average for the unresolved slopes), sky
     // reflected about the resolved normal (a ray reflected into the sea meets the next wave's
@@ -467,6 +494,14 @@ uint64_t FlirChannel::ShadeRows(const FrameShading& f, int y0, int y1, float* ou
         for (int x = 0; x < sw; ++x) {
             const uint32_t k = kRow + uint32_t(x), prim = prims[x];
             if (prim == kNoPrimitive) {
+                // A run of sky (most rows above the horizon): shaded straight into out.
+                int end = x + 1;
+                while (end < sw && prims[end] == kNoPrimitive) ++end;
+                if (end - x >= kMinSkyRun) {
+                    ShadeSkyRun(f, rowBase, x, end, sc, out + kRow);
+                    x = end - 1;
+                    continue;
+                }
                 const glm::vec3 d = rowBase + (float(x) + 0.5f) * f.colStep;
                 sc.skyK[skyCount] = k;
                 sc.skyZ[skyCount] = d.z;

@@ -203,6 +203,10 @@ class FlirChannel {
     uint64_t ShadeRows(const FrameShading& frame, int y0, int y1, float* out);
     // Shade the first count (≤ kChunk) gathered sky or sea samples of a row block into out.
     void ShadeSky(ShadeBlock& block, size_t count, float* out) const;
+    // Shade the sky samples [x0, x1) of the sample row whose view rays start at rowBase (see
+    // FrameShading) into rowOut[x0 … x1).
+    void ShadeSkyRun(const FrameShading& frame, const glm::vec3& rowBase, int x0, int x1,
+                     ShadeBlock& block, float* rowOut) const;
     void ShadeSea(const FrameShading& frame, ShadeBlock& block, size_t count, float* out) const;
 
     const scene::World& world_;

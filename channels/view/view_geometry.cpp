@@ -137,14 +137,30 @@ double NearestVisibleSeaRange_m(const ChannelCamera& cam, double crestHeight_m,
 
 double NearestVisibleSeaRange_m(const ChannelCamera& cam, const scene::OceanSurfaceFrame& sea,
                                 const glm::dvec3& eye_m) {
-    // The bound of the sea right under the eye gives the largest candidate range; the bound over
-    // that whole disc (never lower, since the disc holds the eye's point) then gives a range no
-    // larger, inside the disc the bound was taken over, so it holds there.
-    const scene::SurfaceBounds under = sea.BoundsNear(eye_m.x, eye_m.y, 0.0);
-    const double r0 = NearestVisibleSeaRange_m(cam, under.height_m, under.horizontal_m);
+    // A radius r is a safe nearest range when the range found from the bounds over the disc of
+    // radius r is at least r (every rest position within r is then drawn below the view), and so
+    // is that range when it is at most r (the disc holds it). The range from the bounds over a
+    // disc never grows with its radius, so the largest safe r lies between the range r1 from the
+    // disc of the under-eye range r0 (safe: r1 ≤ r0) and r0; bisection narrows it, each step
+    // keeping a safe lower end. The bounds near the eye (LocalBoundsNear) follow the waves
+    // there, which puts the range of a 2 m eye several metres further out than the whole sea's
+    // highest crest does (configs/five-channel.yaml's flir: 1.3 m → 5–7 m).
+    const auto rangeFrom = [&](double radius_m) {
+        const scene::SurfaceBounds b = sea.LocalBoundsNear(eye_m.x, eye_m.y, radius_m);
+        return NearestVisibleSeaRange_m(cam, b.height_m, b.horizontal_m);
+    };
+    const double r0 = rangeFrom(0.0);
     if (!(r0 > 0.0) || !std::isfinite(r0)) return r0;
-    const scene::SurfaceBounds disc = sea.BoundsNear(eye_m.x, eye_m.y, r0);
-    return NearestVisibleSeaRange_m(cam, disc.height_m, disc.horizontal_m);
+    double lo = rangeFrom(r0), hi = r0;
+    constexpr int kBisections = 6;
+    for (int i = 0; i < kBisections && hi - lo > 0.01 * hi; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        if (rangeFrom(mid) >= mid)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return lo;
 }
 
 scene::OceanMeshRequest SeaMeshRequest(const ChannelCamera& cam,

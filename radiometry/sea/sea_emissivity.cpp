@@ -153,19 +153,65 @@ SeaEmissivityCurve::SeaEmissivityCurve(std::vector<float> nodes) : nodes_(std::m
     last_ = float(nodes_.size() - 1);
 }
 
-SeaEmissivityTable::SeaEmissivityTable(const SeaSurfaceEmissivity& model, double maxWind_mps) {
+namespace {
+
+// The number of wind nodes (0, 1, … m/s) of a table to maxWind_mps; InputError unless it is
+// finite and in [1, 60].
+int WindNodes(double maxWind_mps) {
     if (!std::isfinite(maxWind_mps) || maxWind_mps < 1.0 || maxWind_mps > 60.0) {
         std::ostringstream msg;
         msg << "sea emissivity table: maximum wind " << maxWind_mps
             << " m/s; expected a number in [1, 60]";
         throw InputError(msg.str());
     }
-    windNodes_ = int(std::ceil(maxWind_mps)) + 1;
+    return int(std::ceil(maxWind_mps)) + 1;
+}
+
+// Wind node w at or below windSpeed_mps (clamped to the table) and the weight tw of node w + 1.
+void WindCell(double windSpeed_mps, int windNodes, size_t& w, double& tw) {
+    const double wv = std::clamp(windSpeed_mps, 0.0, double(windNodes - 1));
+    w = std::min(size_t(wv), size_t(windNodes - 2));
+    tw = wv - double(w);
+}
+
+// The table's nodes at wind node w (cos θ = i / (kCosNodes − 1)).
+void WindColumn(const SeaSurfaceEmissivity& model, size_t w, float* out) {
+    constexpr int n = SeaEmissivityTable::kCosNodes;
+    for (int i = 0; i < n; ++i)
+        out[i] = float(model.EmissivityForWind(double(i) / (n - 1), double(w)));
+}
+
+// The curve between two wind nodes' columns, weight tw on the second.
+SeaEmissivityCurve Blend(const float* e0, const float* e1, double tw) {
+    std::vector<float> nodes(SeaEmissivityTable::kCosNodes);
+    for (size_t i = 0; i < nodes.size(); ++i)
+        nodes[i] = float(double(e0[i]) + (double(e1[i]) - double(e0[i])) * tw);
+    return SeaEmissivityCurve(std::move(nodes));
+}
+
+}  // namespace
+
+SeaEmissivityTable::SeaEmissivityTable(const SeaSurfaceEmissivity& model, double maxWind_mps) {
+    windNodes_ = WindNodes(maxWind_mps);
     table_.resize(size_t(windNodes_) * kCosNodes);
     for (int w = 0; w < windNodes_; ++w)
-        for (int i = 0; i < kCosNodes; ++i)
-            table_[size_t(w) * kCosNodes + size_t(i)] =
-                float(model.EmissivityForWind(double(i) / (kCosNodes - 1), double(w)));
+        WindColumn(model, size_t(w), table_.data() + size_t(w) * kCosNodes);
+}
+
+SeaEmissivityCurve SeaEmissivityTable::CurveForWind(const SeaSurfaceEmissivity& model,
+                                                    double windSpeed_mps, double maxWind_mps) {
+    size_t w = 0;
+    double tw = 0.0;
+    WindCell(windSpeed_mps, WindNodes(maxWind_mps), w, tw);
+    std::vector<float> columns(2 * size_t(kCosNodes));
+    WindColumn(model, w, columns.data());
+    // At a whole wind speed the second node's weight is 0 and e0 + (e1 − e0) · 0 is e0 for any
+    // finite e1: the first column again serves.
+    if (tw > 0.0)
+        WindColumn(model, w + 1, columns.data() + kCosNodes);
+    else
+        std::copy_n(columns.data(), kCosNodes, columns.data() + kCosNodes);
+    return Blend(columns.data(), columns.data() + kCosNodes, tw);
 }
 
 double SeaEmissivityTable::Emissivity(double cosTheta, double windSpeed_mps) const {
@@ -182,15 +228,10 @@ double SeaEmissivityTable::Emissivity(double cosTheta, double windSpeed_mps) con
 }
 
 SeaEmissivityCurve SeaEmissivityTable::Curve(double windSpeed_mps) const {
-    const double wv = std::clamp(windSpeed_mps, 0.0, MaxWind_mps());
-    const size_t w = std::min(size_t(wv), size_t(windNodes_ - 2));
-    const double tw = wv - double(w);
-    std::vector<float> nodes(kCosNodes);
-    for (size_t i = 0; i < size_t(kCosNodes); ++i) {
-        const double e0 = table_[w * kCosNodes + i], e1 = table_[(w + 1) * kCosNodes + i];
-        nodes[i] = float(e0 + (e1 - e0) * tw);
-    }
-    return SeaEmissivityCurve(std::move(nodes));
+    size_t w = 0;
+    double tw = 0.0;
+    WindCell(windSpeed_mps, windNodes_, w, tw);
+    return Blend(table_.data() + w * kCosNodes, table_.data() + (w + 1) * kCosNodes, tw);
 }
 
 }  // namespace seasense::radiometry

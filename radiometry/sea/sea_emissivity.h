@@ -101,6 +101,11 @@ class SeaEmissivityTable {
     double Emissivity(double cosTheta, double windSpeed_mps) const;
     // The curve for one wind speed (per frame), interpolated between wind nodes.
     SeaEmissivityCurve Curve(double windSpeed_mps) const;
+    // SeaEmissivityTable(model, maxWind_mps).Curve(windSpeed_mps), bit for bit, from only the
+    // one or two wind nodes it interpolates (a channel of one wind needs no more: the whole table
+    // is 31 nodes of 129 × 64 × 24 facets each). Throws as the constructor.
+    static SeaEmissivityCurve CurveForWind(const SeaSurfaceEmissivity& model, double windSpeed_mps,
+                                           double maxWind_mps = 30.0);
 
   private:
     int windNodes_;

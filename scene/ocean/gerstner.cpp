@@ -143,6 +143,24 @@ SurfaceTerms GerstnerOcean::Terms(double x0, double y0, double t, double footpri
     return out;
 }
 
+double GerstnerOcean::MaxElevationNear_m(double x, double y, double radius_m, double t) const {
+    CHECK(radius_m >= 0.0);
+    double bound = 0.0;
+    for (size_t i = 0; i < k_.size(); ++i) {
+        // The rest positions within the disc have phases within k r of the centre's (|d| = 1).
+        const double half = k_[i] * radius_m + kPhaseMargin_rad;
+        const double centre = std::remainder(
+            k_[i] * (dirX_[i] * x + dirY_[i] * y) - omega_[i] * t + phase_[i], 2.0 * M_PI);
+        // cos is largest at the crest (θ ≡ 0) when the interval holds it, else at the end nearer
+        // to it; a wave's weighted elevation w A cos θ, w ∈ [0, 1], is then at most A times the
+        // positive part.
+        const double c =
+            std::abs(centre) <= half ? 1.0 : std::cos(std::max(std::abs(centre) - half, 0.0));
+        bound += amplitude_[i] * std::max(c, 0.0);
+    }
+    return std::min(bound, maxAmplitude_m_);
+}
+
 GerstnerOcean::LocalFrame GerstnerOcean::Local(double ox, double oy, double t) const {
     LocalFrame f;
     for (size_t i = 0; i < k_.size(); ++i) {

@@ -90,6 +90,14 @@ class GerstnerOcean {
     double Direction_rad(size_t i) const { return std::atan2(dirX_[i], dirY_[i]); }
     // Largest |elevation| the waves can reach: Σ A_i (m).
     double MaxAmplitude_m() const { return maxAmplitude_m_; }
+    // An upper bound (m, ≥ 0) of the elevation at time t_s of the rest positions within radius_m
+    // of world (x, y), for any footprint weights in [0, 1]: Σ A_i max(0, max cos θ_i) over the
+    // phase interval θ_i(centre) ± (k_i radius + kPhaseMargin_rad) that the disc spans. Never
+    // above MaxAmplitude_m().
+    double MaxElevationNear_m(double x, double y, double radius_m, double t_s) const;
+    // Phase slack of MaxElevationNear_m: far above the float rounding of LocalFrame's phases
+    // (~1e-4 rad, see LocalFrame), so that the bound also holds for the float mesh path.
+    static constexpr double kPhaseMargin_rad = 1e-2;
     // Largest horizontal displacement the waves can cause: Σ Q A / tanh(kh) (m).
     double MaxHorizontal_m() const { return maxHorizontal_m_; }
     // Shortest wavelength among the waves (m), for mesh resolution choices.

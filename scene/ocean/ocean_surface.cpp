@@ -411,6 +411,75 @@ SurfaceBounds OceanSurfaceFrame::BoundsNear(double x, double y, double radius_m)
     return {std::max({tide + b.height_m, zBed, 0.0}), b.horizontal_m};
 }
 
+SurfWaves::Bound OceanSurfaceFrame::CascadeBoundNear(size_t c, double x, double y,
+                                                     double radius_m) const {
+    const CascadeTexture& t = textures_[c];
+    SurfWaves::Bound b;
+    for (size_t level = 0; level < t.levels.size(); ++level) {
+        // AddBilinear at rest position x0 reads texels floor(u) and floor(u) + 1 of the level,
+        // u = ((x0 + Δ/2) / Δ) 2^−l − ½, which grows with x0: the disc's bounding box reads
+        // those from its low edge to its high edge, one more on each side for rounding.
+        const int n = t.n >> level;
+        const double scale = 1.0 / double(1 << level);
+        const auto texels = [&](double centre, int64_t& lo, int64_t& hi) {
+            const auto u = [&](double x0) {
+                return ((x0 + 0.5 * t.texel_m) / t.texel_m) * scale - 0.5;
+            };
+            lo = int64_t(std::floor(u(centre - radius_m))) - 1;
+            hi = int64_t(std::floor(u(centre + radius_m))) + 2;
+            if (hi - lo + 1 >= n) lo = 0, hi = n - 1;  // every texel of the periodic level
+        };
+        int64_t i0 = 0, i1 = 0, j0 = 0, j1 = 0;
+        texels(x, i0, i1);
+        texels(y, j0, j1);
+        const std::vector<Texel>& texture = t.levels[level];
+        float maxHeight = 0.0f;  // 0: a cascade weighted by w ∈ [0, 1] adds at most w · max(0, η)
+        double maxD2 = 0.0;
+        for (int64_t i = i0; i <= i1; ++i) {
+            const Texel* row = texture.data() + size_t(i & (n - 1)) * size_t(n);
+            for (int64_t j = j0; j <= j1; ++j) {
+                const GeometrySums& v = row[size_t(j & (n - 1))].v;
+                maxHeight = std::max(maxHeight, v[kTermHeight]);
+                maxD2 = std::max(maxD2, double(v[kTermDispX]) * double(v[kTermDispX]) +
+                                            double(v[kTermDispY]) * double(v[kTermDispY]));
+            }
+        }
+        // A lookup blends two levels' bilinear interpolations, each within its texels' maxima
+        // (the vector's length by the triangle inequality).
+        b.height_m = std::max(b.height_m, double(maxHeight));
+        b.horizontal_m = std::max(b.horizontal_m, std::sqrt(maxD2));
+    }
+    return b;
+}
+
+SurfaceBounds OceanSurfaceFrame::LocalBoundsNear(double x, double y, double radius_m) const {
+    CHECK(radius_m >= 0.0);
+    const SurfaceBounds global = BoundsNear(x, y, radius_m);
+    std::vector<SurfWaves::Bound> cascades(textures_.size());
+    for (size_t c = 0; c < textures_.size(); ++c) cascades[c] = CascadeBoundNear(c, x, y, radius_m);
+    SurfWaves::Bound gerstner = GerstnerBound();
+    gerstner.height_m = gerstner_.MaxElevationNear_m(x, y, radius_m, t_s_);
+    SurfaceBounds local;
+    if (!surf_) {
+        local.height_m = gerstner.height_m, local.horizontal_m = gerstner.horizontal_m;
+        for (const SurfWaves::Bound& b : cascades)
+            local.height_m += b.height_m, local.horizontal_m += b.horizontal_m;
+    } else {
+        // As BoundsNear, with the local parts in place of the whole surface's, where the disc's
+        // water is all deeper than the surf's deepest fade: there BoundAtDepths is the deep sea's
+        // bound, the sum of the parts. Nearer the shore the surf's components and depth weights
+        // enter, whose interval-by-interval bound (BoundAtDepths without its per-frame table)
+        // would cost more than the mesh saves: BoundsNear serves.
+        const double tide = surf_->Bathy().Tide_m();
+        const double zBed = surf_->Bathy().MaxSeabedZWithin_m(x, y, radius_m + surfReach_m_);
+        if (!(tide - zBed >= surf_->FadeDeep_m())) return global;
+        const SurfWaves::Bound b = surf_->BoundAtDepths(tide - zBed, cascades, gerstner);
+        local = {std::max({tide + b.height_m, zBed, 0.0}), b.horizontal_m};
+    }
+    return {std::min(local.height_m + kLocalBoundMargin_m, global.height_m),
+            std::min(local.horizontal_m + kLocalBoundMargin_m, global.horizontal_m)};
+}
+
 std::shared_ptr<const OceanSurfaceFrame> OceanSurface::At(double t) const {
     CHECK(std::isfinite(t));
     std::lock_guard<std::mutex> lock(cache_->mutex);

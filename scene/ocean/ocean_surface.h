@@ -133,6 +133,15 @@ class OceanSurfaceFrame {
     // with a surf zone, waves over shallow water are capped by their depth, so the sea near an
     // eyepoint in deeper water is bounded far more tightly than the whole surface.
     SurfaceBounds BoundsNear(double x, double y, double radius_m) const;
+    // BoundsNear taken from the waves near (x, y) rather than from their maxima over the whole
+    // surface: each FFT cascade bounded by the highest texel (and the longest horizontal
+    // displacement) that a lookup within the disc can read at any mip level, the Gerstner
+    // waves' elevation by GerstnerOcean::MaxElevationNear_m; the surf zone and the seabed as in
+    // BoundsNear. Never above BoundsNear; the height includes kLocalBoundMargin_m.
+    SurfaceBounds LocalBoundsNear(double x, double y, double radius_m) const;
+    // Added to LocalBoundsNear's height and reach: the float rounding of the mesh's sums (a few
+    // ulp of metres) far below it.
+    static constexpr double kLocalBoundMargin_m = 1e-3;
     // Significant wave height of the sea (time-independent; for mesh spacing choices), m.
     double SignificantHeight_m() const { return significantHeight_m_; }
 
@@ -150,6 +159,8 @@ class OceanSurfaceFrame {
         std::vector<std::vector<Texel>> levels;
     };
     void BuildTextures();
+    // Cascade c's bound over the lookups at rest positions within radius_m of (x, y).
+    SurfWaves::Bound CascadeBoundNear(size_t c, double x, double y, double radius_m) const;
     SurfWaves::Bound GerstnerBound() const;
 
     double t_s_ = 0.0;

@@ -165,6 +165,37 @@ TEST(FlirChannel, CalmSeaAtNadirIsEmissionPlusReflectedZenithSky) {
     EXPECT_NEAR(L.At(4, 4)[0], expected, 1e-3 * expected);
 }
 
+TEST(FlirChannel, SkySamplesAreTheSkyRadianceOfTheirViewDirection) {
+    // Every sample of a view above the horizon (whole rows of sky, shaded as runs, and, with
+    // a roll that tilts the horizon through the frame, short runs and single samples beside
+    // the sea) is the atmosphere's exact band sky radiance at its own view direction's zenith
+    // cosine (Atmosphere::SkyRadiance, not the channel's table: within its 1e-4) through no
+    // path (the sky radiance is already the path's). 2×2 supersampled, any odd width.
+    for (const double roll_deg : {0.0, 25.0}) {
+        scene::Scenario sc = BaseScenario();
+        sc.eyepoint.position_m = {0, 0, 10.0};
+        sc.eyepoint.attitude.pitch_rad = (roll_deg == 0.0 ? 30.0 : 2.0) * M_PI / 180.0;
+        sc.eyepoint.attitude.roll_rad = roll_deg * M_PI / 180.0;
+        sc.channels[0].width = 61;
+        sc.channels[0].supersampling = 2;
+        const scene::World world(sc);
+        FlirChannel flir(world, sc.channels[0]);
+        const Image L = RenderOnce(world, flir, 2);
+        const ChannelCamera& cam = flir.Camera();
+        const radiometry::Atmosphere& air = flir.GetAtmosphere();
+        int sky = 0;
+        for (int y = 0; y < L.height; ++y)
+            for (int x = 0; x < L.width; ++x) {
+                const glm::dvec3 d = cam.SampleDirection(x, y);
+                if (d.z < 0.02) continue;  // the sea, and its crests near the horizon
+                const double expected = air.SkyRadiance(d.z / glm::length(d));
+                EXPECT_NEAR(L.At(x, y)[0], expected, 2e-4 * expected) << x << " " << y;
+                ++sky;
+            }
+        EXPECT_GE(sky, L.width * L.height / (roll_deg == 0.0 ? 1 : 4));
+    }
+}
+
 TEST(FlirChannel, IsothermalSceneRendersTheAirBlackbodyEverywhere) {
     // Kirchhoff: in a dense fog (visibility 100 m: aerosol optical depth ≈ 39 to the zenith)
     // the sky is B(T_air); with the sea and a grey (ε = 0.6) box at T_air too, emission plus

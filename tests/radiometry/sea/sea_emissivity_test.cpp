@@ -4,10 +4,13 @@
 
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
 #include <complex>
+#include <cstdint>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include "radiometry/sea/water_index.h"
 #include "radiometry/surface/fresnel.h"
@@ -133,6 +136,29 @@ TEST(SeaEmissivity, TableAndCurveMatchTheDirectQuadrature) {
     EXPECT_EQ(e[1], curve.Emissivity(0.5f));
     EXPECT_EQ(e[2], curve.Emissivity(1.0f));
     EXPECT_THROW(SeaEmissivityTable(sea, 0.5), InputError);
+}
+
+// The curve of one wind from its own wind nodes is the whole table's curve bit for bit: whole
+// and fractional winds, calm, the table's end and beyond it (clamped), two table sizes, LWIR
+// and MWIR.
+TEST(SeaEmissivity, CurveForOneWindIsTheTablesCurveBitForBit) {
+    for (const Band& band : {Band::Lwir(), Band::Mwir()}) {
+        const SeaSurfaceEmissivity sea(band);
+        for (const double maxWind : {30.0, 12.5}) {
+            const SeaEmissivityTable table(sea, maxWind);
+            for (const double w : {0.0, 0.4, 6.0, 7.25, 12.5, 13.0, 29.9, 30.0, 45.0, -2.0}) {
+                const std::vector<float> fast =
+                    SeaEmissivityTable::CurveForWind(sea, w, maxWind).Nodes();
+                const std::vector<float> full = table.Curve(w).Nodes();
+                ASSERT_EQ(fast.size(), full.size());
+                for (size_t i = 0; i < full.size(); ++i)
+                    EXPECT_EQ(std::bit_cast<uint32_t>(fast[i]), std::bit_cast<uint32_t>(full[i]))
+                        << band.Name() << " " << maxWind << " " << w << " " << i;
+            }
+        }
+    }
+    EXPECT_THROW(SeaEmissivityTable::CurveForWind(SeaSurfaceEmissivity(Band::Lwir()), 5.0, 0.5),
+                 InputError);
 }
 
 TEST(SeaEmissivity, RejectsBandsOutsideTheWaterTable) {

@@ -36,6 +36,49 @@ double CrestX(const GerstnerOcean& o, double xGuess, double halfWidth, double t)
     return 0.5 * (a + b);
 }
 
+// The elevation bound over a disc holds at every rest position sampled in it (one wave and two,
+// many times and discs); for one wave it is the sampled maximum but for the phase margin, so
+// below the amplitude where no crest lies in the disc.
+TEST(Gerstner, ElevationNearADiscBoundsEveryPointInIt) {
+    const OceanSettings one = OneWave(60.0, 0.5, 0.6, 30.0, 20.0);
+    OceanSettings two = one;
+    GerstnerWaveSettings w;
+    w.direction_rad = 2.0;
+    w.wavelength_m = 23.0;
+    w.amplitude_m = 0.2;
+    w.steepness = 0.3;
+    w.phase_rad = 0.7;
+    two.waves.push_back(w);
+    for (const OceanSettings& s : {one, two}) {
+        const GerstnerOcean o(s);
+        int below = 0;
+        for (int f = 0; f < 40; ++f) {
+            const double t = 0.91 * f, cx = 13.0 * f - 200.0, cy = 7.0 * f;
+            for (const double r : {0.0, 2.0, 8.0, 30.0}) {
+                const double bound = o.MaxElevationNear_m(cx, cy, r, t);
+                EXPECT_LE(bound, o.MaxAmplitude_m());
+                double highest = -1.0;
+                for (int i = 0; i <= 40; ++i)
+                    for (int j = 0; j < (i == 0 ? 1 : 144); ++j) {
+                        const double rho = r * i / 40.0, a = 2.0 * M_PI * j / 144.0;
+                        const double x = cx + rho * std::cos(a), y = cy + rho * std::sin(a);
+                        const SurfaceTerms terms = o.Terms(x, y, t);
+                        highest = std::max(highest, terms.displacement.z);
+                        EXPECT_LE(terms.displacement.z, bound + 1e-12) << f << " " << r;
+                    }
+                if (s.waves.size() == 1) {
+                    // The margin moves the phase by 0.01 rad (≤ 0.005 m at A = 0.5 m).
+                    EXPECT_LE(bound, std::max(highest, 0.0) + 0.006) << f << " " << r;
+                    if (bound < 0.9 * o.MaxAmplitude_m()) ++below;
+                }
+            }
+        }
+        if (s.waves.size() == 1) {
+            EXPECT_GT(below, 20);
+        }
+    }
+}
+
 TEST(Gerstner, DeepWaterCrestsTravelAtPhaseSpeed) {
     // Deep water: c = √(g λ / 2π) (Airy theory, e.g. Lamb, Hydrodynamics §229).
     const double lambda = 40.0;

@@ -302,6 +302,61 @@ TEST(OceanMesh, SurfVertexHeightsMatchTheQueryAtThatPoint) {
     EXPECT_LT(worst, 1e-4);
 }
 
+// The bounds near a point that cull the sea nearest a view (OceanSurfaceFrame::LocalBoundsNear)
+// hold at every vertex the mesh draws from a rest position inside the disc (whatever mip level
+// and Gerstner footprint weights its ring uses) and at the unfiltered surface there, over many
+// frames: in open water, and with a surf zone from deep water over the bar to the beach. Near
+// an eye in open water they are well below the whole surface's bound they replace.
+TEST(OceanMesh, LocalBoundsHoldAtEveryVertexDrawnFromTheDisc) {
+    for (const bool surf : {false, true}) {
+        const OceanSurface sea(surf ? WithSurf(Beaufort5()) : Beaufort5());
+        int vertices = 0, tighter = 0;
+        for (int f = 0; f < 12; ++f) {
+            const auto frame = sea.At(1.37 * f);
+            for (const double cx : {-20.0, 120.0, 260.0, 900.0}) {
+                const glm::dvec3 eye(cx, 40.0 * f, 2.0);
+                OceanMeshRequest req = View(eye, 0.0, kPi);  // the whole circle
+                req.angularStep_rad = 0.02;
+                OceanMesh m;
+                BuildOceanMesh(*frame, req, m);
+                for (const double r : {0.0, 3.0, 12.0, 40.0}) {
+                    const SurfaceBounds b = frame->LocalBoundsNear(eye.x, eye.y, r);
+                    const SurfaceBounds all = frame->BoundsNear(eye.x, eye.y, r);
+                    EXPECT_LE(b.height_m, all.height_m);
+                    EXPECT_LE(b.horizontal_m, all.horizontal_m);
+                    if (!surf && b.height_m < 0.8 * all.height_m) ++tighter;
+                    for (int j = 0; j < m.rings && m.radii_m[size_t(j)] <= r; ++j) {
+                        const double rho = m.radii_m[size_t(j)];
+                        const double drop = CurvatureDrop_m(rho);
+                        for (uint32_t v = m.ringStart[size_t(j)]; v < m.ringStart[size_t(j) + 1];
+                             ++v) {
+                            const int64_t column =
+                                m.ringFirstColumn[size_t(j)] +
+                                int64_t(v - m.ringStart[size_t(j)]) * m.ringStride[size_t(j)];
+                            const double az = 2.0 * kPi * double(column) / m.circleSegments;
+                            const double x0 = eye.x + rho * std::sin(az),
+                                         y0 = eye.y + rho * std::cos(az);
+                            const glm::dvec3 p(m.positions[v]);
+                            EXPECT_LE(p.z + drop, b.height_m) << surf << " " << cx << " " << r;
+                            EXPECT_LE(std::hypot(p.x - x0, p.y - y0), b.horizontal_m + 1e-3)
+                                << surf << " " << cx << " " << r;
+                            const SurfaceTerms t = frame->Terms(x0, y0);
+                            EXPECT_LE(t.displacement.z, b.height_m);
+                            EXPECT_LE(std::hypot(t.displacement.x, t.displacement.y),
+                                      b.horizontal_m);
+                            ++vertices;
+                        }
+                    }
+                }
+            }
+        }
+        EXPECT_GT(vertices, 10000);
+        if (!surf) {
+            EXPECT_GT(tighter, 24);  // of 192 discs
+        }
+    }
+}
+
 TEST(OceanMesh, DryLandShortcutIsTheFullEvaluationBitForBit) {
     // Where OceanSurfaceFrame::DryLandSums claims dry land, the mesh skips the surf terms, the
     // faded deep sea and the clamp test: its sums must be exactly what that whole path (as
