@@ -17,6 +17,9 @@ namespace seasense::channels {
 
 namespace {
 
+// PlumeScreenBins::kStride, the floats of one puff's record (for the loaders below).
+constexpr size_t kPuffRecord = 16;
+
 // The screen ellipse of a puff's cutoff ellipsoid wholly in front of the eye: the pixel
 // coordinates p = (x, y) whose rays meet the ellipsoid of Mahalanobis radius² r2, as
 // {p : (p − centre)ᵀ Q (p − centre) ≤ 1}; out = centre x, y, Q_xx, Q_xy, Q_yy, √λmax(Q), or
@@ -71,6 +74,7 @@ void FootprintEllipse(const glm::dmat3& cameraFromWorld, const glm::dvec3& q, do
 PlumeScreenBins::PlumeScreenBins(const scene::PlumeField& field, const ChannelCamera& camera,
                                  scene::ObscurantBand band, float tolerance) {
     CHECK(tolerance > 0.0f);
+    static_assert(size_t(kStride) == kPuffRecord);
     UseWideTraces(true);
     width_ = camera.width + kMargin;
     height_ = camera.height + kMargin;
@@ -268,20 +272,21 @@ PlumeScreenBins::PlumeScreenBins(const scene::PlumeField& field, const ChannelCa
     for (const Projected& p : projected) keptCount += p.kept;
     kept_.reserve(keptCount);
     footprint_.reserve(keptCount);
-    for (int f = 0; f < kFields; ++f) data_[f].reserve(keptCount + 1);
+    puffData_.assign((keptCount + 1) * kStride, 0.0f);
     for (size_t i = 0; i < n; ++i) {
         const Projected& p = projected[i];
         if (!p.kept) continue;
         kept_.push_back(uint32_t(i));
         footprint_.push_back(p.footprint);
-        for (int f = 0; f < kFields; ++f) data_[f].push_back(p.values[f]);
+        std::copy(std::begin(p.values), std::end(p.values),
+                  puffData_.begin() + ptrdiff_t((kept_.size() - 1) * kStride));
     }
 
     // The inert puff: a unit sphere at the eye with a negative cutoff, beyond every range.
     inert_ = uint32_t(kept_.size());
     const float inert[kFields] = {0, 0, 0, 1, 1, -1, 0, std::numeric_limits<float>::infinity(),
                                   0, 0, 0, 0, 0};
-    for (int f = 0; f < kFields; ++f) data_[f].push_back(inert[f]);
+    std::copy(std::begin(inert), std::end(inert), puffData_.begin() + ptrdiff_t(inert_ * kStride));
 
     // Counting sort of (tile, kept position) pairs: per tile in increasing kept position.
     tileStart_.assign(size_t(tilesX_) * size_t(tilesY_) + 1, 0);
@@ -488,11 +493,22 @@ void PlumeScreenBins::GatherRow(const List& from, int x0, int y0, int y1, int st
 void PlumeScreenBins::Copy(List& list) const {
     static_assert(std::size(decltype(List::data){}) == kFields);
     if (list.copied) return;
-    for (int f = 0; f < kFields; ++f) {
-        std::vector<float>& v = list.data[f];
-        v.resize(list.index.size());
-        const float* src = data_[f].data();
-        for (size_t j = 0; j < list.index.size(); ++j) v[j] = src[list.index[j]];
+    const size_t n = list.index.size();  // a multiple of 4
+    for (int f = 0; f < kFields; ++f) list.data[f].resize(n);
+    // Four puffs at a time: each block of four fields of their records transposed into four
+    // fields of four puffs (SSE2 shuffles: the values are moved, not changed).
+    for (size_t j = 0; j < n; j += 4) {
+        const float* rec[4];
+        for (int l = 0; l < 4; ++l)
+            rec[l] = puffData_.data() + size_t(list.index[j + size_t(l)]) * kStride;
+        for (int f0 = 0; f0 < kFields; f0 += 4) {
+            __m128 r0 = _mm_loadu_ps(rec[0] + f0), r1 = _mm_loadu_ps(rec[1] + f0);
+            __m128 r2 = _mm_loadu_ps(rec[2] + f0), r3 = _mm_loadu_ps(rec[3] + f0);
+            _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+            const __m128 fields[4] = {r0, r1, r2, r3};
+            for (int f = f0; f < std::min(f0 + 4, int(kFields)); ++f)
+                _mm_storeu_ps(list.data[f].data() + j, fields[f - f0]);
+        }
     }
     list.copied = true;
 }
@@ -576,7 +592,8 @@ inline BandTrace Result(const BandAccumulator& lo, const BandAccumulator& hi) {
     return t;
 }
 
-// Four values of a field from k on: contiguous in a copied list, else gathered by index.
+// Four values of a field from k on: contiguous in a copied list, else gathered by index from
+// the records (field: the field in the first record).
 template <bool Copied>
 inline F4 Load4(const std::vector<float>& copied, const float* field, const uint32_t* index,
                 size_t k) {
@@ -584,7 +601,8 @@ inline F4 Load4(const std::vector<float>& copied, const float* field, const uint
         return _mm_loadu_ps(copied.data() + k);
     } else {
         const uint32_t* i = index + k;
-        return _mm_setr_ps(field[i[0]], field[i[1]], field[i[2]], field[i[3]]);
+        constexpr size_t m = kPuffRecord;
+        return _mm_setr_ps(field[i[0] * m], field[i[1] * m], field[i[2] * m], field[i[3] * m]);
     }
 }
 
@@ -630,7 +648,8 @@ __attribute__((target("avx2"))) inline F8 ErfOrSign8(F8 x, F8 use) {
     return _mm256_or_ps(e, sign);
 }
 
-// Eight values of a field from k on: contiguous in a copied list, else gathered by index.
+// Eight values of a field from k on: contiguous in a copied list, else gathered by index from
+// the records (field: the field in the first record).
 template <bool Copied>
 __attribute__((target("avx2"))) inline F8 Load8(const std::vector<float>& copied,
                                                 const float* field, const uint32_t* index,
@@ -639,8 +658,9 @@ __attribute__((target("avx2"))) inline F8 Load8(const std::vector<float>& copied
         return _mm256_loadu_ps(copied.data() + k);
     } else {
         const uint32_t* i = index + k;
-        return _mm256_setr_ps(field[i[0]], field[i[1]], field[i[2]], field[i[3]], field[i[4]],
-                              field[i[5]], field[i[6]], field[i[7]]);
+        constexpr size_t m = kPuffRecord;
+        return _mm256_setr_ps(field[i[0] * m], field[i[1] * m], field[i[2] * m], field[i[3] * m],
+                              field[i[4] * m], field[i[5] * m], field[i[6] * m], field[i[7] * m]);
     }
 }
 
@@ -741,15 +761,15 @@ __attribute__((target("avx2"))) void PlumeScreenBins::TraceWide(const List& l, c
     size_t k = 0;
     for (; k + 8 <= l.index.size(); k += 8)
         eight([&](int f) __attribute__((target("avx2"))) {
-            return Load8<Copied>(l.data[f], data_[f].data(), l.index.data(), k);
+            return Load8<Copied>(l.data[f], puffData_.data() + f, l.index.data(), k);
         });
     // A last group of four (lists hold a multiple of four): in the low lanes, the inert puff
     // in the high ones (unused, so they add zeros to the odd groups' sums).
     if (k < l.index.size())
         eight([&](int f) __attribute__((target("avx2"))) {
             return _mm256_insertf128_ps(_mm256_castps128_ps256(Load4<Copied>(
-                                            l.data[f], data_[f].data(), l.index.data(), k)),
-                                        _mm_set1_ps(data_[f][inert_]), 1);
+                                            l.data[f], puffData_.data() + f, l.index.data(), k)),
+                                        _mm_set1_ps(puffData_[inert_ * kStride + size_t(f)]), 1);
         });
     BandAccumulator lo, hi;
     first.Split(lo, hi);
@@ -784,7 +804,7 @@ template <bool Copied, bool Two>
 void PlumeScreenBins::Trace2Impl(const List& l, const glm::vec3& dir, float range_m, float range2_m,
                                  BandTrace& first, BandTrace& second) const {
     const auto load = [&](int f, size_t k) {
-        return Load4<Copied>(l.data[f], data_[f].data(), l.index.data(), k);
+        return Load4<Copied>(l.data[f], puffData_.data() + f, l.index.data(), k);
     };
 #ifdef SEASENSE_PLUME_WIDE
     if (wide_) {
