@@ -404,38 +404,38 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
         }
     };
 
-    // Apply(*t[l], PixelDirection(px[l], py[l]), px[l], py[l], …, nullptr) for l < n ≤ 4
-    // pixels with one trace each (t[l] for l ≥ n: any trace), the directions and visible source
-    // functions four pixels at a time (VisibleSource4, the same bits); e^(−τ) per pixel.
-    const auto ApplyFour = [&](const BandTrace* const t[4], const int px[4], const int py[4],
-                               int n) {
-        float T[4] = {1.0f, 1.0f, 1.0f, 1.0f};
-        bool active[4] = {false, false, false, false};
-        for (int l = 0; l < n; ++l) {
-            active[l] = t[l]->opticalDepth > 0.0f;
-            if (active[l]) T[l] = std::exp(-t[l]->opticalDepth);
-        }
-        if (!visible) {
-            for (int l = 0; l < n; ++l)
-                if (active[l]) {
-                    const float S[3] = {InfraredSource(*t[l], light), 0.0f, 0.0f};
-                    CompositeAll(px[l], py[l], T[l], S);
+    // Apply(t[l], PixelDirection(px[l], py[l]), px[l], py[l], …, nullptr) for the n ≤ kCell²
+    // pixels l of a cell with one trace each: first the visible source functions four pixels
+    // at a time (VisibleSource4, the same bits; the groups are independent, so the processor
+    // overlaps their divisions and square roots), then e^(−τ) and the compositing per pixel.
+    constexpr int kCellPixels = kCell * kCell;
+    const auto ApplyCell = [&](const BandTrace* t, const int* px, const int* py, int n) {
+        glm::vec3 S[kCellPixels];
+        if (visible)
+            for (int k = 0; k < n; k += 4) {
+                // A last group of fewer than four repeats its last pixel.
+                const BandTrace* group[4];
+                float a[4], b[4];
+                for (int l = 0; l < 4; ++l) {
+                    const int m = std::min(k + l, n - 1);
+                    group[l] = &t[m];
+                    a[l] = colA[size_t(px[m])];
+                    b[l] = rowB[size_t(py[m])];
                 }
-            return;
-        }
-        // The lanes beyond n repeat lane 0 (their results are not used).
-        float a[4], b[4];
-        for (int l = 0; l < 4; ++l) {
-            a[l] = colA[size_t(px[l < n ? l : 0])];
-            b[l] = rowB[size_t(py[l < n ? l : 0])];
-        }
-        glm::vec3 S[4];
-        plume_detail::VisibleSource4(t, worldFromCamera, a, b, n, light, S);
-        for (int l = 0; l < n; ++l)
-            if (active[l]) {
-                const float Sl[3] = {S[l].x, S[l].y, S[l].z};
-                CompositeAll(px[l], py[l], T[l], Sl);
+                plume_detail::VisibleSource4(group, worldFromCamera, a, b, std::min(4, n - k),
+                                             light, S + k);
             }
+        for (int l = 0; l < n; ++l) {
+            if (!(t[l].opticalDepth > 0.0f)) continue;
+            const float T = std::exp(-t[l].opticalDepth);
+            if (visible) {
+                const float Sl[3] = {S[l].x, S[l].y, S[l].z};
+                CompositeAll(px[l], py[l], T, Sl);
+            } else {
+                const float Sl[3] = {InfraredSource(t[l], light), 0.0f, 0.0f};
+                CompositeAll(px[l], py[l], T, Sl);
+            }
+        }
     };
 
     // Every cell works on the puffs whose screen
@@ -816,7 +816,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                     // The pixels composited with one trace each, deferred to the end of the cell
                     // so that ApplyFour does them four at a time: those blended from the cell's
                     // corners (Bilinear4, four at a time too) and those whose trace is made.
-                    constexpr int kPixels = kCell * kCell;
+                    constexpr int kPixels = kCellPixels;
                     int blended = 0, pending = 0;
                     int blendPx[kPixels], blendPy[kPixels], pendingPx[kPixels], pendingPy[kPixels];
                     float blendFx[kPixels], blendFy[kPixels];
@@ -946,12 +946,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                         for (int l = 0; l < std::min(4, blended - k); ++l)
                             Defer(out[l], blendPx[k + l], blendPy[k + l]);
                     }
-                    for (int k = 0; k < pending; k += 4) {
-                        const BandTrace* t[4];
-                        for (int l = 0; l < 4; ++l)
-                            t[l] = &pendingTrace[std::min(k + l, pending - 1)];
-                        ApplyFour(t, pendingPx + k, pendingPy + k, std::min(4, pending - k));
-                    }
+                    ApplyCell(pendingTrace, pendingPx, pendingPy, pending);
                 }
                 rowCovered[size_t(cy)] = covered;
                 rowTraces[size_t(cy)] += traces, rowTests[size_t(cy)] += tests;
