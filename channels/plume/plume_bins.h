@@ -142,7 +142,12 @@ class PlumeScreenBins {
         kWg,
         kFields
     };
-    std::vector<float> data_[kFields];
+    // The fields of kept puff k at puffData_[k · kStride + field]: one puff's record in one 64-byte
+    // block, so that Copy reads a puff's fields together (four puffs transposed at a time)
+    // instead of thirteen scattered values.
+    static constexpr int kStride = 16;
+    static_assert(kFields <= kStride);
+    std::vector<float> puffData_;
     std::vector<uint32_t> kept_;
     // What list building reads of a kept puff, in one record: its screen rectangle; the
     // ellipse of its cutoff ellipsoid on the screen, (p − centre)ᵀ Q (p − centre) ≤ 1 in pixel

@@ -12,6 +12,8 @@
 #include <limits>
 #include <memory>
 #include <numbers>
+#include <utility>
+#include <vector>
 
 #include "channels/flir/flir_channel.h"
 #include "channels/plume/plume_bins.h"
@@ -41,8 +43,34 @@ constexpr float kInterpolationTolerance_K = 10.0f;
 // A pixel whose samples' surface ranges differ by more than this ratio traces a second ray.
 constexpr float kDepthEdgeRatio = 1.1f;
 
-// Bilinear blend of four traces (corners 00, 10, 01, 11) at fractions fx, fy: optical depths
-// blend linearly; albedo, temperatures and asymmetry as the matching depth-weighted means.
+// Absorption-weighted emission of the trace's puffs in band b: the hot (flame) part and the
+// rest each at their own mean temperature. emit(T) is the band's blackbody radiance.
+template <class Emission>
+auto ThermalEmission(const BandTrace& t, const Emission& emit) {
+    const float h = t.hotFraction;
+    const float T = t.temperature_K, Thot = t.hotTemperature_K;
+    using Value = decltype(emit(T));
+    Value sum = Value(0.0f);
+    if (h > 0.0f && Thot > 0.0f) sum = sum + emit(Thot) * h;
+    if (h < 1.0f && T > 0.0f) {
+        // T = (1 − h) T_rest + h T_hot.
+        const float rest = std::max((T - h * Thot) / (1.0f - h), 0.0f);
+        if (rest > 0.0f) sum = sum + emit(rest) * (1.0f - h);
+    }
+    return sum;
+}
+
+float InfraredSource(const BandTrace& t, const PlumeLighting& light) {
+    const float omega = t.albedo;
+    return omega * light.ambient + (1.0f - omega) * ThermalEmission(t, [&](float T_K) {
+                                       return T_K > 0.0f ? float(light.planck->Radiance(T_K))
+                                                         : 0.0f;
+                                   });
+}
+}  // namespace
+
+namespace plume_detail {
+
 BandTrace Bilinear(const BandTrace* const t[4], float fx, float fy) {
     const float w[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
     float tau = 0.0f, scattering = 0.0f, absorbing = 0.0f, temperature = 0.0f, hot = 0.0f,
@@ -70,20 +98,50 @@ BandTrace Bilinear(const BandTrace* const t[4], float fx, float fy) {
     return out;
 }
 
-// Absorption-weighted emission of the trace's puffs in band b: the hot (flame) part and the
-// rest each at their own mean temperature. emit(T) is the band's blackbody radiance.
-template <class Emission>
-auto ThermalEmission(const BandTrace& t, const Emission& emit) {
-    const float h = t.hotFraction;
-    const float T = t.temperature_K, Thot = t.hotTemperature_K;
-    decltype(emit(T)) sum = emit(0.0f) * 0.0f;
-    if (h > 0.0f && Thot > 0.0f) sum = sum + emit(Thot) * h;
-    if (h < 1.0f && T > 0.0f) {
-        // T = (1 − h) T_rest + h T_hot.
-        const float rest = std::max((T - h * Thot) / (1.0f - h), 0.0f);
-        if (rest > 0.0f) sum = sum + emit(rest) * (1.0f - h);
+// The same operations lane for lane as Bilinear (SSE2, no fused multiply-add; a quotient
+// where Bilinear takes 0 is masked to +0).
+void Bilinear4(const BandTrace* const t[4], const float fx[4], const float fy[4],
+               BandTrace out[4]) {
+    const __m128 one = _mm_set1_ps(1.0f), zero = _mm_setzero_ps();
+    const __m128 x = _mm_loadu_ps(fx), y = _mm_loadu_ps(fy);
+    const __m128 x1 = _mm_sub_ps(one, x), y1 = _mm_sub_ps(one, y);
+    const __m128 w[4] = {_mm_mul_ps(x1, y1), _mm_mul_ps(x, y1), _mm_mul_ps(x1, y),
+                         _mm_mul_ps(x, y)};
+    __m128 tau = zero, scattering = zero, absorbing = zero, temperature = zero, hot = zero,
+           hotT = zero, g = zero;
+    for (int k = 0; k < 4; ++k) {
+        const __m128 wt = _mm_mul_ps(w[k], _mm_set1_ps(t[k]->opticalDepth));
+        tau = _mm_add_ps(tau, wt);
+        const __m128 ws = _mm_mul_ps(wt, _mm_set1_ps(t[k]->albedo));
+        scattering = _mm_add_ps(scattering, ws);
+        g = _mm_add_ps(g, _mm_mul_ps(ws, _mm_set1_ps(t[k]->asymmetry)));
+        const __m128 wa = _mm_mul_ps(wt, _mm_set1_ps(1.0f - t[k]->albedo));
+        absorbing = _mm_add_ps(absorbing, wa);
+        temperature = _mm_add_ps(temperature, _mm_mul_ps(wa, _mm_set1_ps(t[k]->temperature_K)));
+        const __m128 wh = _mm_mul_ps(wa, _mm_set1_ps(t[k]->hotFraction));
+        hot = _mm_add_ps(hot, wh);
+        hotT = _mm_add_ps(hotT, _mm_mul_ps(wh, _mm_set1_ps(t[k]->hotTemperature_K)));
     }
-    return sum;
+    // q where mask, else +0.
+    const auto masked = [&](__m128 mask, __m128 q) { return _mm_and_ps(mask, q); };
+    const __m128 anyTau = _mm_cmpgt_ps(tau, zero), anyAbs = _mm_cmpgt_ps(absorbing, zero);
+    const __m128 anyHot = _mm_cmpgt_ps(hot, zero), anyScat = _mm_cmpgt_ps(scattering, zero);
+    alignas(16) float f[6][4];
+    _mm_store_ps(f[0], tau);
+    _mm_store_ps(f[1], masked(anyTau, _mm_div_ps(scattering, tau)));
+    _mm_store_ps(f[2], masked(anyAbs, _mm_div_ps(temperature, absorbing)));
+    // std::min(q, 1) is (1 < q ? 1 : q), which _mm_min_ps(1, q) is.
+    _mm_store_ps(f[3], masked(anyAbs, _mm_min_ps(one, _mm_div_ps(hot, absorbing))));
+    _mm_store_ps(f[4], masked(anyHot, _mm_div_ps(hotT, hot)));
+    _mm_store_ps(f[5], masked(anyScat, _mm_div_ps(g, scattering)));
+    for (int l = 0; l < 4; ++l) {
+        out[l].opticalDepth = f[0][l];
+        out[l].albedo = f[1][l];
+        out[l].temperature_K = f[2][l];
+        out[l].hotFraction = f[3][l];
+        out[l].hotTemperature_K = f[4][l];
+        out[l].asymmetry = f[5][l];
+    }
 }
 
 glm::vec3 VisibleSource(const BandTrace& t, const glm::vec3& toEye, const PlumeLighting& light) {
@@ -97,13 +155,66 @@ glm::vec3 VisibleSource(const BandTrace& t, const glm::vec3& toEye, const PlumeL
     return S;
 }
 
-float InfraredSource(const BandTrace& t, const PlumeLighting& light) {
-    const float omega = t.albedo;
-    return omega * light.ambient + (1.0f - omega) * ThermalEmission(t, [&](float T_K) {
-                                       return T_K > 0.0f ? float(light.planck->Radiance(T_K))
-                                                         : 0.0f;
-                                   });
+void VisibleSource4(const BandTrace* const t[4], const glm::mat3& worldFromCamera, const float a[4],
+                    const float b[4], int n, const PlumeLighting& light, glm::vec3 out[4]) {
+    const auto lanes = [&](auto value) {
+        return _mm_setr_ps(value(0), value(1), value(2), value(3));
+    };
+    // glm::normalize(worldFromCamera * glm::vec3(a, 1, b)): each row's products summed left to
+    // right, then v · (1 / √((v_x² + v_y²) + v_z²)).
+    const __m128 av = _mm_loadu_ps(a), bv = _mm_loadu_ps(b);
+    __m128 v[3];
+    for (int r = 0; r < 3; ++r)
+        v[r] = _mm_add_ps(
+            _mm_add_ps(_mm_mul_ps(_mm_set1_ps(worldFromCamera[0][r]), av),
+                       _mm_mul_ps(_mm_set1_ps(worldFromCamera[1][r]), _mm_set1_ps(1.0f))),
+            _mm_mul_ps(_mm_set1_ps(worldFromCamera[2][r]), bv));
+    const __m128 one = _mm_set1_ps(1.0f), sign = _mm_set1_ps(-0.0f);
+    const __m128 vv = _mm_add_ps(_mm_add_ps(_mm_mul_ps(v[0], v[0]), _mm_mul_ps(v[1], v[1])),
+                                 _mm_mul_ps(v[2], v[2]));
+    const __m128 inv = _mm_div_ps(one, _mm_sqrt_ps(vv));
+    // VisibleSource with toEye = −dir: cos θ = −(sun · toEye), glm's dot summed left to right.
+    __m128 toEye[3];
+    for (int r = 0; r < 3; ++r) toEye[r] = _mm_xor_ps(_mm_mul_ps(v[r], inv), sign);
+    const __m128 cosTheta =
+        _mm_xor_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_set1_ps(light.sunDirection.x), toEye[0]),
+                                         _mm_mul_ps(_mm_set1_ps(light.sunDirection.y), toEye[1])),
+                              _mm_mul_ps(_mm_set1_ps(light.sunDirection.z), toEye[2])),
+                   sign);
+    // HenyeyGreensteinPhase(cos θ, g).
+    const __m128 g = lanes([&](int l) { return t[l]->asymmetry; });
+    const __m128 gg = _mm_mul_ps(g, g);
+    const __m128 denom =
+        _mm_sub_ps(_mm_add_ps(one, gg), _mm_mul_ps(_mm_mul_ps(_mm_set1_ps(2.0f), g), cosTheta));
+    const __m128 phase =
+        _mm_div_ps(_mm_sub_ps(one, gg),
+                   _mm_mul_ps(_mm_mul_ps(_mm_set1_ps(4.0f * kPi), denom), _mm_sqrt_ps(denom)));
+    const __m128 omega = lanes([&](int l) { return t[l]->albedo; });
+    const __m128 rest = _mm_sub_ps(one, omega);
+    // The glow per lane (table look-ups).
+    glm::vec3 glow[4] = {glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f)};
+    if (light.glow)
+        for (int l = 0; l < n; ++l)
+            glow[l] = ThermalEmission(*t[l], [&](float T_K) { return (*light.glow)(T_K); });
+    alignas(16) float S[3][4];
+    for (int c = 0; c < 3; ++c) {
+        __m128 Sc =
+            _mm_mul_ps(omega, _mm_add_ps(_mm_mul_ps(_mm_set1_ps(light.sunIlluminance[c]), phase),
+                                         _mm_set1_ps(light.ambientRgb[c])));
+        if (light.glow)
+            Sc = _mm_add_ps(Sc, _mm_mul_ps(rest, lanes([&](int l) { return glow[l][c]; })));
+        _mm_store_ps(S[c], Sc);
+    }
+    for (int l = 0; l < n; ++l) out[l] = glm::vec3(S[0][l], S[1][l], S[2][l]);
 }
+
+}  // namespace plume_detail
+
+namespace {
+
+using plume_detail::Bilinear;
+using plume_detail::Bilinear4;
+using plume_detail::VisibleSource;
 
 // One row of cells' lists: cell cx has index[start[cx], start[cx + 1]) (padded to 4).
 struct CellRow {
@@ -158,6 +269,7 @@ struct Scratch {
     PlumeScreenBins::List strip, list;
     std::vector<PlumeScreenBins::List> cellLists{PlumeScreenBins::kTile / kCell};
     std::vector<float> range, depthRows;
+    std::vector<std::pair<int, int>> depthRuns;
 };
 Scratch& LocalScratch() {
     thread_local Scratch scratch;
@@ -185,8 +297,9 @@ BlackbodyGlowTable::BlackbodyGlowTable() {
 }
 
 glm::vec3 BlackbodyGlowTable::operator()(float T_K) const {
+    // Below the table (or NaN) without the division: u ≥ 0 exactly when T_K ≥ kMinT_K.
+    if (!(double(T_K) >= kMinT_K)) return glm::vec3(0.0f);
     const double u = (double(T_K) - kMinT_K) / kStep_K;
-    if (!(u >= 0.0)) return glm::vec3(0.0f);
     if (u >= double(rgb_.size() - 1)) return rgb_.back();
     const size_t i = size_t(u);
     const float f = float(u - double(i));
@@ -229,6 +342,32 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
         return glm::normalize(worldFromCamera *
                               glm::vec3(colA[size_t(px)], 1.0f, rowB[size_t(py)]));
     };
+    // Composites every sample of pixel (px, py) with transmittance T and source S (S[0] alone
+    // in the infrared): each sample row's N·channels values are contiguous.
+    const auto CompositeAll = [&](int px, int py, float T, const float* S) {
+        if (visible && N == 2) {
+            // The usual case, each sample row's six values (R G B R G B) at once (SSE2): the
+            // same L_bg·T + (1 − T)·S per value.
+            const __m128 Tv = _mm_set1_ps(T), oneMinusT = _mm_set1_ps(1.0f - T);
+            const __m128 s0 = _mm_mul_ps(oneMinusT, _mm_setr_ps(S[0], S[1], S[2], S[0]));
+            const __m128 s1 = _mm_mul_ps(oneMinusT, _mm_setr_ps(S[1], S[2], 0.0f, 0.0f));
+            for (int j = 0; j < 2; ++j) {
+                float* o = radiance.At(px * 2, py * 2 + j);
+                _mm_storeu_ps(o, _mm_add_ps(_mm_mul_ps(_mm_loadu_ps(o), Tv), s0));
+                const __m128 hi =
+                    _mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<__m128i*>(o + 4)));
+                _mm_storel_epi64(reinterpret_cast<__m128i*>(o + 4),
+                                 _mm_castps_si128(_mm_add_ps(_mm_mul_ps(hi, Tv), s1)));
+            }
+            return;
+        }
+        const int channels = visible ? 3 : 1;
+        for (int j = 0; j < N; ++j) {
+            float* o = radiance.At(px * N, py * N + j);
+            for (int i = 0; i < N; ++i, o += channels)
+                for (int c = 0; c < channels; ++c) o[c] = CompositeThroughPlume(o[c], T, S[c]);
+        }
+    };
     // Composites one pixel's samples with trace t seen along dir (far: the trace to the
     // farthest surface, for the samples nearer it than the nearest).
     const auto Apply = [&](const BandTrace& t, const glm::vec3& dir, int px, int py,
@@ -236,7 +375,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
         if (!(t.opticalDepth > 0.0f) && !(far && far->opticalDepth > 0.0f)) return;
         const BandTrace* traces[2] = {&t, far ? far : &t};
         float T[2], Sir[2] = {0.0f, 0.0f};
-        glm::vec3 Svis[2];
+        glm::vec3 Svis[2] = {glm::vec3(0.0f), glm::vec3(0.0f)};
         for (int k = 0; k < (far ? 2 : 1); ++k) {
             T[k] = std::exp(-traces[k]->opticalDepth);
             if (visible)
@@ -245,16 +384,8 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                 Sir[k] = InfraredSource(*traces[k], light);
         }
         if (!far) {
-            // One trace for every sample: each sample row's N·channels values are contiguous.
-            float S[3] = {Sir[0], 0.0f, 0.0f};
-            if (visible) S[0] = Svis[0].x, S[1] = Svis[0].y, S[2] = Svis[0].z;
-            const int channels = visible ? 3 : 1;
-            for (int j = 0; j < N; ++j) {
-                float* o = radiance.At(px * N, py * N + j);
-                for (int i = 0; i < N; ++i, o += channels)
-                    for (int c = 0; c < channels; ++c)
-                        o[c] = CompositeThroughPlume(o[c], T[0], S[c]);
-            }
+            const float S[3] = {visible ? Svis[0].x : Sir[0], Svis[0].y, Svis[0].z};
+            CompositeAll(px, py, T[0], S);
             return;
         }
         for (int j = 0; j < N; ++j) {
@@ -269,6 +400,40 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                 } else {
                     o[0] = CompositeThroughPlume(o[0], T[k], Sir[k]);
                 }
+            }
+        }
+    };
+
+    // Apply(t[l], PixelDirection(px[l], py[l]), px[l], py[l], …, nullptr) for the n ≤ kCell²
+    // pixels l of a cell with one trace each: first the visible source functions four pixels
+    // at a time (VisibleSource4, the same bits; the groups are independent, so the processor
+    // overlaps their divisions and square roots), then e^(−τ) and the compositing per pixel.
+    constexpr int kCellPixels = kCell * kCell;
+    const auto ApplyCell = [&](const BandTrace* t, const int* px, const int* py, int n) {
+        glm::vec3 S[kCellPixels];
+        if (visible)
+            for (int k = 0; k < n; k += 4) {
+                // A last group of fewer than four repeats its last pixel.
+                const BandTrace* group[4];
+                float a[4], b[4];
+                for (int l = 0; l < 4; ++l) {
+                    const int m = std::min(k + l, n - 1);
+                    group[l] = &t[m];
+                    a[l] = colA[size_t(px[m])];
+                    b[l] = rowB[size_t(py[m])];
+                }
+                plume_detail::VisibleSource4(group, worldFromCamera, a, b, std::min(4, n - k),
+                                             light, S + k);
+            }
+        for (int l = 0; l < n; ++l) {
+            if (!(t[l].opticalDepth > 0.0f)) continue;
+            const float T = std::exp(-t[l].opticalDepth);
+            if (visible) {
+                const float Sl[3] = {S[l].x, S[l].y, S[l].z};
+                CompositeAll(px[l], py[l], T, Sl);
+            } else {
+                const float Sl[3] = {InfraredSource(t[l], light), 0.0f, 0.0f};
+                CompositeAll(px[l], py[l], T, Sl);
             }
         }
     };
@@ -294,19 +459,41 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     // The depths of cell row cy's samples in its cells with puffs, read once in the visibility
     // buffer's order (its rows streamed rather than 2 × 2 samples at a time) into kCell·N rows
     // of vis.width at out; −1 where the sample sees the sky.
-    const auto ReadDepths = [&](int cy, const CellRow& row, float* out) {
+    // Pass 2 never reads the depths of cells without puffs or in front of them: the row's other
+    // cells are read, as runs of neighbouring cells' sample columns [first, second) (runs: the
+    // caller's scratch), four samples at a time (SSE2, the same selection per lane).
+    const auto ReadDepths = [&](int cy, const CellRow& row, float* out,
+                                std::vector<std::pair<int, int>>& runs) {
         const int rowSamples = kCell * N, sy0 = cy * rowSamples;
+        runs.clear();
+        for (int cx = 0; cx < cellsX; ++cx) {
+            if (row.count[size_t(cx)] == 0 || row.inFront[size_t(cx)]) continue;
+            const int sx0 = cx * rowSamples, sx1 = std::min(sx0 + rowSamples, vis.width);
+            if (sx0 >= sx1) continue;
+            if (!runs.empty() && runs.back().second == sx0)
+                runs.back().second = sx1;
+            else
+                runs.emplace_back(sx0, sx1);
+        }
+        const __m128 zero = _mm_setzero_ps(), skyDepth = _mm_set1_ps(-1.0f);
+        const __m128i none = _mm_set1_epi32(int32_t(kNoPrimitive));
         for (int j = 0; j < std::min(rowSamples, vis.height - sy0); ++j) {
             const size_t idx0 = vis.Index(0, sy0 + j);
             const float* depth = vis.depth.data() + idx0;
             const uint32_t* primitive = vis.primitive.data() + idx0;
             float* o = out + size_t(j) * size_t(vis.width);
-            for (int cx = 0; cx < cellsX; ++cx) {
-                // Pass 2 never reads the depths of cells without puffs or in front of them.
-                if (row.count[size_t(cx)] == 0 || row.inFront[size_t(cx)]) continue;
-                for (int sx = cx * rowSamples; sx < std::min((cx + 1) * rowSamples, vis.width);
-                     ++sx) {
-                    // Both tests evaluated (no short circuit), so that the loop vectorises.
+            for (const auto& [sx0, sx1] : runs) {
+                int sx = sx0;
+                for (; sx + 4 <= sx1; sx += 4) {
+                    const __m128 d = _mm_loadu_ps(depth + sx);
+                    const __m128i p =
+                        _mm_loadu_si128(reinterpret_cast<const __m128i*>(primitive + sx));
+                    const __m128 sky = _mm_or_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(p, none)),
+                                                 _mm_cmple_ps(d, zero));
+                    _mm_storeu_ps(o + sx,
+                                  _mm_or_ps(_mm_and_ps(sky, skyDepth), _mm_andnot_ps(sky, d)));
+                }
+                for (; sx < sx1; ++sx) {
                     const float d = depth[sx];
                     const bool sky = (primitive[sx] == kNoPrimitive) | (d <= 0.0f);
                     o[sx] = sky ? -1.0f : d;
@@ -533,13 +720,14 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             range.resize(samples);
             PlumeScreenBins::List& list = local.list;
             const int rowSamples = kCell * N;
+            const __m128 skyRange = _mm_set1_ps(kPlumeSkyRange_m), minusOne = _mm_set1_ps(-1.0f);
             std::vector<float>& depthRows = local.depthRows;
             depthRows.resize(size_t(rowSamples) * size_t(vis.width));
             for (int cy = rows.begin(); cy != rows.end(); ++cy) {
                 uint64_t covered = 0, traces = 0, tests = 0;
                 const CellRow& row = cellRows[size_t(cy)];
                 const int sy0 = cy * rowSamples;
-                ReadDepths(cy, row, depthRows.data());
+                ReadDepths(cy, row, depthRows.data(), local.depthRuns);
                 const auto DepthAt = [&](int sx, int sy) {
                     return depthRows[size_t(sy - sy0) * size_t(vis.width) + size_t(sx)];
                 };
@@ -625,24 +813,61 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                                 subSmooth[sb][sa] = Smooth(c, cT, subFine, subClear[sb][sa]);
                             }
                     };
+                    // The pixels composited with one trace each, deferred to the end of the cell
+                    // so that ApplyFour does them four at a time: those blended from the cell's
+                    // corners (Bilinear4, four at a time too) and those whose trace is made.
+                    constexpr int kPixels = kCellPixels;
+                    int blended = 0, pending = 0;
+                    int blendPx[kPixels], blendPy[kPixels], pendingPx[kPixels], pendingPy[kPixels];
+                    float blendFx[kPixels], blendFy[kPixels];
+                    BandTrace pendingTrace[kPixels];
+                    const auto Defer = [&](const BandTrace& t, int px, int py) {
+                        pendingTrace[pending] = t;
+                        pendingPx[pending] = px, pendingPy[pending] = py;
+                        ++pending;
+                    };
                     for (int py = cy * kCell; py < std::min(H, (cy + 1) * kCell); ++py) {
                         for (int px = cx * kCell; px < std::min(W, (cx + 1) * kCell); ++px) {
                             ++covered;
                             // Samples that see the sky first (no direction needed for them).
                             bool allSky = true;
                             float minDepth = std::numeric_limits<float>::infinity();
-                            for (int j = 0; j < N; ++j)
-                                for (int i = 0; i < N; ++i) {
-                                    const float d = DepthAt(px * N + i, py * N + j);
-                                    const bool sky = d < 0.0f;
-                                    range[size_t(j * N + i)] = sky ? kPlumeSkyRange_m : -1.0f;
-                                    allSky &= sky;
-                                    minDepth = std::min(minDepth, d);
-                                }
+                            if (N == 2) {
+                                // The usual 2 × 2 samples at once (SSE2), in range's order.
+                                const float* d0 =
+                                    &depthRows[size_t(py * 2 - sy0) * size_t(vis.width) +
+                                               size_t(px * 2)];
+                                const __m128 d = _mm_castsi128_ps(_mm_unpacklo_epi64(
+                                    _mm_loadl_epi64(reinterpret_cast<const __m128i*>(d0)),
+                                    _mm_loadl_epi64(
+                                        reinterpret_cast<const __m128i*>(d0 + vis.width))));
+                                const __m128 sky = _mm_cmplt_ps(d, _mm_setzero_ps());
+                                _mm_storeu_ps(range.data(),
+                                              _mm_or_ps(_mm_and_ps(sky, skyRange),
+                                                        _mm_andnot_ps(sky, minusOne)));
+                                allSky = _mm_movemask_ps(sky) == 0xf;
+                                // The depths are finite and not zero (sky −1), so the minimum
+                                // is the same in any order.
+                                __m128 m = _mm_min_ps(d, _mm_movehl_ps(d, d));
+                                m = _mm_min_ss(m, _mm_shuffle_ps(m, m, 1));
+                                minDepth = _mm_cvtss_f32(m);
+                            } else {
+                                for (int j = 0; j < N; ++j)
+                                    for (int i = 0; i < N; ++i) {
+                                        const float d = DepthAt(px * N + i, py * N + j);
+                                        const bool sky = d < 0.0f;
+                                        range[size_t(j * N + i)] = sky ? kPlumeSkyRange_m : -1.0f;
+                                        allSky &= sky;
+                                        minDepth = std::min(minDepth, d);
+                                    }
+                            }
                             // Every surface surely in front of the plumes (skipped below too).
                             if (minDepth >= depthInFront) continue;
                             if (allSky && clearSky) continue;
-                            const glm::vec3 dir = PixelDirection(px, py);
+                            // The direction, where it is needed before ApplyFour (which makes
+                            // it again, the same bits): for the ranges and for traces.
+                            const glm::vec3 dir = allSky ? glm::vec3(0.0f) : PixelDirection(px, py);
+                            const auto Dir = [&] { return allSky ? PixelDirection(px, py) : dir; };
                             float rMin = kPlumeSkyRange_m, rMax = 0.0f;
                             if (allSky) {
                                 rMax = kPlumeSkyRange_m;
@@ -666,10 +891,10 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                                 // Every surface behind the plumes: the sky trace is the trace.
                                 if (clearSky) continue;
                                 if (smooth) {
-                                    const float fx = float(px - cx * kCell) / kCell;
-                                    const float fy = float(py - cy * kCell) / kCell;
-                                    Apply(Bilinear(corner, fx, fy), dir, px, py, range.data(), rMin,
-                                          rMax, nullptr);
+                                    blendFx[blended] = float(px - cx * kCell) / kCell;
+                                    blendFy[blended] = float(py - cy * kCell) / kCell;
+                                    blendPx[blended] = px, blendPy[blended] = py;
+                                    ++blended;
                                     continue;
                                 }
                                 if (!refined) Refine();
@@ -678,8 +903,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                                 const int sa = lx / kHalf, sb = ly / kHalf;
                                 const int ix = lx - sa * kHalf, iy = ly - sb * kHalf;
                                 if (ix == 0 && iy == 0) {
-                                    Apply(sub[sb][sa], dir, px, py, range.data(), rMin, rMax,
-                                          nullptr);
+                                    Defer(sub[sb][sa], px, py);
                                     continue;
                                 }
                                 if (subSmooth[sb][sa]) {
@@ -687,12 +911,11 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                                     const BandTrace* c[4] = {&sub[sb][sa], &sub[sb][sa + 1],
                                                              &sub[sb + 1][sa],
                                                              &sub[sb + 1][sa + 1]};
-                                    Apply(Bilinear(c, float(ix) / kHalf, float(iy) / kHalf), dir,
-                                          px, py, range.data(), rMin, rMax, nullptr);
+                                    Defer(Bilinear(c, float(ix) / kHalf, float(iy) / kHalf), px,
+                                          py);
                                 } else {
                                     Count(1);
-                                    Apply(bins.Trace(list, dir, kPlumeSkyRange_m), dir, px, py,
-                                          range.data(), rMin, rMax, nullptr);
+                                    Defer(bins.Trace(list, Dir(), kPlumeSkyRange_m), px, py);
                                 }
                                 continue;
                             }
@@ -702,15 +925,28 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                             if (rMax > rMin * kDepthEdgeRatio) {
                                 BandTrace nearTrace, farTrace;
                                 Count(2);
-                                bins.Trace2(list, dir, rMin, rMax, nearTrace, farTrace);
-                                Apply(nearTrace, dir, px, py, range.data(), rMin, rMax, &farTrace);
+                                bins.Trace2(list, Dir(), rMin, rMax, nearTrace, farTrace);
+                                Apply(nearTrace, Dir(), px, py, range.data(), rMin, rMax,
+                                      &farTrace);
                             } else {
                                 Count(1);
-                                Apply(bins.Trace(list, dir, rMin), dir, px, py, range.data(), rMin,
-                                      rMax, nullptr);
+                                Defer(bins.Trace(list, Dir(), rMin), px, py);
                             }
                         }
                     }
+                    for (int k = 0; k < blended; k += 4) {
+                        // A last group of fewer than four repeats its first pixel.
+                        float fx[4], fy[4];
+                        for (int l = 0; l < 4; ++l) {
+                            const int m = k + l < blended ? k + l : k;
+                            fx[l] = blendFx[m], fy[l] = blendFy[m];
+                        }
+                        BandTrace out[4];
+                        Bilinear4(corner, fx, fy, out);
+                        for (int l = 0; l < std::min(4, blended - k); ++l)
+                            Defer(out[l], blendPx[k + l], blendPy[k + l]);
+                    }
+                    ApplyCell(pendingTrace, pendingPx, pendingPy, pending);
                 }
                 rowCovered[size_t(cy)] = covered;
                 rowTraces[size_t(cy)] += traces, rowTests[size_t(cy)] += tests;

@@ -78,6 +78,25 @@ struct PlumeLighting {
     const radiometry::BandRadianceTable* planck = nullptr;
 };
 
+// The per-pixel arithmetic of CompositePlumes, with the forms that do four pixels at once
+// (SSE2; the same operations lane for lane in the same order and no fused multiply-add, so each
+// lane has the bits of the one-pixel form: tested).
+namespace plume_detail {
+// Bilinear blend of four traces (corners 00, 10, 01, 11) at fractions fx, fy: optical depths
+// blend linearly; albedo, temperatures and asymmetry as the matching depth-weighted means.
+BandTrace Bilinear(const BandTrace* const t[4], float fx, float fy);
+// Bilinear(t, fx[l], fy[l]) into out[l], l = 0 … 3.
+void Bilinear4(const BandTrace* const t[4], const float fx[4], const float fy[4], BandTrace out[4]);
+// The visible source function S of PlumeLighting for trace t seen along toEye (unit, from the
+// plume to the eye).
+glm::vec3 VisibleSource(const BandTrace& t, const glm::vec3& toEye, const PlumeLighting& light);
+// VisibleSource(*t[l], −normalize(worldFromCamera · (a[l], 1, b[l])), light) into out[l] for
+// l < n ≤ 4 (the direction as CompositePlumes makes a pixel's); lanes l ≥ n are computed from
+// t[l], a[l], b[l] too and dropped.
+void VisibleSource4(const BandTrace* const t[4], const glm::mat3& worldFromCamera, const float a[4],
+                    const float b[4], int n, const PlumeLighting& light, glm::vec3 out[4]);
+}  // namespace plume_detail
+
 struct PlumeCompositeStats {
     uint64_t pixelsCovered = 0;  // output pixels inside some plume's screen bounds
     uint64_t traces = 0;         // rays traced (one per covered pixel, two at depth edges)

@@ -16,6 +16,7 @@
 
 #include "radiometry/bands/builtin_bands.h"
 #include "radiometry/planck/planck.h"
+#include "scene/core/frames.h"
 #include "scene/plumes/plume_system.h"
 #include "tests/support/sky_view.h"
 
@@ -458,6 +459,86 @@ TEST(PlumeComposite, CellsBehindANearSurfaceSkipTheirNodes) {
     EXPECT_GT(dark, 100);
     EXPECT_GT(darkBehindWall, 100);
     EXPECT_LT(worst, 0.02);
+}
+
+// Traces of every kind the blends and source functions branch on: none, purely scattering,
+// purely absorbing (cold and glowing), part hot, wholly hot, forward and backward scattering.
+std::vector<BandTrace> VariedTraces() {
+    std::vector<BandTrace> traces;
+    const auto add = [&](float tau, float albedo, float T, float hot, float Thot, float g) {
+        BandTrace t;
+        t.opticalDepth = tau, t.albedo = albedo, t.temperature_K = T;
+        t.hotFraction = hot, t.hotTemperature_K = Thot, t.asymmetry = g;
+        traces.push_back(t);
+    };
+    add(0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f);
+    add(0.37f, 1.0f, 0.0f, 0.0f, 0.0f, 0.64f);
+    add(1.9f, 0.0f, 305.0f, 0.0f, 0.0f, 0.0f);
+    add(0.8f, 0.2f, 1733.3f, 0.0f, 0.0f, -0.3f);
+    add(2.6f, 0.35f, 912.0f, 0.41f, 1450.0f, 0.86f);
+    add(5.1f, 0.05f, 1300.0f, 1.0f, 1300.0f, 0.2f);
+    add(1e-6f, 0.9f, 290.0f, 0.0f, 0.0f, 0.7f);
+    return traces;
+}
+
+// The four-pixel forms give each pixel the bits of the one-pixel forms (which CompositePlumes
+// used for every pixel before them): Bilinear4 against Bilinear over corners of every kind
+// and fractions across the cell, VisibleSource4 against VisibleSource along the same pixel
+// direction, with and without the glow.
+TEST(PlumeComposite, FourPixelFormsMatchTheOnePixelForms) {
+    const std::vector<BandTrace> traces = VariedTraces();
+    const size_t n = traces.size();
+    const auto same = [](const BandTrace& a, const BandTrace& b) {
+        return std::memcmp(&a, &b, sizeof(BandTrace)) == 0;
+    };
+    int compared = 0;
+    for (size_t c = 0; c < n * n * n * n; c += 7) {
+        const BandTrace* corner[4] = {&traces[c % n], &traces[c / n % n], &traces[c / n / n % n],
+                                      &traces[c / n / n / n % n]};
+        for (int j = 0; j < 4; ++j) {
+            const float fx[4] = {0.0f, 0.25f, 0.5f, 0.75f};
+            const float fy[4] = {0.25f * float(j), 0.25f * float(3 - j), 1.0f / 3.0f, 0.1f};
+            BandTrace four[4];
+            plume_detail::Bilinear4(corner, fx, fy, four);
+            for (int l = 0; l < 4; ++l) {
+                EXPECT_TRUE(same(four[l], plume_detail::Bilinear(corner, fx[l], fy[l])))
+                    << c << " " << l;
+                ++compared;
+            }
+        }
+    }
+    EXPECT_GT(compared, 1000);
+
+    const BlackbodyGlowTable glow;
+    for (const bool withGlow : {false, true}) {
+        PlumeLighting light = Sunlit(glow);
+        if (!withGlow) light.glow = nullptr;
+        scene::Attitude attitude;
+        attitude.heading_rad = 0.7;
+        attitude.pitch_rad = 0.07;
+        attitude.roll_rad = -0.02;
+        const glm::mat3 worldFromCamera(scene::WorldFromBodyRotation(attitude));
+        for (size_t k = 0; k < 64; ++k) {
+            const BandTrace* t[4];
+            float a[4], b[4];
+            for (int l = 0; l < 4; ++l) {
+                t[l] = &traces[(k + 3 * size_t(l)) % n];
+                a[l] = -0.6f + 0.0191f * float(k) + 0.05f * float(l);
+                b[l] = 0.45f - 0.0137f * float(k) - 0.03f * float(l);
+            }
+            for (int used = 1; used <= 4; ++used) {
+                glm::vec3 S[4];
+                plume_detail::VisibleSource4(t, worldFromCamera, a, b, used, light, S);
+                for (int l = 0; l < used; ++l) {
+                    const glm::vec3 dir =
+                        glm::normalize(worldFromCamera * glm::vec3(a[l], 1.0f, b[l]));
+                    const glm::vec3 expected = plume_detail::VisibleSource(*t[l], -dir, light);
+                    EXPECT_EQ(std::memcmp(&S[l], &expected, sizeof(glm::vec3)), 0)
+                        << withGlow << " " << k << " " << l;
+                }
+            }
+        }
+    }
 }
 
 // Luminance of a blackbody at the platinum freezing point, 2042 K: 60 cd/cm² (the candela's
