@@ -1177,7 +1177,7 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     if (!basisGlow_ && basis_->blackbody)
         basisGlow_ = std::make_unique<BlackbodyGlowTable>(basis_->blackbody);
     const PlumeLighting light = BasisPlumeLighting(key, downwelling, sky, basisGlow_.get());
-    CompositePlumes(plumes_->FieldAt(state.time_s), cam, vis, light, radiance);
+    CompositePlumes(plumes_->FieldAt(state.time_s), cam, vis, light, radiance, renderSpans_);
 }
 
 }  // namespace seasense::channels

@@ -308,7 +308,7 @@ glm::vec3 BlackbodyGlowTable::operator()(float T_K) const {
 
 PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const ChannelCamera& camera,
                                     const VisibilityBuffer& vis, const PlumeLighting& light,
-                                    Image& radiance) {
+                                    Image& radiance, std::span<const PixelSpan> renderSpans) {
     const auto start = std::chrono::steady_clock::now();
     PlumeCompositeStats stats;
     const bool visible = light.kind == PlumeLighting::Kind::Visible;
@@ -585,6 +585,19 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
         },
         tbb::simple_partitioner());
 
+    // Whether a pixel of cell (cx, cy) lies in the render spans (all do without spans).
+    CHECK(renderSpans.empty() || renderSpans.size() == size_t(H));
+    const auto CellInSpans = [&](int cx, int cy) {
+        if (renderSpans.empty()) return true;
+        for (int py = cy * kCell; py < std::min(H, (cy + 1) * kCell); ++py) {
+            const PixelSpan& span = renderSpans[size_t(py)];
+            if (span.begin < span.end && span.begin < std::min(W, (cx + 1) * kCell) &&
+                span.end > cx * kCell)
+                return true;
+        }
+        return false;
+    };
+
     // Pass 1, the cells' lists and which cells lie wholly behind surfaces in front of their
     // puffs; one task per row of cells (simple_partitioner): the rows' costs differ by orders
     // of magnitude (most have no plume), so coarser chunks leave one thread idle at the end.
@@ -633,10 +646,13 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                 // The cells whose every surface lies in front of their puffs: their pixels
                 // are all skipped in pass 2 (minDepth ≥ depthInFront), so their corners are
                 // traced only if another cell uses them.
+                // Cells with no pixel in the render spans are skipped the same way (their
+                // lists stay: a node they are the near corner of is traced from theirs).
                 row.inFront.assign(size_t(cellsX), 0);
                 for (int cx = 0; cx < cellsX; ++cx)
                     if (row.count[size_t(cx)] != 0)
                         row.inFront[size_t(cx)] =
+                            !CellInSpans(cx, cy) ||
                             AllDepthsAtLeast(cx, cy, DepthInFront(cx, cy, row.near_m[size_t(cx)]));
             }
         },

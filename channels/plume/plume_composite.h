@@ -7,6 +7,7 @@
 #include <glm/glm.hpp>
 #include <limits>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "channels/camera/channel_camera.h"
@@ -122,11 +123,14 @@ inline constexpr float kPlumeSkyRange_m = 1.0e6f;
 //  - otherwise one ray through the pixel centre to the nearest surface and, when the ranges
 //    differ by more than 10 %, to the farthest in the same pass; each sample takes the trace
 //    whose end is nearer its own range.
-// Samples whose traces have no optical depth are left bit for bit as they were. Runs in the
-// caller's oneTBB arena; bit-identical for any thread count.
+// Samples whose traces have no optical depth are left bit for bit as they were. With
+// renderSpans (one per pixel row; empty: every pixel), a cell none of whose pixels lies in
+// them is skipped as a cell wholly behind surfaces is: the pixels in the spans come out bit
+// for bit as without them, the others of such cells are left alone (an NVG field stop passes
+// no light there). Runs in the caller's oneTBB arena; bit-identical for any thread count.
 PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const ChannelCamera& camera,
                                     const VisibilityBuffer& vis, const PlumeLighting& light,
-                                    Image& radiance);
+                                    Image& radiance, std::span<const PixelSpan> renderSpans = {});
 
 // One channel's plumes: the scenario's PlumeSystem (ambient from the scenario's wind, the sun
 // elevation at frame 0 and a clear sky; air temperature from plumes.air_temperature_K, else

@@ -11,8 +11,10 @@
 #include <cmath>
 #include <cstring>
 #include <numbers>
+#include <span>
 #include <thread>
 #include <utility>
+#include <vector>
 
 #include "radiometry/bands/builtin_bands.h"
 #include "radiometry/planck/planck.h"
@@ -303,6 +305,66 @@ TEST(PlumeComposite, CommittedPlumesSameImageForAnyThreadCount) {
                 << threads << " threads, visible " << visible;
         }
     }
+}
+
+// Render spans (an NVG field stop: a disc of pixels): every sample of a pixel inside them is
+// the same bit for bit as without spans — so a cell outside, skipped, still hands its list to
+// the grid nodes it owns where cells inside read them — and a cell with no pixel inside is left
+// alone.
+TEST(PlumeComposite, RenderSpansKeepTheirPixelsAndSkipCellsOutside) {
+    const scene::PlumeField field = CommittedFourPlumes();
+    const glm::dvec3 eye{0.0, 0.0, 10.0};
+    constexpr int kW = 150, kH = 100, kN = 2;
+    const ChannelCamera cam = NorthCamera(eye, kW, kH, kN);
+    const VisibilityBuffer vis = SkyAndLevelSea(cam, eye);
+    const BlackbodyGlowTable glow;
+    const PlumeLighting light = Sunlit(glow);
+    // Pixels whose centres lie within 0.3·width of (0.4·width, 0.5·height): the disc's edge
+    // crosses the plumes.
+    std::vector<PixelSpan> spans(static_cast<size_t>(kH));
+    const double cx = 0.4 * kW, cy = 0.5 * kH, r = 0.3 * kW;
+    for (int y = 0; y < kH; ++y) {
+        const double dy = y + 0.5 - cy;
+        if (std::abs(dy) > r) continue;
+        const double half = std::sqrt(r * r - dy * dy);
+        spans[size_t(y)] = {std::max(0, int(std::ceil(cx - half - 0.5))),
+                            std::min(kW, int(std::floor(cx + half - 0.5)) + 1)};
+    }
+    const auto render = [&](std::span<const PixelSpan> s) {
+        Image image(cam.SampleWidth(), cam.SampleHeight(), 3);
+        std::fill(image.pixels.begin(), image.pixels.end(), 10.0f);
+        CompositePlumes(field, cam, vis, light, image, s);
+        return image;
+    };
+    const Image all = render({}), some = render(spans);
+    int inside = 0, changedInside = 0, outsideCells = 0;
+    for (int py = 0; py < kH; ++py)
+        for (int px = 0; px < kW; ++px) {
+            const bool in = px >= spans[size_t(py)].begin && px < spans[size_t(py)].end;
+            // The 4 × 4-pixel cell of the pixel has a pixel in the spans.
+            bool cellIn = false;
+            for (int y = py / 4 * 4; y < std::min(kH, py / 4 * 4 + 4); ++y)
+                cellIn |= spans[size_t(y)].begin < std::min(kW, px / 4 * 4 + 4) &&
+                          spans[size_t(y)].end > px / 4 * 4 &&
+                          spans[size_t(y)].begin < spans[size_t(y)].end;
+            for (int j = 0; j < kN; ++j)
+                for (int i = 0; i < kN; ++i)
+                    for (int c = 0; c < 3; ++c) {
+                        const float a = all.At(px * kN + i, py * kN + j)[c];
+                        const float b = some.At(px * kN + i, py * kN + j)[c];
+                        if (in) {
+                            ++inside;
+                            changedInside += a != 10.0f;
+                            EXPECT_EQ(std::memcmp(&a, &b, sizeof a), 0) << px << "," << py;
+                        } else if (!cellIn) {
+                            ++outsideCells;
+                            EXPECT_EQ(b, 10.0f) << px << "," << py;
+                        }
+                    }
+        }
+    EXPECT_GT(changedInside, 1000);  // the plumes are in the disc
+    EXPECT_GT(outsideCells, 1000);
+    EXPECT_GT(inside, 10000);
 }
 
 // CompositePlumes keeps its frame buffers (grid nodes, cell lists) on the calling thread from
