@@ -319,52 +319,57 @@ TEST(PlumeComposite, RenderSpansKeepTheirPixelsAndSkipCellsOutside) {
     const VisibilityBuffer vis = SkyAndLevelSea(cam, eye);
     const BlackbodyGlowTable glow;
     const PlumeLighting light = Sunlit(glow);
-    // Pixels whose centres lie within 0.3·width of (0.4·width, 0.5·height): the disc's edge
-    // crosses the plumes.
-    std::vector<PixelSpan> spans(static_cast<size_t>(kH));
-    const double cx = 0.4 * kW, cy = 0.5 * kH, r = 0.3 * kW;
-    for (int y = 0; y < kH; ++y) {
-        const double dy = y + 0.5 - cy;
-        if (std::abs(dy) > r) continue;
-        const double half = std::sqrt(r * r - dy * dy);
-        spans[size_t(y)] = {std::max(0, int(std::ceil(cx - half - 0.5))),
-                            std::min(kW, int(std::floor(cx + half - 0.5)) + 1)};
-    }
     const auto render = [&](std::span<const PixelSpan> s) {
         Image image(cam.SampleWidth(), cam.SampleHeight(), 3);
         std::fill(image.pixels.begin(), image.pixels.end(), 10.0f);
         CompositePlumes(field, cam, vis, light, image, s);
         return image;
     };
-    const Image all = render({}), some = render(spans);
-    int inside = 0, changedInside = 0, outsideCells = 0;
-    for (int py = 0; py < kH; ++py)
-        for (int px = 0; px < kW; ++px) {
-            const bool in = px >= spans[size_t(py)].begin && px < spans[size_t(py)].end;
-            // The 4 × 4-pixel cell of the pixel has a pixel in the spans.
-            bool cellIn = false;
-            for (int y = py / 4 * 4; y < std::min(kH, py / 4 * 4 + 4); ++y)
-                cellIn |= spans[size_t(y)].begin < std::min(kW, px / 4 * 4 + 4) &&
-                          spans[size_t(y)].end > px / 4 * 4 &&
-                          spans[size_t(y)].begin < spans[size_t(y)].end;
-            for (int j = 0; j < kN; ++j)
-                for (int i = 0; i < kN; ++i)
-                    for (int c = 0; c < 3; ++c) {
-                        const float a = all.At(px * kN + i, py * kN + j)[c];
-                        const float b = some.At(px * kN + i, py * kN + j)[c];
-                        if (in) {
-                            ++inside;
-                            changedInside += a != 10.0f;
-                            EXPECT_EQ(std::memcmp(&a, &b, sizeof a), 0) << px << "," << py;
-                        } else if (!cellIn) {
-                            ++outsideCells;
-                            EXPECT_EQ(b, 10.0f) << px << "," << py;
-                        }
-                    }
+    const Image all = render({});
+    // Discs of pixels (centre and radius in pixels) whose edges cross the plumes on every side.
+    struct Disc {
+        double x, y, r;
+    };
+    for (const Disc d : {Disc{60, 50, 45}, Disc{45, 15, 40}, Disc{100, 30, 30}}) {
+        std::vector<PixelSpan> spans(static_cast<size_t>(kH));
+        for (int y = 0; y < kH; ++y) {
+            const double dy = y + 0.5 - d.y;
+            if (std::abs(dy) > d.r) continue;
+            const double half = std::sqrt(d.r * d.r - dy * dy);
+            spans[size_t(y)] = {std::max(0, int(std::ceil(d.x - half - 0.5))),
+                                std::min(kW, int(std::floor(d.x + half - 0.5)) + 1)};
         }
-    EXPECT_GT(changedInside, 1000);  // the plumes are in the disc
-    EXPECT_GT(outsideCells, 1000);
-    EXPECT_GT(inside, 10000);
+        const Image some = render(spans);
+        const auto in = [&](int px, int py) {
+            const PixelSpan& s = spans[size_t(py)];
+            return s.begin < s.end && px >= s.begin && px < s.end;
+        };
+        int changedInside = 0, outsideCells = 0, mismatches = 0;
+        for (int py = 0; py < kH; ++py)
+            for (int px = 0; px < kW; ++px) {
+                // Whether the pixel's 4 × 4-pixel cell has a pixel in the spans.
+                bool cellIn = false;
+                for (int y = py / 4 * 4; y < std::min(kH, py / 4 * 4 + 4); ++y)
+                    for (int x = px / 4 * 4; x < std::min(kW, px / 4 * 4 + 4); ++x)
+                        cellIn |= in(x, y);
+                for (int j = 0; j < kN; ++j)
+                    for (int i = 0; i < kN; ++i)
+                        for (int c = 0; c < 3; ++c) {
+                            const float a = all.At(px * kN + i, py * kN + j)[c];
+                            const float b = some.At(px * kN + i, py * kN + j)[c];
+                            if (in(px, py)) {
+                                changedInside += a != 10.0f;
+                                mismatches += std::memcmp(&a, &b, sizeof a) != 0;
+                            } else if (!cellIn) {
+                                ++outsideCells;
+                                EXPECT_EQ(b, 10.0f) << px << "," << py;
+                            }
+                        }
+            }
+        EXPECT_EQ(mismatches, 0) << "disc " << d.x << "," << d.y;
+        EXPECT_GT(changedInside, 1000) << "disc " << d.x << "," << d.y;  // plumes in the disc
+        EXPECT_GT(outsideCells, 1000) << "disc " << d.x << "," << d.y;
+    }
 }
 
 // CompositePlumes keeps its frame buffers (grid nodes, cell lists) on the calling thread from
