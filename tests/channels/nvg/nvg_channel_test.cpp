@@ -236,12 +236,13 @@ TEST(NvgChannel, SmokeDimsTheMoonlitSkyByItsTransmittance) {
     const VisibilityBuffer& vis = b.Otw().Visibility();
     const glm::dvec3 eye = cam.worldFromCamera.position_m;
     // The plumes are traced per output pixel, through its centre: pixels all of whose samples
-    // see sky.
+    // see sky, inside the field stop (the channel renders nothing else).
+    const std::vector<PixelSpan> spans = sensors::FieldStopSpans(b.IntensifierSettings());
     const int n = cam.supersampling;
     int dimmed = 0;
     double worst = 0.0;
     for (int py = 0; py < cam.height; ++py)
-        for (int px = 0; px < cam.width; ++px) {
+        for (int px = spans[size_t(py)].begin; px < spans[size_t(py)].end; ++px) {
             bool sky = true;
             for (int j = 0; j < n; ++j)
                 for (int i = 0; i < n; ++i)
