@@ -81,20 +81,21 @@ float CoxMunkSlopeVariance(double windSpeed_mps) {
     return float(0.003 + 0.00512 * std::max(windSpeed_mps, 0.0));
 }
 
-// Four-lane (SSE2, the x86-64 baseline) arithmetic for the sky and sea passes. Each lane does
-// the scalar code's operations in the scalar code's order, so a sample's result does not
-// depend on its neighbours, the batch size or the thread count.
+// Four- and eight-lane arithmetic for the sky and sea passes (simd4, simd). Each lane does the
+// scalar code's operations in the scalar code's order, so a sample's result does not depend on
+// its neighbours, the batch size, the lane count or the thread count.
 
 // Normalizes count directions in place: v · (1 / √(v·v)), as glm::normalize.
 void Normalize(size_t count, float* x, float* y, float* z) {
-    for (size_t i = 0; i < count; i += 4) {
-        const size_t lanes = std::min<size_t>(4, count - i);
-        const F4 dx = LoadLanes(x + i, lanes, 0.0f), dy = LoadLanes(y + i, lanes, 0.0f),
-                 dz = LoadLanes(z + i, lanes, 1.0f);
-        const F4 inv = _mm_div_ps(Set4(1.0f), _mm_sqrt_ps(Dot4(dx, dy, dz, dx, dy, dz)));
-        StoreLanes(x + i, lanes, _mm_mul_ps(dx, inv));
-        StoreLanes(y + i, lanes, _mm_mul_ps(dy, inv));
-        StoreLanes(z + i, lanes, _mm_mul_ps(dz, inv));
+    using namespace simd;
+    for (size_t i = 0; i < count; i += kLanes) {
+        const size_t lanes = std::min(kLanes, count - i);
+        const VF dx = Load(x + i, lanes, 0.0f), dy = Load(y + i, lanes, 0.0f),
+                 dz = Load(z + i, lanes, 1.0f);
+        const VF inv = 1.0f / Sqrt(Dot(dx, dy, dz, dx, dy, dz));
+        Store(x + i, dx * inv, lanes);
+        Store(y + i, dy * inv, lanes);
+        Store(z + i, dz * inv, lanes);
     }
 }
 

@@ -33,8 +33,14 @@ inline VF Load(const float* p, size_t count = kLanes, float pad = 0.0f) {
     for (size_t i = 0; i < count; ++i) v[i] = p[i];
     return v;
 }
-// Stores all kLanes lanes (the caller's arrays have room for them).
-inline void Store(float* p, VF v) { std::memcpy(p, &v, sizeof v); }
+// Stores the first count ≤ kLanes lanes (all of them by default: the caller's array has room).
+inline void Store(float* p, VF v, size_t count = kLanes) {
+    if (count >= kLanes) {
+        std::memcpy(p, &v, sizeof v);
+        return;
+    }
+    for (size_t i = 0; i < count; ++i) p[i] = v[i];
+}
 
 // a where mask (a comparison's result) is set, else b.
 inline VF Select(VI mask, VF a, VF b) { return mask ? a : b; }
