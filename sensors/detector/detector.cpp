@@ -109,18 +109,21 @@ double LogAverageLuminance(const Image& rgb) {
                     const float* p = row + size_t(x + l) * c;
                     r[l] = p[0], g[l] = p[1], b[l] = p[2];
                 }
-                const V4d Y = (0.2126 * r + 0.7152 * g) + 0.0722 * b;
-                const V4d v = 1e-4 + (Y < 0.0 ? V4d{} : Y);  // std::max(Y, 0.0) per lane
+                const V4d Y = (0.2126 * r + 0.7152 * g) + 0.0722 * b;  // LuminanceRec709
+                const V4d v = 1e-4 + (Y < 0.0 ? V4d{} : Y);            // std::max(Y, 0.0) per lane
                 const V4u bits = (V4u)v;
-                nonFinite |= (V4u)((bits >> 52) == 0x7ff);  // the sign bit is 0
-                exponents += (V4i)(bits >> 52) - 1023;
+                // The exponent field (a NaN may carry the sign bit; a number here is > 0).
+                const V4u field = (bits >> 52) & 0x7ff;
+                nonFinite |= (V4u)(field == 0x7ff);
+                exponents += (V4i)field - 1023;
                 product *= (V4d)((bits & kMantissa) | kExponentOne);
             }
             double p = ((product[0] * product[1]) * product[2]) * product[3];
             for (; x < x1; ++x) {  // the row's last pixels, fewer than four
                 const uint64_t bits = std::bit_cast<uint64_t>(value(x));
-                nonFinite[0] |= (bits >> 52) == 0x7ff;
-                tailExponents += int64_t(bits >> 52) - 1023;
+                const uint64_t field = (bits >> 52) & 0x7ff;
+                nonFinite[0] |= field == 0x7ff;
+                tailExponents += int64_t(field) - 1023;
                 p *= std::bit_cast<double>((bits & kMantissa) | kExponentOne);
             }
             s += std::log(p);

@@ -88,6 +88,14 @@ TEST(Detector, LogAverageLuminanceOfANonFiniteImageIsNotFinite) {
     EXPECT_TRUE(std::isinf(LogAverageLuminance(img)));
     img.At(3, 0)[0] = std::numeric_limits<float>::quiet_NaN();
     EXPECT_TRUE(std::isnan(LogAverageLuminance(img)));
+    // A NaN with its sign bit set (x86's default NaN, e.g. of 0 · ∞), in a group of four and
+    // among the last pixels of a row.
+    for (const int x : {5, 21}) {
+        Image row(22, 2, 3);
+        std::fill(row.pixels.begin(), row.pixels.end(), 5.0f);
+        row.At(x, 1)[2] = -std::numeric_limits<float>::quiet_NaN();
+        EXPECT_TRUE(std::isnan(LogAverageLuminance(row))) << x;
+    }
 }
 
 TEST(Detector, AdaptedExposureKeepsNightDarkerThanDay) {
