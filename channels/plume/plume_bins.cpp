@@ -373,6 +373,20 @@ inline void PlumeScreenBins::Add(uint32_t k, float smallPixels, List& out) const
     if (fp.sigmaPixels < 0.5f * smallPixels) out.halfSmallOpticalDepth += fp.tauMax;
 }
 
+inline void PlumeScreenBins::AddRange(uint32_t k, float smallPixels, std::span<List> out) const {
+    // Add for each list, with the puff's tests made once.
+    const Footprint& fp = footprint_[k];
+    const bool small = fp.sigmaPixels < smallPixels,
+               halfSmall = fp.sigmaPixels < 0.5f * smallPixels;
+    for (List& o : out) {
+        o.index.push_back(k);
+        o.near_m = std::min(o.near_m, fp.near_m);
+        o.far_m = std::max(o.far_m, fp.far_m);
+        if (small) o.smallOpticalDepth += fp.tauMax;
+        if (halfSmall) o.halfSmallOpticalDepth += fp.tauMax;
+    }
+}
+
 inline void PlumeScreenBins::Take(uint32_t k, int x0, int y0, int x1, int y1, float rho,
                                   float smallPixels, List& out) const {
     if (Reaches(k, x0, y0, x1, y1, rho)) Add(k, smallPixels, out);
@@ -459,6 +473,9 @@ void PlumeScreenBins::GatherRow(const List& from, int x0, int y0, int y1, int st
     if (y0 < y1 && cells > 0) {
         const float rho = HalfDiagonal(width, y1 - y0);
         const float centreY = 0.5f * float(y0 + y1);
+        // The last rectangle of full width (width_ − width − x0 may be negative: none).
+        const int lastFull =
+            width_ - width - x0 >= 0 ? std::min((width_ - width - x0) / step, cells - 1) : -1;
         for (size_t j = 0; j < from.count; ++j) {
             const uint32_t k = from.index[j];
             const Footprint& fp = footprint_[k];
@@ -473,17 +490,42 @@ void PlumeScreenBins::GatherRow(const List& from, int x0, int y0, int y1, int st
             // by one on each side (the tests below decide exactly).
             const int lo = std::max((r.x0 - x0 - width) / step - 1, 0);
             const int hi = std::min((r.x1 - x0) / step + 1, cells - 1);
-            for (int c = lo; c <= hi; ++c) {
+            // The full-width rectangles among them (those before lastFull) that the puff
+            // reaches: rectangle overlap and ellipse span are each an interval of c (the centres
+            // increase with c), so they are too. Its ends are found from an estimate by the
+            // exact tests, and the rectangles between them take the puff without tests.
+            const auto Reached = [&](int c) {
+                const int cx0 = x0 + c * step, cx1 = cx0 + width;
+                if (r.x1 <= cx0 || r.x0 >= cx1) return false;
+                const double cx = 0.5 * double(cx0 + cx1);
+                return cx >= spanLo && cx <= spanHi;
+            };
+            const int fullHi = std::min(hi, lastFull);
+            if (lo <= fullHi) {
+                // Estimates of the interval's ends from the four bounds (centre x0 + c·step +
+                // width / 2), clamped to the candidates; the walks then find them exactly.
+                const double centre0 = double(x0) + 0.5 * width;
+                const double firstEstimate =
+                    std::max(std::floor(double(r.x0 - x0 - width) / step) + 1.0,
+                             std::ceil((spanLo - centre0) / step));
+                const double lastEstimate = std::min(std::ceil(double(r.x1 - x0) / step) - 1.0,
+                                                     std::floor((spanHi - centre0) / step));
+                int first = int(std::clamp(firstEstimate, double(lo), double(fullHi)));
+                while (first > lo && Reached(first - 1)) --first;
+                while (first <= fullHi && !Reached(first)) ++first;
+                if (first <= fullHi) {
+                    int last = int(std::clamp(lastEstimate, double(first), double(fullHi)));
+                    while (last > first && !Reached(last)) --last;
+                    while (last < fullHi && Reached(last + 1)) ++last;
+                    AddRange(k, smallPixels, out.subspan(size_t(first), size_t(last - first + 1)));
+                }
+            }
+            // Rectangles clipped at the bin area's edge: each with its own ρ.
+            for (int c = std::max(lo, lastFull + 1); c <= hi; ++c) {
                 const int cx0 = x0 + c * step, cx1 = Right(c);
                 if (cx0 >= cx1 || r.x1 <= cx0 || r.x0 >= cx1) continue;
-                if (cx1 - cx0 != width) {
-                    // Clipped at the bin area's edge: its own ρ.
-                    Take(k, cx0, y0, cx1, y1, HalfDiagonal(cx1 - cx0, y1 - y0), smallPixels,
-                         out[size_t(c)]);
-                    continue;
-                }
-                const double cx = 0.5 * double(cx0 + cx1);
-                if (cx >= spanLo && cx <= spanHi) Add(k, smallPixels, out[size_t(c)]);
+                Take(k, cx0, y0, cx1, y1, HalfDiagonal(cx1 - cx0, y1 - y0), smallPixels,
+                     out[size_t(c)]);
             }
         }
     }

@@ -5,8 +5,10 @@
 #include <emmintrin.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -727,10 +729,29 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     };
 
     // Pass 2, cells in parallel (a row of cells each); each pixel depends only on its own rays
-    // and the cell's corner nodes.
+    // and the cell's corner nodes. The rows' costs differ by orders of magnitude, so they are
+    // handed out costliest first (by the puff entries of their cells that are not skipped,
+    // plus a pixel block's worth per such cell), each to the next free thread: the last rows
+    // taken are cheap and the threads finish together (greedy longest-first scheduling,
+    // Graham, SIAM J. Appl. Math. 17 (1969) 416). Which thread does a row does not change it.
+    std::vector<std::pair<uint64_t, int>> rowOrder;
+    for (int cy = 0; cy < cellsY; ++cy) {
+        const CellRow& row = cellRows[size_t(cy)];
+        uint64_t cost = 0;
+        bool puffs = false;
+        for (int cx = 0; cx < cellsX; ++cx) {
+            puffs |= row.count[size_t(cx)] != 0;
+            if (row.count[size_t(cx)] != 0 && !row.inFront[size_t(cx)])
+                cost += row.count[size_t(cx)] + kCell * kCell;
+        }
+        if (puffs) rowOrder.emplace_back(cost, cy);
+    }
+    std::stable_sort(rowOrder.begin(), rowOrder.end(),
+                     [](const auto& a, const auto& b) { return a.first > b.first; });
+    std::atomic<size_t> nextRow{0};
     tbb::parallel_for(
-        tbb::blocked_range<int>(0, cellsY, 1),
-        [&](const tbb::blocked_range<int>& rows) {
+        0, tbb::this_task_arena::max_concurrency(),
+        [&](int) {
             Scratch& local = LocalScratch();
             std::vector<float>& range = local.range;
             range.resize(samples);
@@ -739,7 +760,8 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             const __m128 skyRange = _mm_set1_ps(kPlumeSkyRange_m), minusOne = _mm_set1_ps(-1.0f);
             std::vector<float>& depthRows = local.depthRows;
             depthRows.resize(size_t(rowSamples) * size_t(vis.width));
-            for (int cy = rows.begin(); cy != rows.end(); ++cy) {
+            for (size_t taken; (taken = nextRow.fetch_add(1)) < rowOrder.size();) {
+                const int cy = rowOrder[taken].second;
                 uint64_t covered = 0, traces = 0, tests = 0;
                 const CellRow& row = cellRows[size_t(cy)];
                 const int sy0 = cy * rowSamples;
