@@ -192,7 +192,8 @@ int RunHost(const RunOptions& opt) {
                                  : AutoThreadsPerChannel(scenario.channels.size());
     spec.firstFrame = 0;
     spec.frameCount = opt.frames;
-    spec.stateBytes = sync::EncodedFrameStateBytes(scenario.entities.size());
+    spec.stateBytes =
+        sync::StateSlotBytes(scenario.entities.size(), world.Ocean().SharedFieldBytes());
     spec.imageBytes = opt.video ? maxImage : 0;
     sync::Segment segment = sync::Segment::Create(spec);
     sync::SegmentHeader& header = segment.Header();
@@ -286,8 +287,12 @@ int RunHost(const RunOptions& opt) {
     const auto publish = [&](uint32_t index) {
         if (periodNs > 0) SleepUntilNs(runStartNs + int64_t(index) * periodNs);
         const scene::FrameState fs = world.Advance(spec.firstFrame + int64_t(index));
+        // The sea's fields at the frame's time, synthesized once here for every renderer.
+        const std::shared_ptr<const scene::OceanSurfaceFrame> sea =
+            world.Ocean().Spectral() ? world.Ocean().At(fs.time_s) : nullptr;
         uint8_t* bytes = lock.BeginPublish(index);
-        const size_t n = sync::EncodeFrameState(fs, bytes, header.stateBytes);
+        const size_t n =
+            sync::EncodeStateSlot(fs, sea ? sea->Fft() : nullptr, bytes, header.stateBytes);
         lock.EndPublish(index, fs.frame, n);
     };
 
@@ -528,9 +533,11 @@ int RunChannelRenderer(const ChannelOptions& opt) {
         item.index = i;
         item.timing.frame = frame;
         item.timing.startNs = sync::MonotonicNs();
-        const scene::FrameState state = sync::DecodeFrameState(stateBytes, n);
+        const sync::StateSlotContents slot = sync::DecodeStateSlot(stateBytes, n);
+        const scene::FrameState& state = slot.state;
         FrameRecord rec;
         arena.execute([&] {
+            world.Ocean().Adopt(state.time_s, slot.sea);
             rec = pipeline->Render(state);
             if (copyImages) item.rgb = pipeline->PreviewRgb8(previewW, previewH);
         });

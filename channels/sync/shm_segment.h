@@ -14,7 +14,8 @@ namespace seasense::channels::sync {
 inline constexpr uint64_t kSegmentMagic = 0x31304d4853414553ull;
 // Bumped whenever the layout below or the protocol over it changes; a segment of another
 // version is refused. 4: renderers render ahead, the barrier reads each channel's counters.
-inline constexpr uint32_t kLayoutVersion = 4;
+// 5: a state slot also carries the sea's synthesized fields (sync::EncodeStateSlot).
+inline constexpr uint32_t kLayoutVersion = 5;
 inline constexpr int kMaxChannels = 16;
 // State slots: the host publishes frame n+1 while channels may still present frame n, and
 // never writes the slot of frame n+2 before every channel has presented frame n.

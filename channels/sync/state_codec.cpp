@@ -131,4 +131,35 @@ scene::FrameState DecodeFrameState(const uint8_t* buffer, size_t bytes) {
     return s;
 }
 
+size_t StateSlotBytes(size_t entityCount, size_t seaBytes) {
+    return EncodedFrameStateBytes(entityCount) + seaBytes;
+}
+
+size_t EncodeStateSlot(const scene::FrameState& state, const scene::FftOceanFrame* sea,
+                       uint8_t* buffer, size_t capacity) {
+    const size_t n = EncodeFrameState(state, buffer, capacity);
+    if (!sea) return n;
+    const size_t m = sea->EncodedBytes();
+    if (m > capacity - n)
+        throw RuntimeError("sea fields (" + std::to_string(m) +
+                           " bytes) do not fit the shared-memory state slot (" +
+                           std::to_string(capacity) + " bytes)");
+    sea->Encode(buffer + n);
+    return n + m;
+}
+
+StateSlotContents DecodeStateSlot(const uint8_t* buffer, size_t bytes) {
+    // The state's length follows from its entity count (its second word).
+    Reader r(buffer, bytes);
+    r.Get<uint32_t>();
+    const size_t stateBytes = EncodedFrameStateBytes(r.Get<uint32_t>());
+    if (stateBytes > bytes)
+        throw RuntimeError("state slot in shared memory has " + std::to_string(bytes) +
+                           " bytes; its frame state alone needs " + std::to_string(stateBytes));
+    StateSlotContents c;
+    c.state = DecodeFrameState(buffer, stateBytes);
+    c.sea = std::span<const uint8_t>(buffer + stateBytes, bytes - stateBytes);
+    return c;
+}
+
 }  // namespace seasense::channels::sync

@@ -3,6 +3,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 
 #include "scene/world/world.h"
 
@@ -18,5 +19,21 @@ scene::FrameState DecodeFrameState(const uint8_t* buffer, size_t bytes);
 
 // Bytes EncodeFrameState needs for a scenario with entityCount entities.
 size_t EncodedFrameStateBytes(size_t entityCount);
+
+// A state slot: the encoded frame state, then, for a spectral sea, the sea's fields at the
+// frame's time as the host synthesized them (scene::FftOceanFrame::Encode), so that the
+// renderers adopt one synthesis (scene::OceanSurface::Adopt) instead of each making the same
+// fields. sea may be null (no spectral sea). Returns the bytes used; RuntimeError when they do
+// not fit.
+size_t EncodeStateSlot(const scene::FrameState& state, const scene::FftOceanFrame* sea,
+                       uint8_t* buffer, size_t capacity);
+struct StateSlotContents {
+    scene::FrameState state;
+    std::span<const uint8_t> sea;  // empty: no sea fields (into the slot's bytes)
+};
+// Reads a slot written by EncodeStateSlot. RuntimeError for a truncated or corrupt slot.
+StateSlotContents DecodeStateSlot(const uint8_t* buffer, size_t bytes);
+// Bytes EncodeStateSlot needs: the state's and seaBytes (OceanSurface::SharedFieldBytes).
+size_t StateSlotBytes(size_t entityCount, size_t seaBytes);
 
 }  // namespace seasense::channels::sync

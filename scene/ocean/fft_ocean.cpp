@@ -7,9 +7,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numbers>
 #include <sstream>
+#include <string>
 
 #include "scene/core/check.h"
 #include "scene/core/error.h"
@@ -336,6 +338,76 @@ float FftOceanFrame::Field(size_t cascade, OceanField field, int ix, int iy) con
     CHECK_MSG(hasRates_ || f / 2 < kPlanes - kRatePlanes, "rate field of a geometry-only frame");
     const cv::Vec2f v = cascades_[cascade].field[f / 2].at<cv::Vec2f>(ix, iy);  // transposed
     return v[f % 2];
+}
+
+namespace {
+constexpr uint32_t kFrameTag = 0x46414553;  // "SEAF"
+// Tag, grid size, cascades, rates flag; choppiness and time; per cascade its patch size.
+constexpr size_t kFrameHeaderBytes = 4 * sizeof(uint32_t) + 2 * sizeof(double);
+}  // namespace
+
+size_t FftOceanFrame::EncodedBytesFor(int n, size_t cascades, bool withRates) {
+    const size_t planes = size_t(withRates ? kPlanes : kPlanes - kRatePlanes);
+    return kFrameHeaderBytes +
+           cascades * (sizeof(double) + planes * size_t(n) * size_t(n) * sizeof(cv::Vec2f));
+}
+
+size_t FftOceanFrame::EncodedBytes() const {
+    return EncodedBytesFor(n_, cascades_.size(), hasRates_);
+}
+
+void FftOceanFrame::Encode(uint8_t* out) const {
+    const auto put = [&out](const auto& v) {
+        std::memcpy(out, &v, sizeof v);
+        out += sizeof v;
+    };
+    put(kFrameTag);
+    put(uint32_t(n_));
+    put(uint32_t(cascades_.size()));
+    put(uint32_t(hasRates_));
+    put(choppiness_);
+    put(t_s_);
+    const int planes = hasRates_ ? kPlanes : kPlanes - kRatePlanes;
+    const size_t rowBytes = size_t(n_) * sizeof(cv::Vec2f);
+    for (const Cascade& c : cascades_) {
+        put(c.patch_m);
+        for (int p = 0; p < planes; ++p)
+            for (int row = 0; row < n_; ++row, out += rowBytes)
+                std::memcpy(out, c.field[size_t(p)].ptr<uint8_t>(row), rowBytes);
+    }
+}
+
+void FftOceanFrame::Decode(const uint8_t* in, size_t bytes) {
+    const auto fail = [&](const std::string& what) {
+        throw RuntimeError("sea fields (" + std::to_string(bytes) + " bytes): " + what);
+    };
+    if (bytes < kFrameHeaderBytes) fail("shorter than their header");
+    const auto get = [&in](auto& v) {
+        std::memcpy(&v, in, sizeof v);
+        in += sizeof v;
+    };
+    uint32_t tag = 0, n = 0, cascades = 0, rates = 0;
+    get(tag), get(n), get(cascades), get(rates);
+    if (tag != kFrameTag) fail("bad tag");
+    if (n == 0 || n > (1u << 14) || cascades > 64 || rates > 1) fail("bad grid");
+    if (EncodedBytesFor(int(n), cascades, rates != 0) != bytes)
+        fail("expected " + std::to_string(EncodedBytesFor(int(n), cascades, rates != 0)) +
+             " bytes for " + std::to_string(cascades) + " cascades of " + std::to_string(n) +
+             "² nodes");
+    n_ = int(n);
+    hasRates_ = rates != 0;
+    get(choppiness_), get(t_s_);
+    cascades_.resize(cascades);
+    const int planes = hasRates_ ? kPlanes : kPlanes - kRatePlanes;
+    const size_t rowBytes = size_t(n_) * sizeof(cv::Vec2f);
+    for (Cascade& c : cascades_) {
+        get(c.patch_m);
+        for (int p = 0; p < planes; ++p) {
+            c.field[size_t(p)].create(n_, n_, CV_32FC2);
+            for (int row = 0; row < n_; ++row, in += rowBytes)
+                std::memcpy(c.field[size_t(p)].ptr<uint8_t>(row), in, rowBytes);
+        }
+    }
 }
 
 const cv::Mat& FftOceanFrame::FieldPlane(size_t cascade, int plane) const {

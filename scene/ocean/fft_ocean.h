@@ -87,6 +87,18 @@ class FftOceanFrame {
     static constexpr int kPlanes = 6;      // two real fields per complex transform
     static constexpr int kRatePlanes = 2;  // the last two planes hold the rates
 
+    // The frame as bytes, to hand fields synthesized in one process to another on the same
+    // machine (channels/sync): grid size, choppiness, time, whether the rates were made, and
+    // each cascade's patch size and field planes, bit for bit (native representation).
+    // EncodedBytes is what Encode writes.
+    size_t EncodedBytes() const;
+    void Encode(uint8_t* out) const;
+    // EncodedBytes of a frame with n × n grids, the given cascades and with or without rates.
+    static size_t EncodedBytesFor(int n, size_t cascades, bool withRates);
+    // Makes this frame the one Encode wrote (reusing its buffers): every field bit for bit.
+    // RuntimeError when the bytes are not such a frame (wrong tag, length or grid).
+    void Decode(const uint8_t* in, size_t bytes);
+
   private:
     friend class FftOcean;
     struct Cascade {
@@ -133,6 +145,7 @@ class FftOcean {
     std::span<const CascadeBand> Cascades() const { return bands_; }
     int GridSize() const { return n_; }
     double Depth_m() const { return depth_m_; }
+    double Choppiness() const { return choppiness_; }
 
     // Σ F(k) Δk² over the synthesized modes: the expected variance of the height field (m²).
     double ModeVariance_m2() const { return modeVariance_m2_; }

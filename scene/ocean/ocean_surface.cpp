@@ -12,8 +12,10 @@
 #include <limits>
 #include <mutex>
 #include <numbers>
+#include <string>
 
 #include "scene/core/check.h"
+#include "scene/core/error.h"
 #include "scene/core/rng.h"
 #include "scene/ocean/sea_state.h"
 
@@ -369,6 +371,11 @@ OceanSurface::OceanSurface(OceanSurface&&) noexcept = default;
 OceanSurface& OceanSurface::operator=(OceanSurface&&) noexcept = default;
 
 void OceanSurface::Fill(OceanSurfaceFrame& frame, double t, bool withVelocity) const {
+    if (fft_) fft_->Synthesize(t, frame.fft_, withVelocity);
+    Complete(frame, t);
+}
+
+void OceanSurface::Complete(OceanSurfaceFrame& frame, double t) const {
     frame.t_s_ = t;
     frame.gerstner_ = gerstner_;
     frame.significantHeight_m_ = summary_.significantHeight_m;
@@ -378,10 +385,7 @@ void OceanSurface::Fill(OceanSurfaceFrame& frame, double t, bool withVelocity) c
         frame.textures_.clear();  // else rebuilt in place, reusing the buffers
         frame.cascadeBounds_.clear();
     }
-    if (fft_) {
-        fft_->Synthesize(t, frame.fft_, withVelocity);
-        frame.BuildTextures();
-    }
+    if (fft_) frame.BuildTextures();
     frame.maxHeight_m_ += gerstner_.MaxAmplitude_m();
     frame.maxHorizontal_m_ += gerstner_.MaxHorizontal_m();
     frame.surf_ = surf_;
@@ -480,12 +484,8 @@ SurfaceBounds OceanSurfaceFrame::LocalBoundsNear(double x, double y, double radi
             std::min(local.horizontal_m + kLocalBoundMargin_m, global.horizontal_m)};
 }
 
-std::shared_ptr<const OceanSurfaceFrame> OceanSurface::At(double t) const {
-    CHECK(std::isfinite(t));
-    std::lock_guard<std::mutex> lock(cache_->mutex);
+std::shared_ptr<OceanSurfaceFrame> OceanSurface::FreeFrame() const {
     std::vector<std::shared_ptr<OceanSurfaceFrame>>& frames = cache_->frames;
-    for (const std::shared_ptr<OceanSurfaceFrame>& f : frames)
-        if (std::bit_cast<uint64_t>(f->t_s_) == std::bit_cast<uint64_t>(t)) return f;
     std::shared_ptr<OceanSurfaceFrame> frame;
     if (frames.size() >= kCachedFrames) {
         // Reuse the oldest frame's buffers when no one else holds it.
@@ -493,11 +493,55 @@ std::shared_ptr<const OceanSurfaceFrame> OceanSurface::At(double t) const {
         frames.erase(frames.begin());
     }
     if (!frame) frame = std::make_shared<OceanSurfaceFrame>();
+    return frame;
+}
+
+std::shared_ptr<const OceanSurfaceFrame> OceanSurface::At(double t) const {
+    CHECK(std::isfinite(t));
+    std::lock_guard<std::mutex> lock(cache_->mutex);
+    std::vector<std::shared_ptr<OceanSurfaceFrame>>& frames = cache_->frames;
+    for (const std::shared_ptr<OceanSurfaceFrame>& f : frames)
+        if (std::bit_cast<uint64_t>(f->t_s_) == std::bit_cast<uint64_t>(t)) return f;
+    std::shared_ptr<OceanSurfaceFrame> frame = FreeFrame();
     // Isolated: while this thread waits inside the synthesis' parallel loops it must not pick
     // up an outer task that could ask for a frame and block on the held lock.
     tbb::this_task_arena::isolate([&] { Fill(*frame, t, false); });
     frames.push_back(frame);
     return frame;
+}
+
+size_t OceanSurface::SharedFieldBytes() const {
+    return fft_ ? FftOceanFrame::EncodedBytesFor(fft_->GridSize(), fft_->Cascades().size(), false)
+                : 0;
+}
+
+void OceanSurface::Adopt(double t, std::span<const uint8_t> fields) const {
+    CHECK(std::isfinite(t));
+    if (!fft_) {
+        if (!fields.empty())
+            throw RuntimeError("sea fields handed to a scenario without a spectral sea");
+        return;
+    }
+    std::lock_guard<std::mutex> lock(cache_->mutex);
+    std::vector<std::shared_ptr<OceanSurfaceFrame>>& frames = cache_->frames;
+    for (const std::shared_ptr<OceanSurfaceFrame>& f : frames)
+        if (std::bit_cast<uint64_t>(f->t_s_) == std::bit_cast<uint64_t>(t)) return;
+    // The oldest frame's buffers when free; decoded and checked before it enters the cache.
+    std::shared_ptr<OceanSurfaceFrame> frame = FreeFrame();
+    FftOceanFrame& in = frame->fft_;
+    in.Decode(fields.data(), fields.size());
+    const std::span<const CascadeBand> bands = fft_->Cascades();
+    bool same = in.GridSize() == fft_->GridSize() && in.CascadeCount() == bands.size() &&
+                !in.HasRates() && in.Choppiness() == fft_->Choppiness() &&
+                std::bit_cast<uint64_t>(in.Time_s()) == std::bit_cast<uint64_t>(t);
+    for (size_t c = 0; same && c < bands.size(); ++c) same = in.PatchSize_m(c) == bands[c].patch_m;
+    if (!same)
+        throw RuntimeError(
+            "sea fields for t = " + std::to_string(in.Time_s()) + " s (" +
+            std::to_string(in.CascadeCount()) + " cascades of " + std::to_string(in.GridSize()) +
+            "² nodes) do not match this scenario's sea at t = " + std::to_string(t) + " s");
+    Complete(*frame, t);
+    frames.push_back(frame);
 }
 
 std::shared_ptr<const OceanSurfaceFrame> OceanSurface::AtWithVelocity(double t) const {

@@ -9,6 +9,7 @@
 #include <glm/glm.hpp>
 #include <memory>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "scene/ocean/fft_ocean.h"
@@ -224,6 +225,16 @@ class OceanSurface {
     // (the two most recent times), so every user of one frame time shares one synthesis;
     // thread-safe; the result is bit-identical for any thread count.
     std::shared_ptr<const OceanSurfaceFrame> At(double t_s) const;
+    // Bytes of the encoded fields of At's frames (FftOceanFrame::EncodedBytes, geometry only);
+    // 0 without a spectral sea.
+    size_t SharedFieldBytes() const;
+    // Caches the frame at t_s made from fields synthesized elsewhere: `fields` is what
+    // FftOceanFrame::Encode wrote of At(t_s)->Fft() of an OceanSurface with the same settings
+    // (the run's host, so that its renderers do not each synthesize the same fields). At(t_s)
+    // then returns it without a synthesis, bit for bit the frame it would have made. No-op when
+    // the cache holds t_s already. RuntimeError, and nothing cached, when the bytes are not
+    // such fields (another grid, cascade patches, choppiness or time, or rates).
+    void Adopt(double t_s, std::span<const uint8_t> fields) const;
     // The surface at t_s with surface velocities (a fresh synthesis, not cached).
     std::shared_ptr<const OceanSurfaceFrame> AtWithVelocity(double t_s) const;
 
@@ -244,6 +255,11 @@ class OceanSurface {
 
   private:
     void Fill(OceanSurfaceFrame& frame, double t_s, bool withVelocity) const;
+    // Everything of Fill after the synthesis of frame.fft_ (made or adopted).
+    void Complete(OceanSurfaceFrame& frame, double t_s) const;
+    // A frame to fill for the cache (the oldest one's buffers when no one holds it); the
+    // cache's mutex must be held.
+    std::shared_ptr<OceanSurfaceFrame> FreeFrame() const;
     void Summarize();
     std::shared_ptr<const SurfWaves> MakeSurfWaves() const;
 

@@ -242,6 +242,14 @@ TEST(Run, NvgChannelFramesEqualCapture) {
                            {"otw", "nvg"}, "nvg");
 }
 
+// Over a spectral sea the renderers adopt the fields the host synthesized instead of making
+// their own (scene::OceanSurface::Adopt): the frames are still the captures' bit for bit.
+TEST(Run, SpectralSeaFramesEqualCapture) {
+    ExpectRunEqualsCapture(
+        std::string(SEASENSE_SOURCE_DIR) + "/tests/data/scenarios/run-spectral.yaml",
+        {"left", "centre"}, "spectral");
+}
+
 TEST(Run, KilledRendererStopsTheRunWithStatusOne) {
     const fs::path out = TempDir("kill");
     const std::string runId = RunId("kill");

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "scene/core/error.h"
+#include "scene/ocean/ocean_surface.h"
 
 namespace seasense::channels::sync {
 namespace {
@@ -79,6 +80,38 @@ TEST(StateCodec, RefusesSmallSlotsAndDamagedStates) {
     std::vector<uint8_t> badCount = buf;
     badCount[4] = 9;  // claims 9 entities
     EXPECT_THROW(DecodeFrameState(badCount.data(), badCount.size()), RuntimeError);
+}
+
+// A state slot carries the state and the host's sea fields: both come back bit for bit (the
+// fields as the span Encode wrote), a slot without fields has none, and a slot too small for
+// them or cut inside the state is refused.
+TEST(StateCodec, SlotCarriesTheStateAndTheSeaFields) {
+    scene::OceanSettings ocean;
+    ocean.depth_m = 50.0;
+    scene::SpectralOceanSettings spectral;
+    spectral.sea.windSpeed_mps = 8.0;
+    spectral.fft.gridSize = 32;
+    ocean.spectral = spectral;
+    const scene::OceanSurface sea(ocean);
+    const auto frame = sea.At(2.5);
+    const scene::FrameState s = Sample(2);
+    std::vector<uint8_t> fields(sea.SharedFieldBytes());
+    frame->Fft()->Encode(fields.data());
+    std::vector<uint8_t> slot(StateSlotBytes(2, fields.size()));
+    ASSERT_EQ(EncodeStateSlot(s, frame->Fft(), slot.data(), slot.size()), slot.size());
+    const StateSlotContents c = DecodeStateSlot(slot.data(), slot.size());
+    EXPECT_EQ(c.state.frame, s.frame);
+    EXPECT_EQ(c.state.entityPoses.size(), 2u);
+    EXPECT_EQ(c.state.eyepoint.worldFromBody, s.eyepoint.worldFromBody);
+    ASSERT_EQ(c.sea.size(), fields.size());
+    EXPECT_EQ(std::memcmp(c.sea.data(), fields.data(), fields.size()), 0);
+
+    const size_t n = EncodeStateSlot(s, nullptr, slot.data(), slot.size());
+    EXPECT_EQ(n, EncodedFrameStateBytes(2));
+    EXPECT_TRUE(DecodeStateSlot(slot.data(), n).sea.empty());
+
+    EXPECT_THROW(EncodeStateSlot(s, frame->Fft(), slot.data(), slot.size() - 1), RuntimeError);
+    EXPECT_THROW(DecodeStateSlot(slot.data(), EncodedFrameStateBytes(2) - 1), RuntimeError);
 }
 
 }  // namespace

@@ -9,6 +9,8 @@
 #include <bit>
 #include <cmath>
 #include <numbers>
+#include <span>
+#include <vector>
 
 #include "scene/core/error.h"
 
@@ -223,6 +225,64 @@ TEST(OceanSurface, FramesAreSharedPerTimeAndIdenticalForAnyThreadCount) {
         }
         ASSERT_EQ(one->HeightAt(x, y), two->HeightAt(x, y));
     }
+}
+
+// A frame adopted from another OceanSurface's encoded fields (the run's host handing its
+// synthesis to a renderer) is the frame At makes, bit for bit: the filtered lookups at fine and
+// coarse footprints (every mip level the textures build), heights and bounds. Adopting a time
+// held already keeps the frame; fields of another time, grid or a sea without them are refused
+// with nothing cached.
+TEST(OceanSurface, AdoptedFieldsMakeTheFrameAtMakes) {
+    const OceanSurface host(Beaufort5(3, 64)), renderer(Beaufort5(3, 64)), own(Beaufort5(3, 64));
+    const auto made = host.At(4.0);
+    ASSERT_NE(made->Fft(), nullptr);
+    std::vector<uint8_t> fields(host.SharedFieldBytes());
+    ASSERT_EQ(made->Fft()->EncodedBytes(), fields.size());
+    made->Fft()->Encode(fields.data());
+    renderer.Adopt(4.0, fields);
+    const auto adopted = renderer.At(4.0), reference = own.At(4.0);
+    EXPECT_EQ(std::bit_cast<uint64_t>(adopted->MaxHeight_m()),
+              std::bit_cast<uint64_t>(reference->MaxHeight_m()));
+    for (int i = 0; i < 60; ++i) {
+        const double x = 17.3 * i - 400.0, y = 0.41 * i * i - 90.0;
+        for (float fp : {0.0f, 2.0f, 9.0f, 60.0f, 500.0f}) {
+            GeometrySums a{}, b{};
+            adopted->AccumulateFft(x, y, fp, a);
+            reference->AccumulateFft(x, y, fp, b);
+            for (int k = 0; k < kGeometryTerms; ++k)
+                ASSERT_EQ(std::bit_cast<uint32_t>(a[size_t(k)]),
+                          std::bit_cast<uint32_t>(b[size_t(k)]));
+        }
+        ASSERT_EQ(std::bit_cast<uint64_t>(adopted->HeightAt(x, y)),
+                  std::bit_cast<uint64_t>(reference->HeightAt(x, y)));
+        const SurfaceBounds ba = adopted->BoundsNear(x, y, 30.0);
+        const SurfaceBounds bb = reference->BoundsNear(x, y, 30.0);
+        ASSERT_EQ(ba.height_m, bb.height_m);
+        ASSERT_EQ(ba.horizontal_m, bb.horizontal_m);
+    }
+    renderer.Adopt(4.0, fields);
+    EXPECT_EQ(renderer.At(4.0).get(), adopted.get());
+
+    EXPECT_THROW(renderer.Adopt(5.0, fields), RuntimeError);  // fields of t = 4 s
+    EXPECT_THROW(renderer.Adopt(5.0, std::span<const uint8_t>(fields).first(fields.size() - 1)),
+                 RuntimeError);
+    std::vector<uint8_t> badTag = fields;
+    badTag[0] ^= 0xFF;
+    EXPECT_THROW(renderer.Adopt(4.5, badTag), RuntimeError);
+    const OceanSurface finer(Beaufort5(3, 128));
+    EXPECT_THROW(finer.Adopt(4.0, fields), RuntimeError);
+    OceanSettings gerstnerOnly = Beaufort5(3, 64);
+    gerstnerOnly.spectral.reset();
+    const OceanSurface waves(gerstnerOnly);
+    EXPECT_EQ(waves.SharedFieldBytes(), 0u);
+    EXPECT_THROW(waves.Adopt(4.0, fields), RuntimeError);
+    EXPECT_NO_THROW(waves.Adopt(4.0, {}));
+    // Nothing refused was cached: t = 5 s is synthesized as usual.
+    GeometrySums a{}, b{};
+    renderer.At(5.0)->AccumulateFft(10.0, 20.0, 0.0f, a);
+    own.At(5.0)->AccumulateFft(10.0, 20.0, 0.0f, b);
+    for (int k = 0; k < kGeometryTerms; ++k)
+        EXPECT_EQ(std::bit_cast<uint32_t>(a[size_t(k)]), std::bit_cast<uint32_t>(b[size_t(k)]));
 }
 
 TEST(OceanSurface, FilteredLookupIsTheFieldAtFineFootprintsAndLosesVarianceAsItGrows) {
