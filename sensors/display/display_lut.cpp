@@ -6,8 +6,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "scene/core/check.h"
+#include "scene/core/simd_lanes.h"
 
 namespace seasense::sensors {
 
@@ -37,6 +39,10 @@ void DisplayLut::Apply(const float rgb[3], float out[3]) const {
         i0[c] = std::min(int(u), edge_ - 2);
         f[c] = u - float(i0[c]);
     }
+    Trilinear(i0, f, out);
+}
+
+void DisplayLut::Trilinear(const int i0[3], const float f[3], float out[3]) const {
     const size_t e = size_t(edge_);
     const float* node = &table_[((size_t(i0[2]) * e + size_t(i0[1])) * e + size_t(i0[0])) * 3];
     // Corner (dr, dg, db)'s weight is (w_r · w_g) · w_b, each w = f or 1 − f by the corner's
@@ -71,18 +77,48 @@ std::vector<std::uint8_t> DisplayLut::ToDisplay8(const Image& linear, float expo
     CHECK(linear.channels == 3);
     std::vector<std::uint8_t> codes(linear.pixels.size());
     const size_t n = linear.pixels.size() / 3;
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096),
-                      [&](const tbb::blocked_range<size_t>& r) {
-                          for (size_t i = r.begin(); i < r.end(); ++i) {
-                              const float in[3] = {linear.pixels[3 * i] * exposureScale,
-                                                   linear.pixels[3 * i + 1] * exposureScale,
-                                                   linear.pixels[3 * i + 2] * exposureScale};
-                              float out[3];
-                              Apply(in, out);
-                              for (int c = 0; c < 3; ++c)
-                                  codes[3 * i + size_t(c)] = QuantizeUnorm8(out[c]);
-                          }
-                      });
+    using simd::kLanes;
+    using simd::VF;
+    using simd::VI;
+    const VF lowest = simd::Splat(1e-30f), minLog2 = simd::Splat(minLog2_);
+    const VF scale = simd::Splat(scale_), zero = simd::Splat(0.0f);
+    const VF top = simd::Splat(float(edge_ - 1));
+    const VI lastCell = VI{} + (edge_ - 2);
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
+            // The grid coordinates of kLanes pixels at a time (one vector per component, the
+            // log2 by simd::Log2 instead of one libm call per value), then each pixel's
+            // trilinear look-up.
+            for (size_t i = r.begin(); i < r.end(); i += kLanes) {
+                const size_t count = std::min(kLanes, r.end() - i);
+                alignas(32) float comp[3][kLanes] = {};
+                for (size_t l = 0; l < count; ++l)
+                    for (int c = 0; c < 3; ++c)
+                        comp[c][l] = linear.pixels[3 * (i + l) + size_t(c)] * exposureScale;
+                alignas(32) int cell[3][kLanes];
+                alignas(32) float frac[3][kLanes];
+                for (int c = 0; c < 3; ++c) {
+                    // Non-positive, tiny and NaN values clamp to the grid's lower end, +∞ to
+                    // its top (the comparison is false for NaN, which then takes `lowest`).
+                    VF x = simd::Load(comp[c]);
+                    x = simd::Select(x > lowest, x, lowest);
+                    const VF u = simd::Min(simd::Max((simd::Log2(x) - minLog2) * scale, zero), top);
+                    VI i0 = __builtin_convertvector(u, VI);
+                    i0 = i0 < lastCell ? i0 : lastCell;
+                    const VF f = u - __builtin_convertvector(i0, VF);
+                    std::memcpy(cell[c], &i0, sizeof i0);
+                    simd::Store(frac[c], f);
+                }
+                for (size_t l = 0; l < count; ++l) {
+                    const int i0[3] = {cell[0][l], cell[1][l], cell[2][l]};
+                    const float f[3] = {frac[0][l], frac[1][l], frac[2][l]};
+                    float out[3];
+                    Trilinear(i0, f, out);
+                    for (int c = 0; c < 3; ++c)
+                        codes[3 * (i + l) + size_t(c)] = QuantizeUnorm8(out[c]);
+                }
+            }
+        });
     return codes;
 }
 

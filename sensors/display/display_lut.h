@@ -29,6 +29,8 @@ class DisplayLut {
     void Apply(const float rgb[3], float out[3]) const;
 
   private:
+    // The interpolated display value of grid cell i0 at fractions f (each in [0, 1]).
+    void Trilinear(const int i0[3], const float f[3], float out[3]) const;
     int edge_;
     float minLog2_, scale_;     // grid coordinate = (log2 x − minLog2) · scale
     std::vector<float> table_;  // edge³ × 3, red fastest, and one float of padding

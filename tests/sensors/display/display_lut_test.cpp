@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <iterator>
+#include <limits>
 #include <opencv2/imgproc.hpp>
 #include <utility>
 
@@ -47,6 +49,46 @@ TEST(DisplayLut, WithinAFewCodeValuesOfTheExactTransform) {
     // Exposure scales the input exactly as for the exact transform.
     const std::vector<uint8_t> a2 = exact.ToDisplay8(img, 0.25f), b2 = lut.ToDisplay8(img, 0.25f);
     for (size_t k = 0; k < a2.size(); ++k) EXPECT_LE(std::abs(int(a2[k]) - int(b2[k])), 6) << k;
+}
+
+// ToDisplay8 takes the grid coordinates eight (or four) pixels at a time with simd::Log2; it
+// gives Apply's codes (libm log2 per value) within one code value, mostly the same, over 19
+// decades and at the ends: zero, negative, NaN (the grid's lower end), tiny and huge values and
+// +∞ (its top).
+TEST(DisplayLut, ToDisplay8AgreesWithApplyPerPixel) {
+    const OcioDisplay exact(kConfig, "sRGB", "ACES 1.0 - SDR Video");
+    const DisplayLut lut(exact);
+    Image img(3001, 1, 3);  // not a multiple of the lanes
+    for (int i = 0; i < img.width; ++i)
+        for (int c = 0; c < 3; ++c)
+            img.At(i, 0)[c] =
+                float(std::exp2(-40.0 + 63.0 * scene::Uniform01(6, uint64_t(c), uint64_t(i))));
+    const float ends[] = {0.0f,
+                          -1.0f,
+                          1e-35f,
+                          1e30f,
+                          std::numeric_limits<float>::infinity(),
+                          std::numeric_limits<float>::quiet_NaN()};
+    for (size_t k = 0; k < std::size(ends); ++k) img.At(int(k), 0)[k % 3] = ends[k];
+    const std::vector<uint8_t> codes = lut.ToDisplay8(img, 1.0f);
+    const float lowest[3] = {0.0f, 0.0f, 0.0f};
+    float low[3];
+    lut.Apply(lowest, low);
+    size_t same = 0;
+    for (int i = 0; i < img.width; ++i) {
+        float in[3], out[3];
+        for (int c = 0; c < 3; ++c) {
+            in[c] = img.At(i, 0)[c];
+            if (std::isnan(in[c])) in[c] = 0.0f;  // NaN reads as the lower end
+        }
+        lut.Apply(in, out);
+        for (int c = 0; c < 3; ++c) {
+            const int d = std::abs(int(codes[size_t(3 * i + c)]) - int(QuantizeUnorm8(out[c])));
+            ASSERT_LE(d, 1) << i << " " << c;
+            same += d == 0;
+        }
+    }
+    EXPECT_GT(same, size_t(3 * img.width) * 99 / 100);
 }
 
 // The preview's 2× downscale is OpenCV's INTER_AREA bit for bit (the preview was made with
