@@ -70,6 +70,11 @@ inline float FromBits(const QuantileTable& t, uint32_t bits) {
 
 float NormalFromBits(uint32_t bits) { return FromBits(Table(), bits); }
 
+void NormalsFromBits(const uint32_t* bits, size_t count, float* z) {
+    const QuantileTable& t = Table();
+    for (size_t i = 0; i < count; ++i) z[i] = FromBits(t, bits[i]);
+}
+
 void NormalPair(uint64_t bits, float& z0, float& z1) {
     const QuantileTable& t = Table();
     z0 = FromBits(t, uint32_t(bits >> 32));
