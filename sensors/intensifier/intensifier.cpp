@@ -72,8 +72,9 @@ inline VU Mix64Lanes(VU z) {
     z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
     return z ^ (z >> 31);
 }
-// Pixels of a halo block: its disc sums stay in registers while the disc's rows are added.
-constexpr int kHaloBlock = 16;
+// Pixels of a halo block: its disc sums stay in registers while the disc's rows are added
+// (eight AVX or SSE2 registers).
+constexpr int kHaloBlock = int(simd::kLanes) * 4;
 
 // sRGB encoding of linear v in [0, 1] (IEC 61966-2-1:1999).
 double SrgbEncode(double v) {
@@ -152,10 +153,10 @@ Intensifier::Intensifier(const IntensifierSettings& settings, int supersampling)
     glm::dvec3 p43 = radiometry::Rec709FromYxy(1.0, kP43x, kP43y);
     p43 = glm::max(p43, glm::dvec3(0.0));
     p43 /= std::max({p43.r, p43.g, p43.b});
-    phosphorLut_.resize(size_t(kLutSize) * 3);
+    phosphorLut_.assign(size_t(kLutSize) * 4, 0);
     for (int i = 0; i < kLutSize; ++i)
         for (int c = 0; c < 3; ++c)
-            phosphorLut_[size_t(i) * 3 + size_t(c)] =
+            phosphorLut_[size_t(i) * 4 + size_t(c)] =
                 uint8_t(std::lround(255.0 * SrgbEncode(double(i) / (kLutSize - 1) * p43[c])));
     radiance_ = Image(w, h, 1);
     electrons_ = Image(w, h, 1);
@@ -305,8 +306,10 @@ void Intensifier::Process(const Image& samples, double time_s, int64_t frame) {
         std::fill(row + span.end, row + w, 0.0f);
         const size_t i0 = size_t(y) * size_t(w);
         // The row's hashes four at a time (a 64-bit lane product is the scalar product mod
-        // 2⁶⁴); its exact-branch pixels drawn as they come, the normal branch's deviates for
-        // the whole row in one call (the table lookup inlined) when it has any.
+        // 2⁶⁴) and the normal deviates of their low halves for the whole row in one call;
+        // then the deviates four pixels at a time where all four take the normal branch with
+        // a mean below 2⁵¹ (NormalPoisson's truncation as the rounding to nearest by 2⁵², less
+        // one where that rounded up: exact for 0 ≤ v < 2⁵²), else pixel by pixel.
         NoiseScratch& noise = noiseScratch.local();
         const int count = span.end - span.begin;
         noise.bits.resize(size_t(count + 4));
@@ -314,49 +317,35 @@ void Intensifier::Process(const Image& samples, double time_s, int64_t frame) {
         noise.z.resize(size_t(count + 4));
         for (int j = 0; j < count; j += 4) {
             const VU counter = VU{0, 1, 2, 3} + uint64_t(i0 + size_t(span.begin + j));
-            const VU bits = Mix64Lanes(counter ^ key);
+            const VU bits = Mix64Lanes(counter ^ key);  // scene::HashBits(seed, frame, pixel)
             std::memcpy(&noise.bits[size_t(j)], &bits, sizeof bits);
+            const auto low =
+                __builtin_convertvector(bits, uint32_t __attribute__((vector_size(16))));
+            std::memcpy(&noise.low[size_t(j)], &low, sizeof low);
         }
-        bool anyNormal = false;
-        for (int j = 0; j < count; ++j) {
-            const uint64_t bits = noise.bits[size_t(j)];
-            noise.low[size_t(j)] = uint32_t(bits);
-            const double mean = double(L[span.begin + j]) * scale;
-            if (mean <= kExactPoissonMean)
-                row[span.begin + j] = float(F * PoissonDeviate(mean, bits));
-            else
-                anyNormal = true;
-        }
-        if (anyNormal) {
-            NormalsFromBits(noise.low.data(), size_t(count), noise.z.data());
-            // Four pixels at a time where all four take the normal branch with a mean below
-            // 2⁵¹ (NormalPoisson's truncation as round-to-nearest by 2⁵², less one where that
-            // rounded up: exact for 0 ≤ v < 2⁵²); otherwise pixel by pixel.
-            int j = 0;
-            for (; j + 4 <= count; j += 4) {
-                const float* Lj = L + span.begin + j;
-                const VD mean = VD{Lj[0], Lj[1], Lj[2], Lj[3]} * scale;
-                if (!AllLanes(mean > kExactPoissonMean && mean < 0x1.0p51)) {
-                    for (int l = 0; l < 4; ++l)
-                        if (!(mean[l] <= kExactPoissonMean))
-                            row[span.begin + j + l] =
-                                float(F * NormalPoisson(mean[l], noise.z[size_t(j + l)]));
-                    continue;
-                }
-                const float* zj = &noise.z[size_t(j)];
-                VD v = mean + SqrtVD(mean) * VD{zj[0], zj[1], zj[2], zj[3]};
-                v = (0.0 < v ? v : 0.0) + 0.5;
-                VD whole = (v + 0x1.0p52) - 0x1.0p52;
-                whole = whole > v ? whole - 1.0 : whole;
-                const VD e = F * whole;
-                for (int l = 0; l < 4; ++l) row[span.begin + j + l] = float(e[l]);
+        NormalsFromBits(noise.low.data(), size_t(count), noise.z.data());
+        const auto draw = [&](int j, double mean) {
+            row[span.begin + j] =
+                float(F * (mean <= kExactPoissonMean ? PoissonDeviate(mean, noise.bits[size_t(j)])
+                                                     : NormalPoisson(mean, noise.z[size_t(j)])));
+        };
+        int j = 0;
+        for (; j + 4 <= count; j += 4) {
+            const float* Lj = L + span.begin + j;
+            const VD mean = VD{Lj[0], Lj[1], Lj[2], Lj[3]} * scale;
+            if (!AllLanes(mean > kExactPoissonMean && mean < 0x1.0p51)) {
+                for (int l = 0; l < 4; ++l) draw(j + l, mean[l]);
+                continue;
             }
-            for (; j < count; ++j) {
-                const double mean = double(L[span.begin + j]) * scale;
-                if (!(mean <= kExactPoissonMean))
-                    row[span.begin + j] = float(F * NormalPoisson(mean, noise.z[size_t(j)]));
-            }
+            const float* zj = &noise.z[size_t(j)];
+            VD v = mean + SqrtVD(mean) * VD{zj[0], zj[1], zj[2], zj[3]};
+            v = (0.0 < v ? v : 0.0) + 0.5;
+            VD whole = (v + 0x1.0p52) - 0x1.0p52;
+            whole = whole > v ? whole - 1.0 : whole;
+            const VD e = F * whole;
+            for (int l = 0; l < 4; ++l) row[span.begin + j + l] = float(e[l]);
         }
+        for (; j < count; ++j) draw(j, double(L[span.begin + j]) * scale);
         if (lag) {
             double sum = 0.0;
             for (int x = span.begin; x < span.end; ++x)
@@ -462,8 +451,17 @@ void Intensifier::Process(const Image& samples, double time_s, int64_t frame) {
         uint8_t* rgb = &display_[size_t(y) * size_t(w) * 3];
         std::fill(bright, bright + span.begin, 0.0f);
         std::fill(bright + span.end, bright + w, 0.0f);
-        for (int x = 0; x < span.begin; ++x) std::memcpy(rgb + 3 * x, &phosphorLut_[0], 3);
-        for (int x = span.end; x < w; ++x) std::memcpy(rgb + 3 * x, &phosphorLut_[0], 3);
+        // Outside the stop the colour of brightness 0; inside, each pixel's four LUT bytes
+        // (the fourth is overwritten by the next pixel, written after it), the row's last
+        // pixel three.
+        const auto fill = [&](int begin, int end) {
+            const uint8_t* c = phosphorLut_.data();
+            if (c[0] == c[1] && c[1] == c[2])
+                std::memset(rgb + 3 * begin, c[0], size_t(3 * (end - begin)));
+            else
+                for (int x = begin; x < end; ++x) std::memcpy(rgb + 3 * x, c, 3);
+        };
+        fill(0, span.begin);
         for (int x = span.begin; x < span.end; x += int(kLanes)) {
             const size_t lanes = std::min(kLanes, size_t(span.end - x));
             VF sum = Splat(0.0f);
@@ -476,9 +474,18 @@ void Intensifier::Process(const Image& samples, double time_s, int64_t frame) {
             const VF scaled = b * float(kLutSize - 1);
             const VI whole = __builtin_convertvector(scaled, VI);
             const VI code = whole - VI(scaled - __builtin_convertvector(whole, VF) >= 0.5f);
-            for (size_t l = 0; l < lanes; ++l)
-                std::memcpy(rgb + 3 * (x + int(l)), &phosphorLut_[3 * size_t(code[l])], 3);
+            int32_t codes[kLanes];
+            std::memcpy(codes, &code, sizeof codes);
+            const uint8_t* lut = phosphorLut_.data();
+            uint8_t* out = rgb + 3 * x;
+            if (lanes == kLanes && x + int(kLanes) < w) {
+                for (size_t l = 0; l < kLanes; ++l) std::memcpy(out + 3 * l, lut + 4 * codes[l], 4);
+            } else {
+                for (size_t l = 0; l < lanes; ++l)
+                    std::memcpy(out + 3 * l, lut + 4 * codes[l], x + int(l) + 1 < w ? 4 : 3);
+            }
         }
+        fill(span.end, w);
     });
 }
 
