@@ -1,7 +1,7 @@
 // Image intensifier: photon radiance → photoelectrons → MCP noise → halo → tube MTF → ABC → P43.
 #include "sensors/intensifier/intensifier.h"
 
-#include <emmintrin.h>
+#include <immintrin.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
@@ -57,7 +57,13 @@ inline VD LoadVD(const double* p) {
 }
 using VU = uint64_t __attribute__((vector_size(4 * sizeof(uint64_t))));
 using VL = int64_t __attribute__((vector_size(4 * sizeof(int64_t))));
-inline bool AllLanes(VL mask) { return mask[0] && mask[1] && mask[2] && mask[3]; }
+inline bool AllLanes(VL mask) {
+#if defined(__AVX__)
+    return _mm256_movemask_pd(__m256d(mask)) == 0xF;
+#else
+    return (mask[0] & mask[1] & mask[2] & mask[3]) != 0;
+#endif
+}
 inline VD SqrtVD(VD v) {
 #if defined(__AVX__)
     return _mm256_sqrt_pd(v);
@@ -72,6 +78,20 @@ inline VU Mix64Lanes(VU z) {
     z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
     return z ^ (z >> 31);
 }
+// Σ term(L[x]) over the span in the order of x: the terms (a function of four doubles, lane for
+// lane) four at a time.
+template <class Term>
+double SumInOrder(const float* L, PixelSpan span, const Term& term) {
+    double sum = 0.0;
+    int x = span.begin;
+    for (; x + 4 <= span.end; x += 4) {
+        const VD t = term(VD{L[x], L[x + 1], L[x + 2], L[x + 3]});
+        for (int l = 0; l < 4; ++l) sum += t[l];
+    }
+    for (; x < span.end; ++x) sum += term(VD{L[x], 0.0, 0.0, 0.0})[0];
+    return sum;
+}
+
 // Pixels of a halo block: its disc sums stay in registers while the disc's rows are added
 // (eight AVX or SSE2 registers).
 constexpr int kHaloBlock = int(simd::kLanes) * 4;
@@ -182,9 +202,32 @@ void Intensifier::Process(const Image& samples, double time_s, int64_t frame) {
         std::fill(row + span.end, row + w, 0.0f);
         int x = span.begin;
         if (n == 2 && comps == 3) {
-            // The default 2×2 samples of three bands: two pixels at a time, one per lane of an
-            // SSE2 double pair, each lane adding its pixel's twelve values in the scalar
-            // loop's order (the same sums bit for bit, without its serial chain of adds).
+            // The default 2×2 samples of three bands: four (AVX) or two pixels at a time, one
+            // per lane, each lane adding its pixel's twelve values in the scalar loop's order
+            // (the same sums bit for bit, without its serial chain of adds).
+#if defined(__AVX__)
+            for (; x + 3 < span.end; x += 4) {
+                __m256d sum = _mm256_setzero_pd();
+                for (int j = 0; j < 2; ++j) {
+                    const float* a = samples.At(x * 2, y * 2 + j);  // six values per pixel
+                    // Values 0–3 of the four pixels transposed to one vector per value, then
+                    // values 4 and 5.
+                    __m128 v0 = _mm_loadu_ps(a), v1 = _mm_loadu_ps(a + 6);
+                    __m128 v2 = _mm_loadu_ps(a + 12), v3 = _mm_loadu_ps(a + 18);
+                    _MM_TRANSPOSE4_PS(v0, v1, v2, v3);
+                    const auto pair = [](const float* p) {
+                        return _mm_castsi128_ps(
+                            _mm_loadl_epi64(reinterpret_cast<const __m128i*>(p)));
+                    };
+                    const __m128 p01 = _mm_unpacklo_ps(pair(a + 4), pair(a + 10));
+                    const __m128 p23 = _mm_unpacklo_ps(pair(a + 16), pair(a + 22));
+                    const __m128 v4 = _mm_movelh_ps(p01, p23), v5 = _mm_movehl_ps(p23, p01);
+                    for (__m128 v : {v0, v1, v2, v3, v4, v5})
+                        sum = _mm256_add_pd(sum, _mm256_cvtps_pd(v));
+                }
+                _mm_storeu_ps(row + x, _mm256_cvtpd_ps(_mm256_div_pd(sum, _mm256_set1_pd(4.0))));
+            }
+#endif
             for (; x + 1 < span.end; x += 2) {
                 __m128d sum = _mm_setzero_pd();
                 for (int j = 0; j < 2; ++j) {
@@ -217,9 +260,7 @@ void Intensifier::Process(const Image& samples, double time_s, int64_t frame) {
             }
             row[x] = float(sum / (n * n));
         }
-        double pe = 0.0;
-        for (x = span.begin; x < span.end; ++x) pe += double(row[x]) * pePerRadiance_;
-        rowSum[size_t(y)] = pe;
+        rowSum[size_t(y)] = SumInOrder(row, span, [&](VD L) { return L * pePerRadiance_; });
     });
     // Sums over the field stop: per row (in parallel), then the rows in order (deterministic for
     // any thread count).
@@ -231,10 +272,7 @@ void Intensifier::Process(const Image& samples, double time_s, int64_t frame) {
     const auto fieldSum = [&](const auto& term) {
         tbb::parallel_for(0, h, [&](int y) {
             const PixelSpan span = spans_[size_t(y)];
-            const float* row = radiance_.At(0, y);
-            double sum = 0.0;
-            for (int x = span.begin; x < span.end; ++x) sum += term(double(row[x]));
-            rowSum[size_t(y)] = sum;
+            rowSum[size_t(y)] = SumInOrder(radiance_.At(0, y), span, term);
         });
         return sumRows();
     };
@@ -247,11 +285,14 @@ void Intensifier::Process(const Image& samples, double time_s, int64_t frame) {
     // The mean as the ABC senses it through the screen current at gain g: each pixel counts at
     // most the photoelectrons that saturate it (1/g).
     const double senseScale = pePerRadiance_ * duty_;
+    const auto sensedTerm = [&](double cap) {
+        return [&senseScale, cap](VD L) {  // std::min(L · senseScale, cap)
+            const VD pe = L * senseScale;
+            return cap < pe ? cap : pe;
+        };
+    };
     const auto sensed = [&](double g) {
-        const double cap = 1.0 / g;
-        return count > 0.0
-                   ? fieldSum([&](double L) { return std::min(L * senseScale, cap); }) / count
-                   : 0.0;
+        return count > 0.0 ? fieldSum(sensedTerm(1.0 / g)) / count : 0.0;
     };
     // ABC: the gain that puts the sensed mean at abcLevel (capped at its value at the
     // threshold), sensed at the previous frame's gain; the first frame starts settled, at the
@@ -346,16 +387,15 @@ void Intensifier::Process(const Image& samples, double time_s, int64_t frame) {
             for (int l = 0; l < 4; ++l) row[span.begin + j + l] = float(e[l]);
         }
         for (; j < count; ++j) draw(j, double(L[span.begin + j]) * scale);
-        if (lag) {
-            double sum = 0.0;
-            for (int x = span.begin; x < span.end; ++x)
-                sum += std::min(double(L[x]) * senseScale, senseCap);
-            rowSum[size_t(y)] = sum;
-        }
+        if (lag) rowSum[size_t(y)] = SumInOrder(L, span, sensedTerm(senseCap));
         if (halo) {
             double* p = &prefix_[size_t(y) * stride];
             std::fill(p, p + R + span.begin + 1, 0.0);
-            for (int x = span.begin; x < span.end; ++x) p[R + x + 1] = p[R + x] + double(row[x]);
+            double sum = 0.0;  // p[R + x] in a register
+            int x = span.begin;
+            for (; x + 4 <= span.end; x += 4)
+                for (int l = 0; l < 4; ++l) p[R + x + l + 1] = sum += double(row[x + l]);
+            for (; x < span.end; ++x) p[R + x + 1] = sum += double(row[x]);
             std::fill(p + R + span.end + 1, p + stride, p[R + span.end]);
         }
     });
