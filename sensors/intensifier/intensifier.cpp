@@ -473,18 +473,21 @@ void Intensifier::Process(const Image& samples, double time_s, int64_t frame) {
         for (int x = need.begin - r; x < 0; ++x) padded[x] = padded[0];
         for (int x = w; x < need.end + r; ++x) padded[x] = padded[w - 1];
         float* out = halo_.At(0, y);  // the horizontally blurred halo (only `need` is read)
-        for (int x = need.begin; x < need.end; x += int(kLanes)) {
-            const size_t lanes = std::min(kLanes, size_t(need.end - x));
+        const auto across = [&](int x, size_t lanes) {
             VF sum = Splat(0.0f);
             for (int k = -r; k <= r; ++k)
                 sum += Splat(mtfKernel_[size_t(k + r)]) * Load(padded + x + k, lanes);
             Store(out + x, sum, lanes);
-        }
+        };
+        int x = need.begin;
+        for (; x + int(kLanes) <= need.end; x += int(kLanes)) across(x, kLanes);
+        if (x < need.end) across(x, size_t(need.end - x));
     });
     // The tube MTF's vertical pass, then ABC gain, screen saturation (min(1, g·v) as
     // std::min) and the field stop; the P43 display through the LUT at lround(b·(kLutSize − 1))
     // (for v ≥ 0: v − trunc(v) is exact in float).
     const float gain = float(gain_);
+    tbb::enumerable_thread_specific<std::vector<const float*>> tapRows;
     tbb::parallel_for(0, h, [&](int y) {
         const PixelSpan span = spans_[size_t(y)];
         float* bright = brightness_.At(0, y);
@@ -502,12 +505,15 @@ void Intensifier::Process(const Image& samples, double time_s, int64_t frame) {
                 for (int x = begin; x < end; ++x) std::memcpy(rgb + 3 * x, c, 3);
         };
         fill(0, span.begin);
-        for (int x = span.begin; x < span.end; x += int(kLanes)) {
-            const size_t lanes = std::min(kLanes, size_t(span.end - x));
+        std::vector<const float*>& rows = tapRows.local();  // row y + k (clamped) at k + r
+        rows.resize(size_t(2 * r + 1));
+        for (int k = -r; k <= r; ++k)
+            rows[size_t(k + r)] = halo_.At(0, std::clamp(y + k, 0, h - 1));
+        const uint8_t* lut = phosphorLut_.data();
+        const auto screen = [&](int x, size_t lanes) {
             VF sum = Splat(0.0f);
             for (int k = -r; k <= r; ++k)
-                sum += Splat(mtfKernel_[size_t(k + r)]) *
-                       Load(halo_.At(x, std::clamp(y + k, 0, h - 1)), lanes);
+                sum += Splat(mtfKernel_[size_t(k + r)]) * Load(rows[size_t(k + r)] + x, lanes);
             const VF v = Splat(gain) * sum;
             const VF b = Select(v < 1.0f, v, Splat(1.0f));
             Store(bright + x, b, lanes);
@@ -516,7 +522,6 @@ void Intensifier::Process(const Image& samples, double time_s, int64_t frame) {
             const VI code = whole - VI(scaled - __builtin_convertvector(whole, VF) >= 0.5f);
             int32_t codes[kLanes];
             std::memcpy(codes, &code, sizeof codes);
-            const uint8_t* lut = phosphorLut_.data();
             uint8_t* out = rgb + 3 * x;
             if (lanes == kLanes && x + int(kLanes) < w) {
                 for (size_t l = 0; l < kLanes; ++l) std::memcpy(out + 3 * l, lut + 4 * codes[l], 4);
@@ -524,7 +529,10 @@ void Intensifier::Process(const Image& samples, double time_s, int64_t frame) {
                 for (size_t l = 0; l < lanes; ++l)
                     std::memcpy(out + 3 * l, lut + 4 * codes[l], x + int(l) + 1 < w ? 4 : 3);
             }
-        }
+        };
+        int x = span.begin;
+        for (; x + int(kLanes) <= span.end; x += int(kLanes)) screen(x, kLanes);
+        if (x < span.end) screen(x, size_t(span.end - x));
         fill(span.end, w);
     });
 }
