@@ -63,7 +63,7 @@ class Intensifier {
     std::vector<uint8_t> display_;
     std::vector<double> prefix_;        // halo: row prefix sums, kept between frames
     std::vector<double> rowSum_;        // per-row sums over the field stop
-    std::vector<uint8_t> phosphorLut_;  // kLutSize × 3: brightness → sRGB P43 colour
+    std::vector<uint8_t> phosphorLut_;  // kLutSize × 4: brightness → sRGB P43 colour, 0
     bool started_ = false;
     double lastTime_s_ = 0.0;
     double gain_ = 0.0, duty_ = 1.0, meanPe_ = 0.0;

@@ -17,6 +17,10 @@ void NormalPair(uint64_t bits, float& z0, float& z1);
 // One deviate from 32 random bits (the low half of NormalPair's input gives z1).
 float NormalFromBits(uint32_t bits);
 
+// count deviates z[i] = NormalFromBits(bits[i]), in one call so that the table lookup inlines
+// into the loop.
+void NormalsFromBits(const uint32_t* bits, size_t count, float* z);
+
 // A row of count deviates: z[2p] and z[2p + 1] are NormalPair(scene::Mix64(key ^ (counter0 +
 // p))) (an odd count drops the last pair's second). The same values as NormalPair one pair at a
 // time, in one call so that the table lookup inlines into the loop.

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
 #include <numbers>
 #include <vector>
@@ -63,6 +64,25 @@ TEST(NormalDeviates, RowOfPairsEqualsPairByPair) {
             NormalPair(scene::Mix64(key ^ (counter0 + i / 2)), z[0], z[1]);
             EXPECT_EQ(row[i], z[i % 2]) << count << " " << i;
         }
+    }
+}
+
+// NormalsFromBits (on simd lanes, a table gather) against NormalFromBits one by one: hashed
+// bits, the ends of the table (v = 0, the last interval's draws of both signs, which the lanes
+// hand to the scalar form) and counts that leave a partial group.
+TEST(NormalDeviates, RowFromBitsEqualsOneByOne) {
+    std::vector<uint32_t> bits;
+    for (uint64_t i = 0; i < 4000; ++i) bits.push_back(uint32_t(scene::Mix64(i)));
+    for (uint32_t b : {0u, 1u, 0xFFFFFFFFu, 0xFFFFFFFEu, 0x7FFFFFFFu, 0xFFFC0000u, 0xFFFBFFFFu,
+                       0xFFF80000u, 0xFFF7FFFFu, 0xFFF80001u})
+        bits.insert(bits.begin() + 37, b);
+    for (size_t count : {size_t(0), size_t(1), size_t(7), size_t(13), bits.size()}) {
+        std::vector<float> z(count, -1.0f);
+        NormalsFromBits(bits.data(), count, z.data());
+        for (size_t i = 0; i < count; ++i)
+            EXPECT_EQ(std::bit_cast<uint32_t>(z[i]),
+                      std::bit_cast<uint32_t>(NormalFromBits(bits[i])))
+                << count << " " << i << " " << bits[i];
     }
 }
 
