@@ -2,6 +2,7 @@
 #include "channels/sync/state_codec.h"
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <cstring>
 #include <vector>
@@ -93,7 +94,10 @@ TEST(StateCodec, SlotCarriesTheStateAndTheSeaFields) {
     spectral.fft.gridSize = 32;
     ocean.spectral = spectral;
     const scene::OceanSurface sea(ocean);
-    const auto frame = sea.At(2.5);
+    // One thread: this file also runs under ThreadSanitizer, which cannot see oneTBB's
+    // synchronization (the synthesis' parallel loops then run on the calling thread).
+    tbb::task_arena arena(1);
+    const auto frame = arena.execute([&] { return sea.At(2.5); });
     const scene::FrameState s = Sample(2);
     std::vector<uint8_t> fields(sea.SharedFieldBytes());
     frame->Fft()->Encode(fields.data());
