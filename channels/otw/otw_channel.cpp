@@ -130,7 +130,7 @@ constexpr size_t kChunk = 256;
 struct SeaChunk {
     alignas(16) float rx[kChunk], ry[kChunk], rz[kChunk];  // reflected view ray, z ≥ 0
     alignas(16) float mvx[kChunk], mvy[kChunk];            // −v: toward the far airlight
-    alignas(16) float range[kChunk], cosV[kChunk], cosS[kChunk], vh[kChunk];
+    alignas(16) float range[kChunk], cosV[kChunk], cosS[kChunk];
     alignas(16) float cos2[kChunk], tan2[kChunk], sunVis[kChunk];
     alignas(16) float F[kChunk], Fs[kChunk];
     alignas(16) float skyR[kChunk], skyG[kChunk], skyB[kChunk];
@@ -186,7 +186,9 @@ struct SeaShading {
             Store(ch.mvx + i, 0.0f - vx);
             Store(ch.mvy + i, 0.0f - vy);
             Store(ch.range + i, range);
-            Store(ch.cosV + i, Max(ndv, Splat(1e-3f)));
+            const VF cosV = Max(ndv, Splat(1e-3f));
+            Store(ch.cosV + i, cosV);
+            Store(ch.F + i, fresnel(cosV));
             const VF cosS = Dot(Nx, Ny, Nz, Splat(keyDir.x), Splat(keyDir.y), Splat(keyDir.z));
             Store(ch.cosS + i, cosS);
             const VF wx = vx + keyDir.x, wy = vy + keyDir.y, wz = vz + keyDir.z;
@@ -196,7 +198,7 @@ struct SeaShading {
             const VF cos2 = cosB * cosB;
             Store(ch.cos2 + i, cos2);
             Store(ch.tan2 + i, (1.0f - cos2) / cos2);
-            Store(ch.vh + i, Dot(vx, vy, vz, hx, hy, hz));
+            Store(ch.Fs + i, fresnel(Dot(vx, vy, vz, hx, hy, hz)));
             // Lambertian irradiance of sand and foam: sky as on a plane tilted to the normal,
             // (1 + n_z)/2 of the level-surface sky irradiance, and the fill lights.
             const VF skyView = 0.5f * (1.0f + Nz);
@@ -215,8 +217,6 @@ struct SeaShading {
         }
         sky.LookUp(count, ch.rx, ch.ry, ch.rz, ch.skyR, ch.skyG, ch.skyB);
         sky.HorizonLookUp(count, ch.mvx, ch.mvy, ch.horR, ch.horG, ch.horB);
-        fresnel(count, ch.cosV, ch.F);
-        fresnel(count, ch.vh, ch.Fs);
 
         const VF glintLimit = Splat(60.0f * slopeVar);
         // Reciprocals of the frame's constants: multiplications in the loop, not divisions.
@@ -514,10 +514,14 @@ class BlockClassifier {
   private:
     int N() const { return kN > 0 ? kN : g_.n; }
 
-    // The cached triangle prim.
-    const CachedTriangle& Triangle(uint32_t prim) {
+    // The cached triangle prim. The hit, most calls, is inlined; the gathering is not.
+    __attribute__((always_inline)) const CachedTriangle& Triangle(uint32_t prim) {
         CachedTriangle& tri = sc_.triangles[prim % BlockScratch::kTriangleCacheSize];
-        if (tri.prim == prim && tri.frame == g_.frame) return tri;
+        if (tri.prim == prim && tri.frame == g_.frame) [[likely]]
+            return tri;
+        return Gather(prim, tri);
+    }
+    __attribute__((noinline)) const CachedTriangle& Gather(uint32_t prim, CachedTriangle& tri) {
         g_.Fetch(prim, tri);
         tri.frame = g_.frame;
         tri.shadowable = false;
