@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include "channels/otw/celestial.h"
@@ -154,7 +155,7 @@ struct SeaShading {
     const std::vector<DirectionalLight>* fill;
     ShoreChannel shore[3];
 
-    // Shades count ≤ kChunk samples at positions p (m, world) with unit normals n, sun
+    // Shades count ≤ kChunk samples at positions p (m, world) with normals n (any length), sun
     // visibility ch.sunVis, water column depth (m), sand wetness and foam coverage; radiance
     // (cd/m²) to ch.outR/G/B.
     void Shade(size_t count, const float* px, const float* py, const float* pz, const float* nx,
@@ -167,8 +168,11 @@ struct SeaShading {
         static_assert(kChunk % kLanes == 0);
         for (size_t i = 0; i < count; i += kLanes) {
             const size_t lanes = std::min(kLanes, count - i);
-            const VF Nx = Load(nx + i, lanes, 0.0f), Ny = Load(ny + i, lanes, 0.0f),
-                     Nz = Load(nz + i, lanes, 1.0f);
+            // The normal normalized as glm::normalize does, v · (1 / √(v·v)).
+            VF Nx = Load(nx + i, lanes, 0.0f), Ny = Load(ny + i, lanes, 0.0f),
+               Nz = Load(nz + i, lanes, 1.0f);
+            const VF invN = 1.0f / Sqrt(Dot(Nx, Ny, Nz, Nx, Ny, Nz));
+            Nx = Nx * invN, Ny = Ny * invN, Nz = Nz * invN;
             const VF tx = eye.x - Load(px + i, lanes, 0.0f);
             const VF ty = eye.y - Load(py + i, lanes, 0.0f);
             const VF tz = eye.z - Load(pz + i, lanes, 0.0f);
@@ -489,11 +493,22 @@ class BlockClassifier {
             const int x0 = px * n;
             const uint32_t prim0 = prim[rowIndex_[0] + size_t(x0)];
             bool same = true, allSea = true;
-            for (int j = 0; j < n; ++j) {
-                const uint32_t* row = prim + rowIndex_[j] + size_t(x0);
-                for (int i = 0; i < n; ++i) {
-                    same &= row[i] == prim0;
-                    allSea &= row[i] < g_.firstModelPrimitive;  // kNoPrimitive is not sea
+            if constexpr (kN == 2) {
+                // The four ids as two 64-bit pairs.
+                uint64_t row0, row1;
+                std::memcpy(&row0, prim + rowIndex_[0] + size_t(x0), sizeof row0);
+                std::memcpy(&row1, prim + rowIndex_[1] + size_t(x0), sizeof row1);
+                same = row0 == row1 && uint32_t(row0 >> 32) == prim0;
+                const uint32_t sea = g_.firstModelPrimitive;  // kNoPrimitive is not sea
+                allSea = prim0 < sea && uint32_t(row0 >> 32) < sea && uint32_t(row1) < sea &&
+                         uint32_t(row1 >> 32) < sea;
+            } else {
+                for (int j = 0; j < n; ++j) {
+                    const uint32_t* row = prim + rowIndex_[j] + size_t(x0);
+                    for (int i = 0; i < n; ++i) {
+                        same &= row[i] == prim0;
+                        allSea &= row[i] < g_.firstModelPrimitive;  // kNoPrimitive is not sea
+                    }
                 }
             }
             const uint32_t k = kRow + uint32_t(x0);
@@ -566,9 +581,10 @@ class BlockClassifier {
         sc_.skyX[e] = d.x, sc_.skyY[e] = d.y, sc_.skyZ[e] = d.z;
     }
 
-    // The pixel with top-left sample x0, all of whose samples see sea triangle prim: shaded at
-    // pixel rate (at the mean barycentrics) unless depth or c = n·v vary too much across it
-    // (then returns false, nothing added). On one triangle c is linear in the barycentrics.
+    // The pixel with top-left sample x0 (entry k), all of whose samples see sea triangle prim:
+    // shaded at pixel rate (at the mean barycentrics) unless c = n·v varies too much across it
+    // (then its samples are added one by one, as Sample adds them) or depth does (then returns
+    // false, nothing added). On one triangle c is linear in the barycentrics.
     bool SeaTrianglePixel(int x0, uint32_t k, uint32_t prim) {
         const int n = N(), count = n * n;
         if (!DepthsClose(x0)) return false;
@@ -600,7 +616,12 @@ class BlockClassifier {
                 cMin = std::min(cMin, c), cMax = std::max(cMax, c);
             }
         }
-        if (!CosSpreadSmall(cMin, cMax, std::sqrt(Dot3(toEye, toEye)))) return false;
+        if (!CosSpreadSmall(cMin, cMax, std::sqrt(Dot3(toEye, toEye)))) {
+            for (int j = 0; j < n; ++j)
+                for (int i = 0; i < n; ++i)
+                    SeaSample(tri, b1[j][i], b2[j][i], k + uint32_t(j * g_.sampleWidth + i));
+            return true;
+        }
         const size_t e =
             AddSea(k | kPixelEntry, p, nSum, InterpolateAttributes(tri, b1Sum * inv, b2Sum * inv));
         if (tri.shadowable) {
@@ -618,7 +639,9 @@ class BlockClassifier {
     bool SeaPixel(int x0, uint32_t k) {
         const int n = N(), count = n * n;
         if (!DepthsClose(x0)) return false;
-        F4 p[kMaxSupersampling * kMaxSupersampling], nrm[kMaxSupersampling * kMaxSupersampling];
+        constexpr int kMaxSamples = kMaxSupersampling * kMaxSupersampling;
+        F4 p[kMaxSamples], nrm[kMaxSamples], a[kMaxSamples];
+        bool sampleShadowable[kMaxSamples];
         F4 pSum = _mm_setzero_ps(), nSum = _mm_setzero_ps(), aSum = _mm_setzero_ps();
         bool shadowable = false;
         for (int j = 0; j < n; ++j) {
@@ -627,8 +650,9 @@ class BlockClassifier {
                 const int s = j * n + i;
                 const CachedTriangle& tri = Triangle(g_.vis.primitive[index]);
                 Interpolate(tri, g_.vis.b1[index], g_.vis.b2[index], p[s], nrm[s]);
-                aSum = _mm_add_ps(aSum,
-                                  InterpolateAttributes(tri, g_.vis.b1[index], g_.vis.b2[index]));
+                a[s] = InterpolateAttributes(tri, g_.vis.b1[index], g_.vis.b2[index]);
+                aSum = _mm_add_ps(aSum, a[s]);
+                sampleShadowable[s] = tri.shadowable;
                 shadowable |= tri.shadowable;
                 pSum = _mm_add_ps(pSum, p[s]);
                 nSum = _mm_add_ps(nSum, nrm[s]);
@@ -641,16 +665,28 @@ class BlockClassifier {
             const float c = Dot3(nrm[s], toEye);
             cMin = std::min(cMin, c), cMax = std::max(cMax, c);
         }
-        if (!CosSpreadSmall(cMin, cMax, std::sqrt(Dot3(toEye, toEye)))) return false;
+        if (!CosSpreadSmall(cMin, cMax, std::sqrt(Dot3(toEye, toEye)))) {
+            // The samples one by one, from the values just interpolated.
+            for (int j = 0; j < n; ++j) {
+                for (int i = 0; i < n; ++i) {
+                    const int s = j * n + i;
+                    const size_t e =
+                        AddSea(k + uint32_t(j * g_.sampleWidth + i), p[s], nrm[s], a[s]);
+                    if (sampleShadowable[s]) SeaShadowRays(e, &p[s], 1);
+                }
+            }
+            return true;
+        }
         const size_t e =
             AddSea(k | kPixelEntry, mean, nSum, _mm_mul_ps(aSum, Set4(1.0f / float(count))));
         if (shadowable) SeaShadowRays(e, p, count);
         return true;
     }
 
-    // A lit sea entry at position p with normal nSum (unnormalized: ShadeSea normalizes the
-    // block's normals four at a time, off this loop's critical path); returns its index.
-    size_t AddSea(uint32_t k, F4 p, F4 nSum, F4 attributes) {
+    // A lit sea entry at position p with normal nSum (unnormalized: SeaShading::Shade normalizes
+    // it with the block's others, simd::kLanes at a time, off this loop's critical path);
+    // returns its index.
+    __attribute__((always_inline)) size_t AddSea(uint32_t k, F4 p, F4 nSum, F4 attributes) {
         alignas(16) float pf[4], nf[4], af[4];
         _mm_store_ps(pf, p);
         _mm_store_ps(af, attributes);
@@ -668,7 +704,7 @@ class BlockClassifier {
     // Shadow rays of sea entry e, one per sample at positions samples[0..count), offset along
     // the entry's normal.
     void SeaShadowRays(size_t e, const F4* samples, int count) {
-        // The entry's unit normal as Normalize makes it for shading: glm::normalize's
+        // The entry's unit normal as SeaShading::Shade makes it: glm::normalize's
         // v · (1 / √(v·v)) with v·v summed (x + y) + z, the same operations lane for lane.
         const glm::vec3 v(sc_.seaNx[e], sc_.seaNy[e], sc_.seaNz[e]);
         const glm::vec3 nrm = v * (1.0f / std::sqrt((v.x * v.x + v.y * v.y) + v.z * v.z));
@@ -681,6 +717,14 @@ class BlockClassifier {
         }
     }
 
+    // Sea sample k at barycentrics (1 − b1 − b2, b1, b2) of triangle tri, shaded on its own.
+    void SeaSample(const CachedTriangle& tri, float b1, float b2, uint32_t k) {
+        F4 p, nSum;
+        Interpolate(tri, b1, b2, p, nSum);
+        const size_t e = AddSea(k, p, nSum, InterpolateAttributes(tri, b1, b2));
+        if (tri.shadowable) SeaShadowRays(e, &p, 1);
+    }
+
     // One sample (x, row j of the pixel row) shaded on its own.
     void Sample(int x, int j, uint32_t k) {
         const size_t index = rowIndex_[j] + size_t(x);
@@ -691,14 +735,12 @@ class BlockClassifier {
             return;
         }
         const CachedTriangle& tri = Triangle(prim);
-        F4 p, nSum;
-        Interpolate(tri, g_.vis.b1[index], g_.vis.b2[index], p, nSum);
         if (tri.mesh == 0) {
-            const size_t e =
-                AddSea(k, p, nSum, InterpolateAttributes(tri, g_.vis.b1[index], g_.vis.b2[index]));
-            if (tri.shadowable) SeaShadowRays(e, &p, 1);
+            SeaSample(tri, g_.vis.b1[index], g_.vis.b2[index], k);
             return;
         }
+        F4 p, nSum;
+        Interpolate(tri, g_.vis.b1[index], g_.vis.b2[index], p, nSum);
         const glm::vec3 position = Store3(p);
         glm::vec3 nrm = glm::normalize(Store3(nSum));
         if (glm::dot(nrm, f_.eye - position) < 0.0f) nrm = -nrm;
@@ -793,7 +835,6 @@ void ShadeSea(const FrameShading& f, const FrameGeometry& g, BlockScratch& sc, f
         const size_t count = std::min(kChunk, sc.seaCount - c);
         SeaChunk& ch = sc.chunk;
         std::copy_n(&sc.seaLit[c], count, ch.sunVis);
-        Normalize(count, &sc.seaNx[c], &sc.seaNy[c], &sc.seaNz[c]);
         f.sea.Shade(count, &sc.seaPx[c], &sc.seaPy[c], &sc.seaPz[c], &sc.seaNx[c], &sc.seaNy[c],
                     &sc.seaNz[c], &sc.seaDepth[c], &sc.seaWet[c], &sc.seaFoam[c], ch);
         for (size_t i = 0; i < count; ++i)

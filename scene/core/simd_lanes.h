@@ -81,6 +81,15 @@ inline bool Any(VI mask) {
 #endif
 }
 
+// Whether every lane of a comparison's result is set.
+inline bool All(VI mask) {
+#if defined(__AVX__)
+    return _mm256_movemask_ps(reinterpret_cast<__m256>(mask)) == 0xff;
+#else
+    return _mm_movemask_ps(reinterpret_cast<__m128>(mask)) == 0xf;
+#endif
+}
+
 // Round to the nearest integer, ties to even (as cvtps2dq in the default rounding mode), for
 // |x| < 2^22: adding and subtracting 1.5·2^23 leaves x's integer part in the units place.
 inline VI RoundToInt(VF x) {
