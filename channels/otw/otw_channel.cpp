@@ -324,7 +324,7 @@ struct BlockScratch {
     std::vector<float> skyX, skyY, skyZ;                          // view directions of sky entries
     std::vector<float> seaPx, seaPy, seaPz, seaNx, seaNy, seaNz;  // normals (unit once shaded)
     std::vector<float> seaDepth, seaWet, seaFoam;                 // OceanAttributes interpolated
-    std::vector<float> seaLit;      // lit fraction of a sea entry's samples
+    std::vector<float> seaLit;      // lit fraction of a sea entry's samples (where seaUnlit > 0)
     std::vector<uint8_t> seaUnlit;  // samples of a sea entry found in shadow
     std::vector<glm::vec3> modelPosition, modelNormal;
     std::vector<int> modelMesh;
@@ -649,8 +649,9 @@ class BlockClassifier {
                 const size_t index = rowIndex_[j] + size_t(x0 + i);
                 const int s = j * n + i;
                 const CachedTriangle& tri = Triangle(g_.vis.primitive[index]);
-                Interpolate(tri, g_.vis.b1[index], g_.vis.b2[index], p[s], nrm[s]);
-                a[s] = InterpolateAttributes(tri, g_.vis.b1[index], g_.vis.b2[index]);
+                const float b1 = g_.vis.b1[index], b2 = g_.vis.b2[index];
+                Interpolate(tri, b1, b2, p[s], nrm[s]);
+                a[s] = InterpolateAttributes(tri, b1, b2);
                 aSum = _mm_add_ps(aSum, a[s]);
                 sampleShadowable[s] = tri.shadowable;
                 shadowable |= tri.shadowable;
@@ -696,7 +697,6 @@ class BlockClassifier {
         sc_.seaPx[e] = pf[0], sc_.seaPy[e] = pf[1], sc_.seaPz[e] = pf[2];
         sc_.seaNx[e] = nf[0], sc_.seaNy[e] = nf[1], sc_.seaNz[e] = nf[2];
         sc_.seaDepth[e] = af[0], sc_.seaWet[e] = af[1], sc_.seaFoam[e] = af[2];
-        sc_.seaLit[e] = 1.0f;
         sc_.seaUnlit[e] = 0;
         return e;
     }
@@ -788,7 +788,8 @@ uint64_t TraceSunVisibility(const FrameShading& f, int n, BlockScratch& sc) {
     return sc.origins.size();
 }
 
-// Writes radiance rgb to the sample(s) of entry k; out is the block's first sample row.
+// Writes radiance rgb to the sample(s) of entry k; out is the block's first sample row (the
+// default 2×2's pixel entries: SplatChunk).
 void Splat(float* out, uint32_t k, int sampleWidth, int n, float r, float g, float b) {
     if (!(k & kPixelEntry)) {
         float* o = out + 3 * size_t(k);
@@ -796,19 +797,44 @@ void Splat(float* out, uint32_t k, int sampleWidth, int n, float r, float g, flo
         return;
     }
     k &= ~kPixelEntry;
-    if (n == 2) {
-        // The default 2×2: each sample row's six floats (r g b r g b) in two stores.
-        const F4 rgbr = _mm_setr_ps(r, g, b, r), gb = _mm_setr_ps(g, b, 0.0f, 0.0f);
-        for (int j = 0; j < 2; ++j) {
-            float* o = out + 3 * (size_t(k) + size_t(j) * size_t(sampleWidth));
-            _mm_storeu_ps(o, rgbr);
-            _mm_storel_pi(reinterpret_cast<__m64*>(o + 4), gb);
-        }
-        return;
-    }
     for (int j = 0; j < n; ++j) {
         float* o = out + 3 * (size_t(k) + size_t(j) * size_t(sampleWidth));
         for (int i = 0; i < n; ++i) o[3 * i] = r, o[3 * i + 1] = g, o[3 * i + 2] = b;
+    }
+}
+
+// Splat of count entries keys[i] with radiance (r[i], g[i], b[i]): the chunk's arrays (kChunk
+// floats, 16-byte aligned) transposed four entries at a time to (r, g, b, 0) registers, written
+// from them (the same values as Splat writes).
+void SplatChunk(float* out, const uint32_t* keys, size_t count, const float* r, const float* g,
+                const float* b, int sampleWidth, int n) {
+    if (n != 2) {
+        for (size_t i = 0; i < count; ++i) Splat(out, keys[i], sampleWidth, n, r[i], g[i], b[i]);
+        return;
+    }
+    for (size_t i = 0; i < count; i += 4) {
+        F4 rgb[4] = {_mm_load_ps(r + i), _mm_load_ps(g + i), _mm_load_ps(b + i), _mm_setzero_ps()};
+        _MM_TRANSPOSE4_PS(rgb[0], rgb[1], rgb[2], rgb[3]);
+        const size_t lanes = std::min<size_t>(4, count - i);
+        for (size_t l = 0; l < lanes; ++l) {
+            uint32_t k = keys[i + l];
+            const F4 v = rgb[l];
+            if (!(k & kPixelEntry)) {
+                float* o = out + 3 * size_t(k);
+                _mm_storel_pi(reinterpret_cast<__m64*>(o), v);
+                _mm_store_ss(o + 2, _mm_movehl_ps(v, v));
+                continue;
+            }
+            // Each sample row's six floats (r g b r g b) in two stores.
+            k &= ~kPixelEntry;
+            const F4 rgbr = _mm_shuffle_ps(v, v, _MM_SHUFFLE(0, 2, 1, 0));
+            const F4 gb = _mm_shuffle_ps(v, v, _MM_SHUFFLE(3, 3, 2, 1));
+            for (int j = 0; j < 2; ++j) {
+                float* o = out + 3 * (size_t(k) + size_t(j) * size_t(sampleWidth));
+                _mm_storeu_ps(o, rgbr);
+                _mm_storel_pi(reinterpret_cast<__m64*>(o + 4), gb);
+            }
+        }
     }
 }
 
@@ -820,12 +846,27 @@ void ShadeSky(const FrameShading& f, const FrameGeometry& g, BlockScratch& sc, f
         Normalize(count, dx, dy, dz);
         SeaChunk& ch = sc.chunk;
         f.sky.LookUp(count, dx, dy, dz, ch.skyR, ch.skyG, ch.skyB);
-        for (size_t i = 0; i < count; ++i) {
-            glm::vec3 L(ch.skyR[i], ch.skyG[i], ch.skyB[i]);
-            // Pixel entries are never near the sun (BlockClassifier): the test is per sample.
-            if (glm::dot(glm::vec3(dx[i], dy[i], dz[i]), f.sunDir) >= f.cosSunRadius) L += f.sunL;
-            Splat(out, sc.skyK[c + i], g.sampleWidth, g.n, L.r, L.g, L.b);
+        // The sun's disc, simd::kLanes at a time (glm::dot's order; lanes past count are
+        // dropped). Pixel entries are never near the sun (BlockClassifier): the test is per
+        // sample.
+        {
+            using namespace simd;
+            for (size_t i = 0; i < count; i += kLanes) {
+                const size_t lanes = std::min(kLanes, count - i);
+                const VI disc = Dot(Load(dx + i, lanes), Load(dy + i, lanes), Load(dz + i, lanes),
+                                    simd::Splat(f.sunDir.x), simd::Splat(f.sunDir.y),
+                                    simd::Splat(f.sunDir.z)) >= f.cosSunRadius;
+                if (!Any(disc)) continue;
+                const auto add = [&](float* L, float sunL) {
+                    const VF v = Load(L + i);
+                    Store(L + i, Select(disc, v + sunL, v));
+                };
+                add(ch.skyR, f.sunL.r);
+                add(ch.skyG, f.sunL.g);
+                add(ch.skyB, f.sunL.b);
+            }
         }
+        SplatChunk(out, &sc.skyK[c], count, ch.skyR, ch.skyG, ch.skyB, g.sampleWidth, g.n);
     }
 }
 
@@ -834,11 +875,15 @@ void ShadeSea(const FrameShading& f, const FrameGeometry& g, BlockScratch& sc, f
     for (size_t c = 0; c < sc.seaCount; c += kChunk) {
         const size_t count = std::min(kChunk, sc.seaCount - c);
         SeaChunk& ch = sc.chunk;
-        std::copy_n(&sc.seaLit[c], count, ch.sunVis);
+        if (sc.origins.empty()) {
+            std::fill_n(ch.sunVis, count, 1.0f);
+        } else {
+            for (size_t i = 0; i < count; ++i)
+                ch.sunVis[i] = sc.seaUnlit[c + i] ? sc.seaLit[c + i] : 1.0f;
+        }
         f.sea.Shade(count, &sc.seaPx[c], &sc.seaPy[c], &sc.seaPz[c], &sc.seaNx[c], &sc.seaNy[c],
                     &sc.seaNz[c], &sc.seaDepth[c], &sc.seaWet[c], &sc.seaFoam[c], ch);
-        for (size_t i = 0; i < count; ++i)
-            Splat(out, sc.seaK[c + i], g.sampleWidth, g.n, ch.outR[i], ch.outG[i], ch.outB[i]);
+        SplatChunk(out, &sc.seaK[c], count, ch.outR, ch.outG, ch.outB, g.sampleWidth, g.n);
     }
 }
 
