@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include "channels/otw/celestial.h"
@@ -130,7 +131,7 @@ constexpr size_t kChunk = 256;
 struct SeaChunk {
     alignas(16) float rx[kChunk], ry[kChunk], rz[kChunk];  // reflected view ray, z ≥ 0
     alignas(16) float mvx[kChunk], mvy[kChunk];            // −v: toward the far airlight
-    alignas(16) float range[kChunk], cosV[kChunk], cosS[kChunk], vh[kChunk];
+    alignas(16) float range[kChunk], cosV[kChunk], cosS[kChunk];
     alignas(16) float cos2[kChunk], tan2[kChunk], sunVis[kChunk];
     alignas(16) float F[kChunk], Fs[kChunk];
     alignas(16) float skyR[kChunk], skyG[kChunk], skyB[kChunk];
@@ -154,7 +155,7 @@ struct SeaShading {
     const std::vector<DirectionalLight>* fill;
     ShoreChannel shore[3];
 
-    // Shades count ≤ kChunk samples at positions p (m, world) with unit normals n, sun
+    // Shades count ≤ kChunk samples at positions p (m, world) with normals n (any length), sun
     // visibility ch.sunVis, water column depth (m), sand wetness and foam coverage; radiance
     // (cd/m²) to ch.outR/G/B.
     void Shade(size_t count, const float* px, const float* py, const float* pz, const float* nx,
@@ -167,8 +168,11 @@ struct SeaShading {
         static_assert(kChunk % kLanes == 0);
         for (size_t i = 0; i < count; i += kLanes) {
             const size_t lanes = std::min(kLanes, count - i);
-            const VF Nx = Load(nx + i, lanes, 0.0f), Ny = Load(ny + i, lanes, 0.0f),
-                     Nz = Load(nz + i, lanes, 1.0f);
+            // The normal normalized as glm::normalize does, v · (1 / √(v·v)).
+            VF Nx = Load(nx + i, lanes, 0.0f), Ny = Load(ny + i, lanes, 0.0f),
+               Nz = Load(nz + i, lanes, 1.0f);
+            const VF invN = 1.0f / Sqrt(Dot(Nx, Ny, Nz, Nx, Ny, Nz));
+            Nx = Nx * invN, Ny = Ny * invN, Nz = Nz * invN;
             const VF tx = eye.x - Load(px + i, lanes, 0.0f);
             const VF ty = eye.y - Load(py + i, lanes, 0.0f);
             const VF tz = eye.z - Load(pz + i, lanes, 0.0f);
@@ -186,7 +190,9 @@ struct SeaShading {
             Store(ch.mvx + i, 0.0f - vx);
             Store(ch.mvy + i, 0.0f - vy);
             Store(ch.range + i, range);
-            Store(ch.cosV + i, Max(ndv, Splat(1e-3f)));
+            const VF cosV = Max(ndv, Splat(1e-3f));
+            Store(ch.cosV + i, cosV);
+            Store(ch.F + i, fresnel(cosV));
             const VF cosS = Dot(Nx, Ny, Nz, Splat(keyDir.x), Splat(keyDir.y), Splat(keyDir.z));
             Store(ch.cosS + i, cosS);
             const VF wx = vx + keyDir.x, wy = vy + keyDir.y, wz = vz + keyDir.z;
@@ -196,7 +202,7 @@ struct SeaShading {
             const VF cos2 = cosB * cosB;
             Store(ch.cos2 + i, cos2);
             Store(ch.tan2 + i, (1.0f - cos2) / cos2);
-            Store(ch.vh + i, Dot(vx, vy, vz, hx, hy, hz));
+            Store(ch.Fs + i, fresnel(Dot(vx, vy, vz, hx, hy, hz)));
             // Lambertian irradiance of sand and foam: sky as on a plane tilted to the normal,
             // (1 + n_z)/2 of the level-surface sky irradiance, and the fill lights.
             const VF skyView = 0.5f * (1.0f + Nz);
@@ -215,8 +221,6 @@ struct SeaShading {
         }
         sky.LookUp(count, ch.rx, ch.ry, ch.rz, ch.skyR, ch.skyG, ch.skyB);
         sky.HorizonLookUp(count, ch.mvx, ch.mvy, ch.horR, ch.horG, ch.horB);
-        fresnel(count, ch.cosV, ch.F);
-        fresnel(count, ch.vh, ch.Fs);
 
         const VF glintLimit = Splat(60.0f * slopeVar);
         // Reciprocals of the frame's constants: multiplications in the loop, not divisions.
@@ -320,7 +324,7 @@ struct BlockScratch {
     std::vector<float> skyX, skyY, skyZ;                          // view directions of sky entries
     std::vector<float> seaPx, seaPy, seaPz, seaNx, seaNy, seaNz;  // normals (unit once shaded)
     std::vector<float> seaDepth, seaWet, seaFoam;                 // OceanAttributes interpolated
-    std::vector<float> seaLit;      // lit fraction of a sea entry's samples
+    std::vector<float> seaLit;      // lit fraction of a sea entry's samples (where seaUnlit > 0)
     std::vector<uint8_t> seaUnlit;  // samples of a sea entry found in shadow
     std::vector<glm::vec3> modelPosition, modelNormal;
     std::vector<int> modelMesh;
@@ -489,11 +493,22 @@ class BlockClassifier {
             const int x0 = px * n;
             const uint32_t prim0 = prim[rowIndex_[0] + size_t(x0)];
             bool same = true, allSea = true;
-            for (int j = 0; j < n; ++j) {
-                const uint32_t* row = prim + rowIndex_[j] + size_t(x0);
-                for (int i = 0; i < n; ++i) {
-                    same &= row[i] == prim0;
-                    allSea &= row[i] < g_.firstModelPrimitive;  // kNoPrimitive is not sea
+            if constexpr (kN == 2) {
+                // The four ids as two 64-bit pairs.
+                uint64_t row0, row1;
+                std::memcpy(&row0, prim + rowIndex_[0] + size_t(x0), sizeof row0);
+                std::memcpy(&row1, prim + rowIndex_[1] + size_t(x0), sizeof row1);
+                same = row0 == row1 && uint32_t(row0 >> 32) == prim0;
+                const uint32_t sea = g_.firstModelPrimitive;  // kNoPrimitive is not sea
+                allSea = prim0 < sea && uint32_t(row0 >> 32) < sea && uint32_t(row1) < sea &&
+                         uint32_t(row1 >> 32) < sea;
+            } else {
+                for (int j = 0; j < n; ++j) {
+                    const uint32_t* row = prim + rowIndex_[j] + size_t(x0);
+                    for (int i = 0; i < n; ++i) {
+                        same &= row[i] == prim0;
+                        allSea &= row[i] < g_.firstModelPrimitive;  // kNoPrimitive is not sea
+                    }
                 }
             }
             const uint32_t k = kRow + uint32_t(x0);
@@ -514,10 +529,14 @@ class BlockClassifier {
   private:
     int N() const { return kN > 0 ? kN : g_.n; }
 
-    // The cached triangle prim.
-    const CachedTriangle& Triangle(uint32_t prim) {
+    // The cached triangle prim. The hit, most calls, is inlined; the gathering is not.
+    __attribute__((always_inline)) const CachedTriangle& Triangle(uint32_t prim) {
         CachedTriangle& tri = sc_.triangles[prim % BlockScratch::kTriangleCacheSize];
-        if (tri.prim == prim && tri.frame == g_.frame) return tri;
+        if (tri.prim == prim && tri.frame == g_.frame) [[likely]]
+            return tri;
+        return Gather(prim, tri);
+    }
+    __attribute__((noinline)) const CachedTriangle& Gather(uint32_t prim, CachedTriangle& tri) {
         g_.Fetch(prim, tri);
         tri.frame = g_.frame;
         tri.shadowable = false;
@@ -562,9 +581,10 @@ class BlockClassifier {
         sc_.skyX[e] = d.x, sc_.skyY[e] = d.y, sc_.skyZ[e] = d.z;
     }
 
-    // The pixel with top-left sample x0, all of whose samples see sea triangle prim: shaded at
-    // pixel rate (at the mean barycentrics) unless depth or c = n·v vary too much across it
-    // (then returns false, nothing added). On one triangle c is linear in the barycentrics.
+    // The pixel with top-left sample x0 (entry k), all of whose samples see sea triangle prim:
+    // shaded at pixel rate (at the mean barycentrics) unless c = n·v varies too much across it
+    // (then its samples are added one by one, as Sample adds them) or depth does (then returns
+    // false, nothing added). On one triangle c is linear in the barycentrics.
     bool SeaTrianglePixel(int x0, uint32_t k, uint32_t prim) {
         const int n = N(), count = n * n;
         if (!DepthsClose(x0)) return false;
@@ -596,7 +616,12 @@ class BlockClassifier {
                 cMin = std::min(cMin, c), cMax = std::max(cMax, c);
             }
         }
-        if (!CosSpreadSmall(cMin, cMax, std::sqrt(Dot3(toEye, toEye)))) return false;
+        if (!CosSpreadSmall(cMin, cMax, std::sqrt(Dot3(toEye, toEye)))) {
+            for (int j = 0; j < n; ++j)
+                for (int i = 0; i < n; ++i)
+                    SeaSample(tri, b1[j][i], b2[j][i], k + uint32_t(j * g_.sampleWidth + i));
+            return true;
+        }
         const size_t e =
             AddSea(k | kPixelEntry, p, nSum, InterpolateAttributes(tri, b1Sum * inv, b2Sum * inv));
         if (tri.shadowable) {
@@ -614,7 +639,9 @@ class BlockClassifier {
     bool SeaPixel(int x0, uint32_t k) {
         const int n = N(), count = n * n;
         if (!DepthsClose(x0)) return false;
-        F4 p[kMaxSupersampling * kMaxSupersampling], nrm[kMaxSupersampling * kMaxSupersampling];
+        constexpr int kMaxSamples = kMaxSupersampling * kMaxSupersampling;
+        F4 p[kMaxSamples], nrm[kMaxSamples], a[kMaxSamples];
+        bool sampleShadowable[kMaxSamples];
         F4 pSum = _mm_setzero_ps(), nSum = _mm_setzero_ps(), aSum = _mm_setzero_ps();
         bool shadowable = false;
         for (int j = 0; j < n; ++j) {
@@ -622,9 +649,11 @@ class BlockClassifier {
                 const size_t index = rowIndex_[j] + size_t(x0 + i);
                 const int s = j * n + i;
                 const CachedTriangle& tri = Triangle(g_.vis.primitive[index]);
-                Interpolate(tri, g_.vis.b1[index], g_.vis.b2[index], p[s], nrm[s]);
-                aSum = _mm_add_ps(aSum,
-                                  InterpolateAttributes(tri, g_.vis.b1[index], g_.vis.b2[index]));
+                const float b1 = g_.vis.b1[index], b2 = g_.vis.b2[index];
+                Interpolate(tri, b1, b2, p[s], nrm[s]);
+                a[s] = InterpolateAttributes(tri, b1, b2);
+                aSum = _mm_add_ps(aSum, a[s]);
+                sampleShadowable[s] = tri.shadowable;
                 shadowable |= tri.shadowable;
                 pSum = _mm_add_ps(pSum, p[s]);
                 nSum = _mm_add_ps(nSum, nrm[s]);
@@ -637,16 +666,28 @@ class BlockClassifier {
             const float c = Dot3(nrm[s], toEye);
             cMin = std::min(cMin, c), cMax = std::max(cMax, c);
         }
-        if (!CosSpreadSmall(cMin, cMax, std::sqrt(Dot3(toEye, toEye)))) return false;
+        if (!CosSpreadSmall(cMin, cMax, std::sqrt(Dot3(toEye, toEye)))) {
+            // The samples one by one, from the values just interpolated.
+            for (int j = 0; j < n; ++j) {
+                for (int i = 0; i < n; ++i) {
+                    const int s = j * n + i;
+                    const size_t e =
+                        AddSea(k + uint32_t(j * g_.sampleWidth + i), p[s], nrm[s], a[s]);
+                    if (sampleShadowable[s]) SeaShadowRays(e, &p[s], 1);
+                }
+            }
+            return true;
+        }
         const size_t e =
             AddSea(k | kPixelEntry, mean, nSum, _mm_mul_ps(aSum, Set4(1.0f / float(count))));
         if (shadowable) SeaShadowRays(e, p, count);
         return true;
     }
 
-    // A lit sea entry at position p with normal nSum (unnormalized: ShadeSea normalizes the
-    // block's normals four at a time, off this loop's critical path); returns its index.
-    size_t AddSea(uint32_t k, F4 p, F4 nSum, F4 attributes) {
+    // A lit sea entry at position p with normal nSum (unnormalized: SeaShading::Shade normalizes
+    // it with the block's others, simd::kLanes at a time, off this loop's critical path);
+    // returns its index.
+    __attribute__((always_inline)) size_t AddSea(uint32_t k, F4 p, F4 nSum, F4 attributes) {
         alignas(16) float pf[4], nf[4], af[4];
         _mm_store_ps(pf, p);
         _mm_store_ps(af, attributes);
@@ -656,7 +697,6 @@ class BlockClassifier {
         sc_.seaPx[e] = pf[0], sc_.seaPy[e] = pf[1], sc_.seaPz[e] = pf[2];
         sc_.seaNx[e] = nf[0], sc_.seaNy[e] = nf[1], sc_.seaNz[e] = nf[2];
         sc_.seaDepth[e] = af[0], sc_.seaWet[e] = af[1], sc_.seaFoam[e] = af[2];
-        sc_.seaLit[e] = 1.0f;
         sc_.seaUnlit[e] = 0;
         return e;
     }
@@ -664,7 +704,7 @@ class BlockClassifier {
     // Shadow rays of sea entry e, one per sample at positions samples[0..count), offset along
     // the entry's normal.
     void SeaShadowRays(size_t e, const F4* samples, int count) {
-        // The entry's unit normal as Normalize makes it for shading: glm::normalize's
+        // The entry's unit normal as SeaShading::Shade makes it: glm::normalize's
         // v · (1 / √(v·v)) with v·v summed (x + y) + z, the same operations lane for lane.
         const glm::vec3 v(sc_.seaNx[e], sc_.seaNy[e], sc_.seaNz[e]);
         const glm::vec3 nrm = v * (1.0f / std::sqrt((v.x * v.x + v.y * v.y) + v.z * v.z));
@@ -677,6 +717,14 @@ class BlockClassifier {
         }
     }
 
+    // Sea sample k at barycentrics (1 − b1 − b2, b1, b2) of triangle tri, shaded on its own.
+    void SeaSample(const CachedTriangle& tri, float b1, float b2, uint32_t k) {
+        F4 p, nSum;
+        Interpolate(tri, b1, b2, p, nSum);
+        const size_t e = AddSea(k, p, nSum, InterpolateAttributes(tri, b1, b2));
+        if (tri.shadowable) SeaShadowRays(e, &p, 1);
+    }
+
     // One sample (x, row j of the pixel row) shaded on its own.
     void Sample(int x, int j, uint32_t k) {
         const size_t index = rowIndex_[j] + size_t(x);
@@ -687,14 +735,12 @@ class BlockClassifier {
             return;
         }
         const CachedTriangle& tri = Triangle(prim);
-        F4 p, nSum;
-        Interpolate(tri, g_.vis.b1[index], g_.vis.b2[index], p, nSum);
         if (tri.mesh == 0) {
-            const size_t e =
-                AddSea(k, p, nSum, InterpolateAttributes(tri, g_.vis.b1[index], g_.vis.b2[index]));
-            if (tri.shadowable) SeaShadowRays(e, &p, 1);
+            SeaSample(tri, g_.vis.b1[index], g_.vis.b2[index], k);
             return;
         }
+        F4 p, nSum;
+        Interpolate(tri, g_.vis.b1[index], g_.vis.b2[index], p, nSum);
         const glm::vec3 position = Store3(p);
         glm::vec3 nrm = glm::normalize(Store3(nSum));
         if (glm::dot(nrm, f_.eye - position) < 0.0f) nrm = -nrm;
@@ -742,7 +788,8 @@ uint64_t TraceSunVisibility(const FrameShading& f, int n, BlockScratch& sc) {
     return sc.origins.size();
 }
 
-// Writes radiance rgb to the sample(s) of entry k; out is the block's first sample row.
+// Writes radiance rgb to the sample(s) of entry k; out is the block's first sample row (the
+// default 2×2's pixel entries: SplatChunk).
 void Splat(float* out, uint32_t k, int sampleWidth, int n, float r, float g, float b) {
     if (!(k & kPixelEntry)) {
         float* o = out + 3 * size_t(k);
@@ -750,19 +797,44 @@ void Splat(float* out, uint32_t k, int sampleWidth, int n, float r, float g, flo
         return;
     }
     k &= ~kPixelEntry;
-    if (n == 2) {
-        // The default 2×2: each sample row's six floats (r g b r g b) in two stores.
-        const F4 rgbr = _mm_setr_ps(r, g, b, r), gb = _mm_setr_ps(g, b, 0.0f, 0.0f);
-        for (int j = 0; j < 2; ++j) {
-            float* o = out + 3 * (size_t(k) + size_t(j) * size_t(sampleWidth));
-            _mm_storeu_ps(o, rgbr);
-            _mm_storel_pi(reinterpret_cast<__m64*>(o + 4), gb);
-        }
-        return;
-    }
     for (int j = 0; j < n; ++j) {
         float* o = out + 3 * (size_t(k) + size_t(j) * size_t(sampleWidth));
         for (int i = 0; i < n; ++i) o[3 * i] = r, o[3 * i + 1] = g, o[3 * i + 2] = b;
+    }
+}
+
+// Splat of count entries keys[i] with radiance (r[i], g[i], b[i]): the chunk's arrays (kChunk
+// floats, 16-byte aligned) transposed four entries at a time to (r, g, b, 0) registers, written
+// from them (the same values as Splat writes).
+void SplatChunk(float* out, const uint32_t* keys, size_t count, const float* r, const float* g,
+                const float* b, int sampleWidth, int n) {
+    if (n != 2) {
+        for (size_t i = 0; i < count; ++i) Splat(out, keys[i], sampleWidth, n, r[i], g[i], b[i]);
+        return;
+    }
+    for (size_t i = 0; i < count; i += 4) {
+        F4 rgb[4] = {_mm_load_ps(r + i), _mm_load_ps(g + i), _mm_load_ps(b + i), _mm_setzero_ps()};
+        _MM_TRANSPOSE4_PS(rgb[0], rgb[1], rgb[2], rgb[3]);
+        const size_t lanes = std::min<size_t>(4, count - i);
+        for (size_t l = 0; l < lanes; ++l) {
+            uint32_t k = keys[i + l];
+            const F4 v = rgb[l];
+            if (!(k & kPixelEntry)) {
+                float* o = out + 3 * size_t(k);
+                _mm_storel_pi(reinterpret_cast<__m64*>(o), v);
+                _mm_store_ss(o + 2, _mm_movehl_ps(v, v));
+                continue;
+            }
+            // Each sample row's six floats (r g b r g b) in two stores.
+            k &= ~kPixelEntry;
+            const F4 rgbr = _mm_shuffle_ps(v, v, _MM_SHUFFLE(0, 2, 1, 0));
+            const F4 gb = _mm_shuffle_ps(v, v, _MM_SHUFFLE(3, 3, 2, 1));
+            for (int j = 0; j < 2; ++j) {
+                float* o = out + 3 * (size_t(k) + size_t(j) * size_t(sampleWidth));
+                _mm_storeu_ps(o, rgbr);
+                _mm_storel_pi(reinterpret_cast<__m64*>(o + 4), gb);
+            }
+        }
     }
 }
 
@@ -774,12 +846,27 @@ void ShadeSky(const FrameShading& f, const FrameGeometry& g, BlockScratch& sc, f
         Normalize(count, dx, dy, dz);
         SeaChunk& ch = sc.chunk;
         f.sky.LookUp(count, dx, dy, dz, ch.skyR, ch.skyG, ch.skyB);
-        for (size_t i = 0; i < count; ++i) {
-            glm::vec3 L(ch.skyR[i], ch.skyG[i], ch.skyB[i]);
-            // Pixel entries are never near the sun (BlockClassifier): the test is per sample.
-            if (glm::dot(glm::vec3(dx[i], dy[i], dz[i]), f.sunDir) >= f.cosSunRadius) L += f.sunL;
-            Splat(out, sc.skyK[c + i], g.sampleWidth, g.n, L.r, L.g, L.b);
+        // The sun's disc, simd::kLanes at a time (glm::dot's order; lanes past count are
+        // dropped). Pixel entries are never near the sun (BlockClassifier): the test is per
+        // sample.
+        {
+            using namespace simd;
+            for (size_t i = 0; i < count; i += kLanes) {
+                const size_t lanes = std::min(kLanes, count - i);
+                const VI disc = Dot(Load(dx + i, lanes), Load(dy + i, lanes), Load(dz + i, lanes),
+                                    simd::Splat(f.sunDir.x), simd::Splat(f.sunDir.y),
+                                    simd::Splat(f.sunDir.z)) >= f.cosSunRadius;
+                if (!Any(disc)) continue;
+                const auto add = [&](float* L, float sunL) {
+                    const VF v = Load(L + i);
+                    Store(L + i, Select(disc, v + sunL, v));
+                };
+                add(ch.skyR, f.sunL.r);
+                add(ch.skyG, f.sunL.g);
+                add(ch.skyB, f.sunL.b);
+            }
         }
+        SplatChunk(out, &sc.skyK[c], count, ch.skyR, ch.skyG, ch.skyB, g.sampleWidth, g.n);
     }
 }
 
@@ -788,12 +875,15 @@ void ShadeSea(const FrameShading& f, const FrameGeometry& g, BlockScratch& sc, f
     for (size_t c = 0; c < sc.seaCount; c += kChunk) {
         const size_t count = std::min(kChunk, sc.seaCount - c);
         SeaChunk& ch = sc.chunk;
-        std::copy_n(&sc.seaLit[c], count, ch.sunVis);
-        Normalize(count, &sc.seaNx[c], &sc.seaNy[c], &sc.seaNz[c]);
+        if (sc.origins.empty()) {
+            std::fill_n(ch.sunVis, count, 1.0f);
+        } else {
+            for (size_t i = 0; i < count; ++i)
+                ch.sunVis[i] = sc.seaUnlit[c + i] ? sc.seaLit[c + i] : 1.0f;
+        }
         f.sea.Shade(count, &sc.seaPx[c], &sc.seaPy[c], &sc.seaPz[c], &sc.seaNx[c], &sc.seaNy[c],
                     &sc.seaNz[c], &sc.seaDepth[c], &sc.seaWet[c], &sc.seaFoam[c], ch);
-        for (size_t i = 0; i < count; ++i)
-            Splat(out, sc.seaK[c + i], g.sampleWidth, g.n, ch.outR[i], ch.outG[i], ch.outB[i]);
+        SplatChunk(out, &sc.seaK[c], count, ch.outR, ch.outG, ch.outB, g.sampleWidth, g.n);
     }
 }
 

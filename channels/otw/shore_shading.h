@@ -68,7 +68,10 @@ inline simd::VF ShoreRadiance(const ShoreChannel& c, simd::VF reflected, simd::V
                               simd::VF E, simd::VF Ed) {
     using namespace simd;
     const VF lambert = E * float(1.0 / M_PI);
-    const VF T = ExpNonPositive(-c.K_perm * (depth * pathFactor));
+    // Deep water in every lane (the common case away from the beach): e^x underflows to the
+    // 0 that ExpNonPositive returns below −87.
+    const VF x = -c.K_perm * (depth * pathFactor);
+    const VF T = All(x < -87.0f) ? Splat(0.0f) : ExpNonPositive(x);
     const VF bottom = c.rhoWet * lambert;
     const VF deep = c.rrs * Ed;
     const VF water = reflected + oneMinusF * (deep + (bottom - deep) * T);

@@ -12,6 +12,7 @@
 
 #include "radiometry/color/rec709.h"
 #include "scene/core/simd4.h"
+#include "scene/core/simd_lanes.h"
 #include "scene/sky/illuminance.h"
 
 namespace seasense::radiometry {
@@ -39,28 +40,6 @@ glm::vec2 HemiOctFromDirection(glm::vec3 d) {
     const float s = std::abs(d.x) + std::abs(d.y) + d.z;
     const float u = d.x / s, v = d.y / s;
     return {u + v, u - v};
-}
-
-// Four-lane helpers for the batched lookups. They reproduce the scalar code's std::min,
-// std::max, std::clamp and std::abs exactly (including which operand a tie or −0 returns), so
-// the batched and scalar lookups agree bit for bit.
-I4 MinI4(I4 a, I4 b) {  // SSE2 has no pminsd
-    const I4 bLess = _mm_cmplt_epi32(b, a);
-    return _mm_or_si128(_mm_and_si128(bLess, b), _mm_andnot_si128(bLess, a));
-}
-I4 MaxI4(I4 a, I4 b) {
-    const I4 aLess = _mm_cmplt_epi32(a, b);
-    return _mm_or_si128(_mm_and_si128(aLess, b), _mm_andnot_si128(aLess, a));
-}
-F4 Lerp4(F4 a, F4 b, F4 f) { return _mm_add_ps(a, _mm_mul_ps(_mm_sub_ps(b, a), f)); }
-
-// Loads four rgb(a) texels (one per lane) and transposes them into r, g, b lanes.
-void Gather4(const glm::vec4* t0, const glm::vec4* t1, const glm::vec4* t2, const glm::vec4* t3,
-             F4& r, F4& g, F4& b) {
-    F4 a0 = _mm_loadu_ps(&t0->x), a1 = _mm_loadu_ps(&t1->x), a2 = _mm_loadu_ps(&t2->x),
-       a3 = _mm_loadu_ps(&t3->x);
-    _MM_TRANSPOSE4_PS(a0, a1, a2, a3);
-    r = a0, g = a1, b = a2;
 }
 
 glm::dvec3 DirectionFromHemiOct(double a, double b) {
@@ -374,40 +353,38 @@ glm::vec3 AnalyticSky::LookUp(const glm::vec3& d) const {
 
 void AnalyticSky::LookUp(size_t n, const float* x, const float* y, const float* z, float* r,
                          float* g, float* b) const {
-    const F4 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
-    const F4 scale = _mm_set1_ps(0.5f * float(kTableSize - 1));
-    const F4 hi = _mm_set1_ps(float(kTableSize - 1));
-    const I4 hiIndex = _mm_set1_epi32(kTableSize - 2);
-    for (size_t k = 0; k < n; k += 4) {
-        const size_t count = std::min<size_t>(4, n - k);
+    using namespace simd;
+    const VF zero = Splat(0.0f), hi = Splat(float(kTableSize - 1));
+    const float scale = 0.5f * float(kTableSize - 1);
+    const VI hiIndex = VI{} + (kTableSize - 2);
+    static_assert(kTableSize == 128);
+    const float* t = &table_.data()->x;
+    for (size_t k = 0; k < n; k += kLanes) {
+        const size_t count = std::min(kLanes, n - k);
         // HemiOctFromDirection and the clamped texel coordinates, as in the scalar LookUp.
-        const F4 dx = LoadLanes(x + k, count, 0.0f), dy = LoadLanes(y + k, count, 0.0f);
-        const F4 dz = Max4(LoadLanes(z + k, count, 1.0f), zero);
-        const F4 s = _mm_add_ps(_mm_add_ps(Abs4(dx), Abs4(dy)), dz);
-        const F4 u = _mm_div_ps(dx, s), v = _mm_div_ps(dy, s);
-        const F4 tu = Clamp4(_mm_mul_ps(_mm_add_ps(_mm_add_ps(u, v), one), scale), zero, hi);
-        const F4 tv = Clamp4(_mm_mul_ps(_mm_add_ps(_mm_sub_ps(u, v), one), scale), zero, hi);
+        const VF dx = Load(x + k, count, 0.0f), dy = Load(y + k, count, 0.0f);
+        const VF dz = Max(Load(z + k, count, 1.0f), zero);
+        const VF s = (Abs(dx) + Abs(dy)) + dz;
+        const VF u = dx / s, v = dy / s;
+        const VF tu = Min(Max(((u + v) + 1.0f) * scale, zero), hi);
+        const VF tv = Min(Max(((u - v) + 1.0f) * scale, zero), hi);
         // tu, tv ≥ 0: truncation is the scalar int() conversion.
-        const I4 i0 = MinI4(_mm_cvttps_epi32(tu), hiIndex);
-        const I4 j0 = MinI4(_mm_cvttps_epi32(tv), hiIndex);
-        const F4 fu = _mm_sub_ps(tu, _mm_cvtepi32_ps(i0));
-        const F4 fv = _mm_sub_ps(tv, _mm_cvtepi32_ps(j0));
-        alignas(16) int32_t offset[4];
-        _mm_store_si128(reinterpret_cast<I4*>(offset),
-                        _mm_add_epi32(i0, _mm_slli_epi32(j0, 7)));  // j0·kTableSize + i0
-        static_assert(kTableSize == 128);
-        const glm::vec4* t = table_.data();
-        const glm::vec4 *p0 = t + offset[0], *p1 = t + offset[1], *p2 = t + offset[2],
-                        *p3 = t + offset[3];
-        F4 r00, g00, b00, r01, g01, b01, r10, g10, b10, r11, g11, b11;
-        Gather4(p0, p1, p2, p3, r00, g00, b00);
-        Gather4(p0 + 1, p1 + 1, p2 + 1, p3 + 1, r01, g01, b01);
-        Gather4(p0 + kTableSize, p1 + kTableSize, p2 + kTableSize, p3 + kTableSize, r10, g10, b10);
-        Gather4(p0 + kTableSize + 1, p1 + kTableSize + 1, p2 + kTableSize + 1, p3 + kTableSize + 1,
-                r11, g11, b11);
-        StoreLanes(r + k, count, Lerp4(Lerp4(r00, r01, fu), Lerp4(r10, r11, fu), fv));
-        StoreLanes(g + k, count, Lerp4(Lerp4(g00, g01, fu), Lerp4(g10, g11, fu), fv));
-        StoreLanes(b + k, count, Lerp4(Lerp4(b00, b01, fu), Lerp4(b10, b11, fu), fv));
+        VI i0 = __builtin_convertvector(tu, VI), j0 = __builtin_convertvector(tv, VI);
+        i0 = i0 < hiIndex ? i0 : hiIndex;
+        j0 = j0 < hiIndex ? j0 : hiIndex;
+        const VF fu = tu - __builtin_convertvector(i0, VF);
+        const VF fv = tv - __builtin_convertvector(j0, VF);
+        // Float index of texel (i0, j0)'s red: 4 floats a texel, kTableSize texels a row.
+        const VI t00 = (i0 + (j0 << 7)) << 2;
+        const VI t10 = t00 + 4 * kTableSize;
+        const auto channel = [&](int c, float* out) {
+            const VF a = Lerp(Gather(t + c, t00), Gather(t + 4 + c, t00), fu);
+            const VF b = Lerp(Gather(t + c, t10), Gather(t + 4 + c, t10), fu);
+            Store(out + k, Lerp(a, b, fv), count);
+        };
+        channel(0, r);
+        channel(1, g);
+        channel(2, b);
     }
 }
 
@@ -421,31 +398,28 @@ glm::vec3 AnalyticSky::HorizonLookUp(const glm::vec3& d) const {
 
 void AnalyticSky::HorizonLookUp(size_t n, const float* x, const float* y, float* r, float* g,
                                 float* b) const {
-    const F4 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), three = _mm_set1_ps(3.0f);
-    const F4 scale = _mm_set1_ps(float(kHorizonSize) / 4.0f);
-    const I4 zeroIndex = _mm_setzero_si128(), hiIndex = _mm_set1_epi32(kHorizonSize - 1);
-    for (size_t k = 0; k < n; k += 4) {
-        const size_t count = std::min<size_t>(4, n - k);
-        const F4 dx = LoadLanes(x + k, count, 1.0f), dy = LoadLanes(y + k, count, 0.0f);
+    using namespace simd;
+    const VF zero = Splat(0.0f), one = Splat(1.0f);
+    const float scale = float(kHorizonSize) / 4.0f;
+    const VI hiIndex = VI{} + (kHorizonSize - 1);
+    const float* h = &horizon_.data()->x;
+    for (size_t k = 0; k < n; k += kLanes) {
+        const size_t count = std::min(kLanes, n - k);
+        const VF dx = Load(x + k, count, 1.0f), dy = Load(y + k, count, 0.0f);
         // HorizonParameter: lanes with s ≤ 0 divide by zero and are then replaced by 0.
-        const F4 s = _mm_add_ps(Abs4(dx), Abs4(dy));
-        const F4 u = _mm_div_ps(dx, s);
-        const F4 up = _mm_cmpge_ps(dy, zero);
-        F4 t =
-            _mm_or_ps(_mm_and_ps(up, _mm_add_ps(one, u)), _mm_andnot_ps(up, _mm_sub_ps(three, u)));
-        t = _mm_and_ps(_mm_cmpgt_ps(s, zero), t);
-        const F4 tu = _mm_mul_ps(t, scale);
-        const I4 i = MaxI4(MinI4(_mm_cvttps_epi32(tu), hiIndex), zeroIndex);
-        const F4 f = Clamp4(_mm_sub_ps(tu, _mm_cvtepi32_ps(i)), zero, one);
-        alignas(16) int32_t index[4];
-        _mm_store_si128(reinterpret_cast<I4*>(index), i);
-        const glm::vec4* h = horizon_.data();
-        F4 r0, g0, b0, r1, g1, b1;
-        Gather4(h + index[0], h + index[1], h + index[2], h + index[3], r0, g0, b0);
-        Gather4(h + index[0] + 1, h + index[1] + 1, h + index[2] + 1, h + index[3] + 1, r1, g1, b1);
-        StoreLanes(r + k, count, Lerp4(r0, r1, f));
-        StoreLanes(g + k, count, Lerp4(g0, g1, f));
-        StoreLanes(b + k, count, Lerp4(b0, b1, f));
+        const VF s = Abs(dx) + Abs(dy);
+        const VF u = dx / s;
+        VF t = Select(dy >= 0.0f, 1.0f + u, 3.0f - u);
+        t = Select(s > 0.0f, t, zero);
+        const VF tu = t * scale;
+        VI i = __builtin_convertvector(tu, VI);
+        i = i < hiIndex ? i : hiIndex;
+        i = i > 0 ? i : VI{};
+        const VF f = Min(Max(tu - __builtin_convertvector(i, VF), zero), one);
+        const VI t0 = i << 2;  // float index of texel i's red
+        Store(r + k, Lerp(Gather(h, t0), Gather(h + 4, t0), f), count);
+        Store(g + k, Lerp(Gather(h + 1, t0), Gather(h + 5, t0), f), count);
+        Store(b + k, Lerp(Gather(h + 2, t0), Gather(h + 6, t0), f), count);
     }
 }
 

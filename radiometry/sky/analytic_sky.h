@@ -79,9 +79,10 @@ class AnalyticSky {
     glm::vec3 HorizonLookUp(const glm::vec3& d) const;
 
     // Batched LookUp / HorizonLookUp over n directions in structure-of-arrays form (x[i],
-    // y[i], z[i]), writing rgb to r[i], g[i], b[i]. Four lanes at a time with SSE2; every
-    // lane does exactly the scalar arithmetic, so results equal the one-at-a-time calls bit
-    // for bit whatever the batch size or a sample's position in it.
+    // y[i], z[i]), writing rgb to r[i], g[i], b[i]. simd::kLanes at a time (eight in the AVX2
+    // build, texels by gather instructions); every lane does exactly the scalar arithmetic, so
+    // results equal the one-at-a-time calls bit for bit whatever the batch size or a sample's
+    // position in it.
     void LookUp(size_t n, const float* x, const float* y, const float* z, float* r, float* g,
                 float* b) const;
     void HorizonLookUp(size_t n, const float* x, const float* y, float* r, float* g,
@@ -125,8 +126,8 @@ class AnalyticSky {
     double coefY_[5], coefX_[5], coefYc_[5];
     double normY_, normX_, normYc_;
     glm::dvec3 skyHorizontal_{0.0};
-    // kTableSize², hemi-octahedral map of the upper hemisphere; rgb padded to 16 bytes so a
-    // batched lookup loads one texel per instruction and transposes four of them.
+    // kTableSize², hemi-octahedral map of the upper hemisphere; rgb padded to 16 bytes (a
+    // texel's float index is 4 × its index).
     std::vector<glm::vec4> table_;
     std::vector<glm::vec4> horizon_;  // kHorizonSize + 1 entries around the horizon
 };

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstddef>
 
+#include "scene/core/simd_lanes.h"
+
 namespace seasense::radiometry {
 
 // Reflectance for light arriving from a medium of index 1 onto a medium of real index n at
@@ -34,6 +36,18 @@ class FresnelTable {
     // F[k] = (*this)(cosI[k]) for k < n: a tight loop the caller's batches can inline.
     void operator()(size_t n, const float* cosI, float* F) const {
         for (size_t k = 0; k < n; ++k) F[k] = (*this)(cosI[k]);
+    }
+    // The scalar lookup's operations lane for lane (std::clamp's NaN passes through; its
+    // index, undefined for the scalar form, is kept in the table here).
+    simd::VF operator()(simd::VF cosI) const {
+        using namespace simd;
+        const VF c = Select(cosI < 0.0f, Splat(0.0f), Select(1.0f < cosI, Splat(1.0f), cosI));
+        const VF u = c * float(kSize);
+        VI i = __builtin_convertvector(u, VI);
+        i = i < kSize - 1 ? i : VI{} + (kSize - 1);
+        i = i > 0 ? i : VI{};
+        const VF t0 = Gather(table_, i), t1 = Gather(table_ + 1, i);
+        return t0 + (t1 - t0) * (u - __builtin_convertvector(i, VF));
     }
 
   private:

@@ -42,11 +42,25 @@ inline void Store(float* p, VF v, size_t count = kLanes) {
     for (size_t i = 0; i < count; ++i) p[i] = v[i];
 }
 
+// base[index[l]] in lane l.
+inline VF Gather(const float* base, VI index) {
+#if defined(__AVX2__)
+    return _mm256_i32gather_ps(base, reinterpret_cast<__m256i>(index), 4);
+#else
+    VF v;
+    for (size_t l = 0; l < kLanes; ++l) v[l] = base[index[l]];
+    return v;
+#endif
+}
+
 // a where mask (a comparison's result) is set, else b.
 inline VF Select(VI mask, VF a, VF b) { return mask ? a : b; }
 // _mm_max_ps(b, a) / _mm_min_ps(b, a) lane for lane: a when either is NaN or both are zeros.
 inline VF Max(VF a, VF b) { return b > a ? b : a; }
 inline VF Min(VF a, VF b) { return b < a ? b : a; }
+inline VF Abs(VF v) { return (VF)((VI)v & 0x7fffffff); }
+// a + (b − a)·f.
+inline VF Lerp(VF a, VF b, VF f) { return a + (b - a) * f; }
 // (x + y) + z, the order of glm::dot.
 inline VF Dot(VF ax, VF ay, VF az, VF bx, VF by, VF bz) { return (ax * bx + ay * by) + az * bz; }
 
@@ -64,6 +78,15 @@ inline bool Any(VI mask) {
     return _mm256_movemask_ps(reinterpret_cast<__m256>(mask)) != 0;
 #else
     return _mm_movemask_ps(reinterpret_cast<__m128>(mask)) != 0;
+#endif
+}
+
+// Whether every lane of a comparison's result is set.
+inline bool All(VI mask) {
+#if defined(__AVX__)
+    return _mm256_movemask_ps(reinterpret_cast<__m256>(mask)) == 0xff;
+#else
+    return _mm_movemask_ps(reinterpret_cast<__m128>(mask)) == 0xf;
 #endif
 }
 

@@ -84,5 +84,34 @@ TEST(ShoreShading, FoamIsLambertianLayer) {
     EXPECT_NEAR(half, 0.5f * (water + 0.55f * E / float(M_PI)), 1e-4f * E);
 }
 
+// Where the bottom's attenuation e^{−K d (1 + 1/cos θ_t)} underflows in every lane (deep water,
+// the common case) ShoreRadiance skips the exponential: each lane's radiance is the same bits as
+// among lanes that need it (the first lane shallow here), whatever its neighbours.
+TEST(ShoreShading, DeepWaterLanesEqualTheirValuesAmongShallowLanes) {
+    ShoreChannel c = kChannel;
+    c.rrs = 0.002f;
+    VF cosV, depth, wet, foam, reflected, E, Ed;
+    for (size_t l = 0; l < kLanes; ++l) {
+        const float f = float(l);
+        cosV[l] = 0.1f + 0.1f * f;
+        // K d (1 + 1/cos θ_t) ≥ 0.2 · 250 · 2 = 100 > 87: e^x is 0 in float.
+        depth[l] = l % 2 ? kDeepColumn_m : 250.0f + 3.0f * f;
+        wet[l] = 0.1f * f;
+        foam[l] = l == 3 ? 0.25f : 0.0f;
+        reflected[l] = 3.0f * f;
+        E[l] = 1000.0f * (f + 1.0f);
+        Ed[l] = 900.0f * (f + 1.0f);
+    }
+    const VF path = WaterPathFactor(cosV, 1.34f);
+    const VF deep = ShoreRadiance(c, reflected, Splat(0.97f), path, depth, wet, foam, E, Ed);
+    VF shallow = depth;
+    shallow[0] = 0.5f;
+    const VF mixed = ShoreRadiance(c, reflected, Splat(0.97f), path, shallow, wet, foam, E, Ed);
+    for (size_t l = 1; l < kLanes; ++l) EXPECT_EQ(deep[l], mixed[l]) << "lane " << l;
+    EXPECT_NE(deep[0], mixed[0]);
+    // No light returns from the bottom: the reflection plus the deep-water colour.
+    EXPECT_NEAR(deep[1], 3.0f + 0.97f * c.rrs * 1800.0f, 1e-4f);
+}
+
 }  // namespace
 }  // namespace seasense::channels

@@ -219,14 +219,22 @@ TEST(AnalyticSky, SameSkyForAnyThreadCount) {
 
 TEST(AnalyticSky, BatchedLookupsEqualSingleLookupsBitForBit) {
     const AnalyticSky sky(SunAt(40.0), 8e4, 4.0);
-    const size_t n = 103;  // not a multiple of the batch width
-    std::vector<float> x(n), y(n), z(n), r(n), g(n), b(n), hr(n), hg(n), hb(n);
-    for (size_t i = 0; i < n; ++i) {
-        const double az = 0.37 * double(i), el = -0.2 + 1.7 * double(i) / n;
-        x[i] = float(std::cos(el) * std::sin(az));
-        y[i] = float(std::cos(el) * std::cos(az));
-        z[i] = float(std::sin(el));
+    // Edges of the table and of the horizon's diamond: the zenith, the axes and diagonals on
+    // the horizon, below it, ±0 components; then a spiral over the sphere (103 + 12: not a
+    // multiple of the batch width).
+    const float h = float(M_SQRT1_2);
+    std::vector<float> x = {0.0f, -0.0f, 1.0f, -1.0f, 0.0f, -0.0f, h, -h, h, -h, 1.0f, 0.0f};
+    std::vector<float> y = {0.0f, 0.0f, 0.0f, 0.0f, 1.0f, -1.0f, h, h, -h, -h, -0.0f, 1.0f};
+    std::vector<float> z = {1.0f, 1.0f, 0.0f, 0.0f, 0.0f,  -0.0f,
+                            0.0f, 0.0f, 0.0f, 0.0f, -0.5f, -0.0f};
+    for (size_t i = 0; i < 103; ++i) {
+        const double az = 0.37 * double(i), el = -0.2 + 1.7 * double(i) / 103;
+        x.push_back(float(std::cos(el) * std::sin(az)));
+        y.push_back(float(std::cos(el) * std::cos(az)));
+        z.push_back(float(std::sin(el)));
     }
+    const size_t n = x.size();
+    std::vector<float> r(n), g(n), b(n), hr(n), hg(n), hb(n);
     sky.LookUp(n, x.data(), y.data(), z.data(), r.data(), g.data(), b.data());
     sky.HorizonLookUp(n, x.data(), y.data(), hr.data(), hg.data(), hb.data());
     for (size_t i = 0; i < n; ++i) {
@@ -258,6 +266,21 @@ TEST(Fresnel, TableFollowsTheExactFormula) {
     for (int i = 0; i <= 5000; ++i) {
         const double c = i / 5000.0;
         EXPECT_NEAR(table(float(c)), FresnelDielectric(c, kSeaWaterIndexVisible), 2e-4) << c;
+    }
+}
+
+TEST(Fresnel, LanesEqualTheScalarTableBitForBit) {
+    // Every cosine of [−0.1, 1.1] in steps of 1/4096 (table nodes, between them, and beyond
+    // both ends, where the scalar form clamps), ±0 and the ends exactly.
+    const FresnelTable table(kSeaWaterIndexVisible);
+    std::vector<float> c = {0.0f, -0.0f, 1.0f, 1.0f - 1e-7f, 1e-30f, -1e30f, 1e30f};
+    for (int i = -410; i <= 4506; ++i) c.push_back(float(i) / 4096.0f);
+    for (size_t i = 0; i < c.size(); i += simd::kLanes) {
+        simd::VF v = simd::Splat(0.5f);
+        for (size_t l = 0; l < simd::kLanes && i + l < c.size(); ++l) v[l] = c[i + l];
+        const simd::VF F = table(v);
+        for (size_t l = 0; l < simd::kLanes && i + l < c.size(); ++l)
+            EXPECT_EQ(F[l], table(c[i + l])) << c[i + l];
     }
 }
 
