@@ -370,11 +370,11 @@ struct FlirChannel::ShadeBlock {
     // Sky: sample index within the block, view direction's z and squared length.
     alignas(16) uint32_t skyK[kChunk];
     alignas(16) float skyZ[kChunk], skyLength[kChunk];
-    // Sea: sample index, and per sample the (x, y, z, 0) records of position and
-    // (unnormalized) normal and the sea-mesh attributes (depth, wet, foam, 0) as
-    // TriangleCache writes them, turned to lanes by a 4×4 transpose when shaded.
-    alignas(16) uint32_t seaK[kChunk];
-    alignas(16) float seaP[4 * kChunk], seaN[4 * kChunk], seaA[4 * kChunk];
+    // Sea: sample index, and per sample the records of position and (unnormalized) normal
+    // (x, y, z, 0, nx, ny, nz, 0) and of the sea-mesh attributes (depth, wet, foam, ·) as
+    // SeaGather writes them, turned to lanes by 4×4 transposes when shaded.
+    alignas(32) uint32_t seaK[kChunk];
+    alignas(32) float seaPN[8 * kChunk], seaA[4 * kChunk];
     std::vector<uint32_t> modelK;
     std::vector<glm::vec3> modelP, modelN;
     std::vector<int> modelMesh;
@@ -429,18 +429,21 @@ void FlirChannel::ShadeSea(const FrameShading& f, ShadeBlock& sc, size_t count, 
     // sky); sand where the sea lies on the beach and foam over both (SurfInfraredRadiance4);
     // through the path. The records past count (the last lane group's unused lanes) repeat the
     // last sample, so that those lanes compute finite values that are never stored.
-    for (size_t i = count; i % 4 != 0; ++i)
-        for (float* r : {sc.seaP, sc.seaN, sc.seaA}) std::copy_n(r + 4 * (count - 1), 4, r + 4 * i);
-    const auto Lanes = [](const float* records, F4& x, F4& y, F4& z, F4& w) {
-        x = _mm_load_ps(records), y = _mm_load_ps(records + 4), z = _mm_load_ps(records + 8),
-        w = _mm_load_ps(records + 12);
+    for (size_t i = count; i % 4 != 0; ++i) {
+        std::copy_n(sc.seaPN + 8 * (count - 1), 8, sc.seaPN + 8 * i);
+        std::copy_n(sc.seaA + 4 * (count - 1), 4, sc.seaA + 4 * i);
+    }
+    // Four records of stride floats from records as lanes.
+    const auto Lanes = [](const float* records, size_t stride, F4& x, F4& y, F4& z, F4& w) {
+        x = _mm_load_ps(records), y = _mm_load_ps(records + stride),
+        z = _mm_load_ps(records + 2 * stride), w = _mm_load_ps(records + 3 * stride);
         _MM_TRANSPOSE4_PS(x, y, z, w);
     };
     const F4 eyeX = Set4(f.eye.x), eyeY = Set4(f.eye.y), eyeZ = Set4(f.eye.z);
     for (size_t i = 0; i < count; i += 4) {
         F4 nx, ny, nz, px, py, pz, unused;
-        Lanes(sc.seaN + 4 * i, nx, ny, nz, unused);
-        Lanes(sc.seaP + 4 * i, px, py, pz, unused);
+        Lanes(sc.seaPN + 8 * i + 4, 8, nx, ny, nz, unused);
+        Lanes(sc.seaPN + 8 * i, 8, px, py, pz, unused);
         const F4 invN = _mm_div_ps(Set4(1.0f), _mm_sqrt_ps(Dot4(nx, ny, nz, nx, ny, nz)));
         nx = _mm_mul_ps(nx, invN), ny = _mm_mul_ps(ny, invN), nz = _mm_mul_ps(nz, invN);
         const F4 tx = _mm_sub_ps(eyeX, px), ty = _mm_sub_ps(eyeY, py), tz = _mm_sub_ps(eyeZ, pz);
@@ -461,7 +464,7 @@ void FlirChannel::ShadeSea(const FrameShading& f, ShadeBlock& sc, size_t count, 
     const F4 one = Set4(1.0f);
     for (size_t i = 0; i < count; i += 4) {
         F4 depth, wet, foam, unused;
-        Lanes(sc.seaA + 4 * i, depth, wet, foam, unused);
+        Lanes(sc.seaA + 4 * i, 4, depth, wet, foam, unused);
         const F4 L = SurfInfraredRadiance4(f.surf, _mm_load_ps(sc.d + i), seaB,
                                            _mm_load_ps(sc.e + i), depth, wet, foam);
         const F4 tau = _mm_load_ps(sc.a + i);
@@ -483,6 +486,9 @@ uint64_t FlirChannel::ShadeRows(const FrameShading& f, int y0, int y1, float* ou
     // time), model positions and normals.
     size_t skyCount = 0, seaCount = 0;
     TriangleCache tri;
+    // Mesh 0's primitives (all of them when there are no models).
+    const std::vector<uint32_t>& bases = f.vis.primitiveBase;
+    SeaGather sea(f.meshes[0], bases[0], (bases.size() > 1 ? bases[1] : kNoPrimitive) - bases[0]);
     for (int y = y0; y < y1; ++y) {
         const double ndcY = 1.0 - 2.0 * (y + 0.5) / f.sampleHeight;
         const glm::vec3 rowBase(f.forward + f.up * ndcY - f.right);
@@ -491,15 +497,21 @@ uint64_t FlirChannel::ShadeRows(const FrameShading& f, int y0, int y1, float* ou
         const float* b1 = f.vis.b1.data() + row;
         const float* b2 = f.vis.b2.data() + row;
         const uint32_t kRow = uint32_t(size_t(y - y0) * size_t(sw));
-        for (int x = 0; x < sw; ++x) {
+        for (int x = 0; x < sw;) {
             const uint32_t k = kRow + uint32_t(x), prim = prims[x];
+            if (sea.IsSea(prim)) {
+                x = sea.Gather<kChunk>(prims, b1, b2, x, sw, kRow, sc.seaK, sc.seaPN, sc.seaA,
+                                       seaCount);
+                if (seaCount == kChunk) ShadeSea(f, sc, seaCount, out), seaCount = 0;
+                continue;
+            }
             if (prim == kNoPrimitive) {
                 // A run of sky (most rows above the horizon): shaded straight into out.
                 int end = x + 1;
                 while (end < sw && prims[end] == kNoPrimitive) ++end;
                 if (end - x >= kMinSkyRun) {
                     ShadeSkyRun(f, rowBase, x, end, sc, out + kRow);
-                    x = end - 1;
+                    x = end;
                     continue;
                 }
                 const glm::vec3 d = rowBase + (float(x) + 0.5f) * f.colStep;
@@ -507,20 +519,13 @@ uint64_t FlirChannel::ShadeRows(const FrameShading& f, int y0, int y1, float* ou
                 sc.skyZ[skyCount] = d.z;
                 sc.skyLength[skyCount] = glm::dot(d, d);
                 if (++skyCount == kChunk) ShadeSky(sc, skyCount, out), skyCount = 0;
+                ++x;
                 continue;
             }
-            // The surface point goes straight into the next sea record; a model sample copies
-            // it out (the record is then reused).
-            float* p = sc.seaP + 4 * seaCount;
-            float* n = sc.seaN + 4 * seaCount;
+            alignas(16) float p[4], n[4];
             int mesh = 0;
             tri.Surface(f.vis.primitiveBase, f.meshes, prim, b1[x], b2[x], p, n, mesh);
-            if (mesh == 0) {
-                sc.seaK[seaCount] = k;
-                tri.Attributes(b1[x], b2[x], sc.seaA + 4 * seaCount);
-                if (++seaCount == kChunk) ShadeSea(f, sc, seaCount, out), seaCount = 0;
-                continue;
-            }
+            ++x;
             const glm::vec3 position(p[0], p[1], p[2]);
             glm::vec3 normal = glm::normalize(glm::vec3(n[0], n[1], n[2]));
             if (glm::dot(normal, f.eye - position) < 0.0f) normal = -normal;
