@@ -16,6 +16,7 @@
 #include "scene/core/check.h"
 #include "scene/core/error.h"
 #include "scene/core/simd4.h"
+#include "scene/core/simd_lanes.h"
 #include "scene/sky/ephemeris.h"
 #include "scene/sky/illuminance.h"
 
@@ -176,6 +177,25 @@ UniformTable::UniformTable(std::vector<float> nodes, float xMax)
 }
 
 void UniformTable::operator()(size_t count, const float* x, float* out) const {
+#if defined(__AVX2__)
+    // Eight lanes: the four-lane arithmetic below lane for lane, the two nodes of each lane's cell
+    // by two gathers.
+    const __m256 scale = _mm256_set1_ps(scale_), last = _mm256_set1_ps(last_),
+                 lastCell = _mm256_set1_ps(float(nodes_.size() - 2));
+    for (size_t i = 0; i < count; i += simd::kLanes) {
+        const size_t lanes = std::min(simd::kLanes, count - i);
+        const __m256 u = _mm256_min_ps(
+            _mm256_max_ps(_mm256_setzero_ps(),
+                          _mm256_mul_ps(__m256(simd::Load(x + i, lanes, 0.0f)), scale)),
+            last);
+        const __m256i cell = _mm256_cvttps_epi32(_mm256_min_ps(u, lastCell));
+        const __m256 a = _mm256_i32gather_ps(nodes_.data(), cell, 4);
+        const __m256 b = _mm256_i32gather_ps(nodes_.data() + 1, cell, 4);
+        const __m256 f = _mm256_sub_ps(u, _mm256_cvtepi32_ps(cell));
+        simd::Store(out + i, simd::VF(_mm256_add_ps(a, _mm256_mul_ps(_mm256_sub_ps(b, a), f))),
+                    lanes);
+    }
+#else
     const F4 scale = Set4(scale_), last = Set4(last_), lastCell = Set4(float(nodes_.size() - 2));
     for (size_t i = 0; i < count; i += 4) {
         const size_t lanes = std::min<size_t>(4, count - i);
@@ -196,6 +216,7 @@ void UniformTable::operator()(size_t count, const float* x, float* out) const {
         const F4 f = _mm_sub_ps(u, _mm_cvtepi32_ps(cell));
         StoreLanes(out + i, lanes, _mm_add_ps(a, _mm_mul_ps(_mm_sub_ps(b, a), f)));
     }
+#endif
 }
 
 FlirChannel::FlirChannel(const scene::World& world, const scene::ChannelSettings& settings)
