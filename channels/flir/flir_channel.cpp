@@ -391,11 +391,14 @@ struct FlirChannel::ShadeBlock {
     // Sky: sample index within the block, view direction's z and squared length.
     alignas(16) uint32_t skyK[kChunk];
     alignas(16) float skyZ[kChunk], skyLength[kChunk];
-    // Sea: sample index, and per sample the records of position and (unnormalized) normal
+    // Sea: per sample the records of position and (unnormalized) normal
     // (x, y, z, 0, nx, ny, nz, 0) and of the sea-mesh attributes (depth, wet, foam, ·) as
-    // SeaGather writes them, turned to lanes by 4×4 transposes when shaded.
-    alignas(32) uint32_t seaK[kChunk];
+    // SeaGather writes them, turned to lanes by 4×4 transposes when shaded; and the runs of
+    // consecutive samples they came from (first sample index and length; a row's sea samples
+    // come in long runs, so they are written back a run at a time).
     alignas(32) float seaPN[8 * kChunk], seaA[4 * kChunk];
+    uint32_t seaRunK[kChunk], seaRunLength[kChunk];
+    size_t seaRuns = 0;
     std::vector<uint32_t> modelK;
     std::vector<glm::vec3> modelP, modelN;
     std::vector<int> modelMesh;
@@ -523,7 +526,10 @@ void FlirChannel::ShadeSea(const FrameShading& f, ShadeBlock& sc, size_t count, 
         const VF tau = simd::Load(sc.a + i);
         simd::Store(sc.b + i, tau * L + (1.0f - tau) * f.airB);
     }
-    for (size_t i = 0; i < count; ++i) out[sc.seaK[i]] = sc.b[i];
+    const float* L = sc.b;
+    for (size_t r = 0; r < sc.seaRuns; L += sc.seaRunLength[r], ++r)
+        std::copy_n(L, sc.seaRunLength[r], out + sc.seaRunK[r]);
+    sc.seaRuns = 0;
 }
 
 uint64_t FlirChannel::ShadeRows(const FrameShading& f, int y0, int y1, float* out) {
@@ -552,8 +558,10 @@ uint64_t FlirChannel::ShadeRows(const FrameShading& f, int y0, int y1, float* ou
         for (int x = 0; x < sw;) {
             const uint32_t k = kRow + uint32_t(x), prim = prims[x];
             if (sea.IsSea(prim)) {
-                x = sea.Gather<kChunk>(prims, b1, b2, x, sw, kRow, sc.seaK, sc.seaPN, sc.seaA,
-                                       seaCount);
+                const int x0 = x;
+                x = sea.Gather<kChunk>(prims, b1, b2, x, sw, sc.seaPN, sc.seaA, seaCount);
+                sc.seaRunK[sc.seaRuns] = k;
+                sc.seaRunLength[sc.seaRuns++] = uint32_t(x - x0);
                 if (seaCount == kChunk) ShadeSea(f, sc, seaCount, out), seaCount = 0;
                 continue;
             }

@@ -75,7 +75,7 @@ class TriangleCache {
     simd4::F4 p_[3] = {}, n_[3] = {};
 };
 
-// Sea-mesh samples of visibility-buffer rows gathered into records: per sample its index, the
+// Sea-mesh samples of visibility-buffer rows gathered into records: per sample the
 // position and (unnormalized) normal as one record (x, y, z, 0, nx, ny, nz, 0) and the vertex
 // attributes (depth, wet, foam, ·), all interpolated with TriangleCache's sums, so the same
 // bits. Most samples of a row are sea, so this is the shading pass's inner loop: the sea mesh
@@ -89,11 +89,11 @@ class SeaGather {
     bool IsSea(uint32_t prim) const { return prim - base_ < count_; }
 
     // Gathers samples x, x + 1, … of a row (primitives prims, barycentrics b1 and b2) while
-    // they are sea, up to the row's end sw or until records holds kCapacity samples; k0 + x
-    // is sample x's index. Returns the first sample not gathered.
+    // they are sea, up to the row's end sw or until records holds kCapacity samples. Returns the
+    // first sample not gathered.
     template <size_t kCapacity>
-    int Gather(const uint32_t* prims, const float* b1, const float* b2, int x, int sw, uint32_t k0,
-               uint32_t* index, float* pn, float* attributes, size_t& records) {
+    int Gather(const uint32_t* prims, const float* b1, const float* b2, int x, int sw, float* pn,
+               float* attributes, size_t& records) {
         using namespace simd4;
         size_t r = records;
         for (; x < sw; ++x) {
@@ -101,19 +101,21 @@ class SeaGather {
             if (!IsSea(prim)) break;
             if (prim != prim_) Fetch(prim);
             const float u = b1[x], v = b2[x];
-            const F4 w0 = Set4(1.0f - u - v), w1 = Set4(u), w2 = Set4(v);
 #if defined(__AVX__)
-            const __m256 W0 = _mm256_set_m128(w0, w0), W1 = _mm256_set_m128(w1, w1),
-                         W2 = _mm256_set_m128(w2, w2);
-            _mm256_storeu_ps(pn + 8 * r, _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(W0, pn_[0]),
-                                                                     _mm256_mul_ps(W1, pn_[1])),
-                                                       _mm256_mul_ps(W2, pn_[2])));
+            const __m256 w0 = _mm256_set1_ps(1.0f - u - v), w1 = _mm256_set1_ps(u),
+                         w2 = _mm256_set1_ps(v);
+            _mm256_storeu_ps(pn + 8 * r, _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(w0, pn_[0]),
+                                                                     _mm256_mul_ps(w1, pn_[1])),
+                                                       _mm256_mul_ps(w2, pn_[2])));
+            _mm_storeu_ps(attributes + 4 * r,
+                          Interpolate(_mm256_castps256_ps128(w0), _mm256_castps256_ps128(w1),
+                                      _mm256_castps256_ps128(w2), a_));
 #else
+            const F4 w0 = Set4(1.0f - u - v), w1 = Set4(u), w2 = Set4(v);
             _mm_storeu_ps(pn + 8 * r, Interpolate(w0, w1, w2, p_));
             _mm_storeu_ps(pn + 8 * r + 4, Interpolate(w0, w1, w2, n_));
-#endif
             _mm_storeu_ps(attributes + 4 * r, Interpolate(w0, w1, w2, a_));
-            index[r] = k0 + uint32_t(x);
+#endif
             if (++r == kCapacity) {
                 ++x;
                 break;
