@@ -269,7 +269,12 @@ void ThermalImager::Process(const Image& samples, double time_s, int64_t noiseFr
     const double top = double(kAdcMaxCount);
     const __m128 sigma4 = _mm_set1_ps(sigma);
     const bool settled = alpha == 1.0;
-    tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
+    // The frame's constants by value: read through the closure, the compiler reloads them for
+    // every pixel group (the row stores might alias them).
+    const double adcGain = adcGain_, adcOffset = adcOffset_;
+    tbb::parallel_for(tbb::blocked_range<int>(0, h), [&, w, tau, alpha, kE, ideal, noisy, settled,
+                                                      sigma4, top, adcGain, adcOffset,
+                                                      key](const tbb::blocked_range<int>& rows) {
         RowScratch& scratch = scratch_.local();
         scratch.noise.resize(size_t(w) + 4);
         float* z = scratch.noise.data();
@@ -316,7 +321,7 @@ void ThermalImager::Process(const Image& samples, double time_s, int64_t noiseFr
                 StoreLanes(sig + x, lanes, __m128(__builtin_convertvector(signal, Floats4)));
                 // Quantize: NaN and v ≤ 0 → 0 (as maxpd(v, 0)), v ≥ 16383 → 16383 (minpd(v,
                 // 16383)), else ⌊v + ½⌋.
-                D4 v = adcGain_ * signal + adcOffset_;
+                D4 v = adcGain * signal + adcOffset;
                 v = v > 0.0 ? v : D4{};
                 v = v < top ? v : D4{} + top;
                 const I4 q = __builtin_convertvector(v + 0.5, I4);
