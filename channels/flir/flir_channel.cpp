@@ -16,6 +16,7 @@
 #include "scene/core/check.h"
 #include "scene/core/error.h"
 #include "scene/core/simd4.h"
+#include "scene/core/simd_lanes.h"
 #include "scene/sky/ephemeris.h"
 #include "scene/sky/illuminance.h"
 
@@ -176,6 +177,25 @@ UniformTable::UniformTable(std::vector<float> nodes, float xMax)
 }
 
 void UniformTable::operator()(size_t count, const float* x, float* out) const {
+#if defined(__AVX2__)
+    // Eight lanes: the four-lane arithmetic below lane for lane, the two nodes of each lane's cell
+    // by two gathers.
+    const __m256 scale = _mm256_set1_ps(scale_), last = _mm256_set1_ps(last_),
+                 lastCell = _mm256_set1_ps(float(nodes_.size() - 2));
+    for (size_t i = 0; i < count; i += simd::kLanes) {
+        const size_t lanes = std::min(simd::kLanes, count - i);
+        const __m256 u = _mm256_min_ps(
+            _mm256_max_ps(_mm256_setzero_ps(),
+                          _mm256_mul_ps(__m256(simd::Load(x + i, lanes, 0.0f)), scale)),
+            last);
+        const __m256i cell = _mm256_cvttps_epi32(_mm256_min_ps(u, lastCell));
+        const __m256 a = _mm256_i32gather_ps(nodes_.data(), cell, 4);
+        const __m256 b = _mm256_i32gather_ps(nodes_.data() + 1, cell, 4);
+        const __m256 f = _mm256_sub_ps(u, _mm256_cvtepi32_ps(cell));
+        simd::Store(out + i, simd::VF(_mm256_add_ps(a, _mm256_mul_ps(_mm256_sub_ps(b, a), f))),
+                    lanes);
+    }
+#else
     const F4 scale = Set4(scale_), last = Set4(last_), lastCell = Set4(float(nodes_.size() - 2));
     for (size_t i = 0; i < count; i += 4) {
         const size_t lanes = std::min<size_t>(4, count - i);
@@ -196,6 +216,7 @@ void UniformTable::operator()(size_t count, const float* x, float* out) const {
         const F4 f = _mm_sub_ps(u, _mm_cvtepi32_ps(cell));
         StoreLanes(out + i, lanes, _mm_add_ps(a, _mm_mul_ps(_mm_sub_ps(b, a), f)));
     }
+#endif
 }
 
 FlirChannel::FlirChannel(const scene::World& world, const scene::ChannelSettings& settings)
@@ -370,11 +391,14 @@ struct FlirChannel::ShadeBlock {
     // Sky: sample index within the block, view direction's z and squared length.
     alignas(16) uint32_t skyK[kChunk];
     alignas(16) float skyZ[kChunk], skyLength[kChunk];
-    // Sea: sample index, and per sample the (x, y, z, 0) records of position and
-    // (unnormalized) normal and the sea-mesh attributes (depth, wet, foam, 0) as
-    // TriangleCache writes them, turned to lanes by a 4×4 transpose when shaded.
-    alignas(16) uint32_t seaK[kChunk];
-    alignas(16) float seaP[4 * kChunk], seaN[4 * kChunk], seaA[4 * kChunk];
+    // Sea: per sample the records of position and (unnormalized) normal
+    // (x, y, z, 0, nx, ny, nz, 0) and of the sea-mesh attributes (depth, wet, foam, ·) as
+    // SeaGather writes them, turned to lanes by 4×4 transposes when shaded; and the runs of
+    // consecutive samples they came from (first sample index and length; a row's sea samples
+    // come in long runs, so they are written back a run at a time).
+    alignas(32) float seaPN[8 * kChunk], seaA[4 * kChunk];
+    uint32_t seaRunK[kChunk], seaRunLength[kChunk];
+    size_t seaRuns = 0;
     std::vector<uint32_t> modelK;
     std::vector<glm::vec3> modelP, modelN;
     std::vector<int> modelMesh;
@@ -387,13 +411,57 @@ struct FlirChannel::ShadeScratch {
     tbb::enumerable_thread_specific<ShadeBlock> perThread;
 };
 
+namespace {
+
+// Lanes x, y, z, w of simd::kLanes consecutive 16-byte aligned records of stride floats from
+// records (eight lanes: two 4×4 transposes side by side).
+void RecordLanes(const float* records, size_t stride, simd::VF& x, simd::VF& y, simd::VF& z,
+                 simd::VF& w) {
+#if defined(__AVX__)
+    const auto Pair = [&](size_t i) {
+        return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(records + i * stride)),
+                                    _mm_load_ps(records + (i + 4) * stride), 1);
+    };
+    const __m256 r0 = Pair(0), r1 = Pair(1), r2 = Pair(2), r3 = Pair(3);
+    const __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpackhi_ps(r0, r1);
+    const __m256 t2 = _mm256_unpacklo_ps(r2, r3), t3 = _mm256_unpackhi_ps(r2, r3);
+    x = simd::VF(_mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0)));
+    y = simd::VF(_mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2)));
+    z = simd::VF(_mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0)));
+    w = simd::VF(_mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2)));
+#else
+    F4 a = _mm_load_ps(records), b = _mm_load_ps(records + stride),
+       c = _mm_load_ps(records + 2 * stride), d = _mm_load_ps(records + 3 * stride);
+    _MM_TRANSPOSE4_PS(a, b, c, d);
+    x = simd::VF(a), y = simd::VF(b), z = simd::VF(c), w = simd::VF(d);
+#endif
+}
+
+// The end of the run of sky samples (kNoPrimitive) in prims[x, sw) that starts at x.
+int SkyRunEnd(const uint32_t* prims, int x, int sw) {
+    int end = x + 1;
+    const __m128i none = _mm_set1_epi32(int32_t(kNoPrimitive));
+    for (; end + 4 <= sw; end += 4) {
+        const __m128i p = _mm_loadu_si128(reinterpret_cast<const __m128i*>(prims + end));
+        const int sky = _mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(p, none)));
+        if (sky != 0xf) return end + __builtin_ctz(unsigned(~sky));
+    }
+    while (end < sw && prims[end] == kNoPrimitive) ++end;
+    return end;
+}
+
+// |v|: the sign bit cleared.
+simd::VF Abs(simd::VF v) { return simd::VF(simd::VI(v) & 0x7fffffff); }
+
+}  // namespace
+
 void FlirChannel::ShadeSky(ShadeBlock& sc, size_t count, float* out) const {
     // L_sky(cos θ) with cos θ = d_z / |d|.
-    for (size_t i = 0; i < count; i += 4) {
-        const size_t lanes = std::min<size_t>(4, count - i);
-        const F4 z = LoadLanes(&sc.skyZ[i], lanes, 1.0f);
-        const F4 len2 = LoadLanes(&sc.skyLength[i], lanes, 1.0f);
-        _mm_store_ps(sc.a + i, _mm_div_ps(z, _mm_sqrt_ps(len2)));
+    for (size_t i = 0; i < count; i += simd::kLanes) {
+        const size_t lanes = std::min(simd::kLanes, count - i);
+        const simd::VF z = simd::Load(&sc.skyZ[i], lanes, 1.0f);
+        const simd::VF len2 = simd::Load(&sc.skyLength[i], lanes, 1.0f);
+        simd::Store(sc.a + i, z / simd::Sqrt(len2));
     }
     skyTable_(count, sc.a, sc.b);
     for (size_t i = 0; i < count; ++i) out[sc.skyK[i]] = sc.b[i];
@@ -401,23 +469,20 @@ void FlirChannel::ShadeSky(ShadeBlock& sc, size_t count, float* out) const {
 
 void FlirChannel::ShadeSkyRun(const FrameShading& f, const glm::vec3& rowBase, int x0, int x1,
                               ShadeBlock& sc, float* rowOut) const {
-    // The view directions of the run four at a time, with glm's operations of the sample-by-sample
-    // path in the same order (d = rowBase + (x + ½) colStep, |d|² = (x² + y²) + z²), so the same
-    // bits; then L_sky(d_z / |d|) as ShadeSky.
-    const F4 baseX = Set4(rowBase.x), baseY = Set4(rowBase.y), baseZ = Set4(rowBase.z);
-    const F4 stepX = Set4(f.colStep.x), stepY = Set4(f.colStep.y), stepZ = Set4(f.colStep.z);
+    // The view directions of the run a lane group at a time, with glm's operations of the
+    // sample-by-sample path in the same order (d = rowBase + (x + ½) colStep,
+    // |d|² = (x² + y²) + z²), so the same bits; then L_sky(d_z / |d|) as ShadeSky.
+    simd::VI iota;
+    for (size_t l = 0; l < simd::kLanes; ++l) iota[l] = int32_t(l);
     for (int start = x0; start < x1; start += int(kChunk)) {
         const size_t count = size_t(std::min(x1 - start, int(kChunk)));
-        for (size_t i = 0; i < count; i += 4) {
-            const int x = start + int(i);
-            const F4 t =
-                _mm_add_ps(_mm_cvtepi32_ps(_mm_setr_epi32(x, x + 1, x + 2, x + 3)), Set4(0.5f));
-            const F4 dx = _mm_add_ps(baseX, _mm_mul_ps(t, stepX));
-            const F4 dy = _mm_add_ps(baseY, _mm_mul_ps(t, stepY));
-            const F4 dz = _mm_add_ps(baseZ, _mm_mul_ps(t, stepZ));
-            const F4 len2 =
-                _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
-            _mm_store_ps(sc.a + i, _mm_div_ps(dz, _mm_sqrt_ps(len2)));
+        for (size_t i = 0; i < count; i += simd::kLanes) {
+            const simd::VF t = __builtin_convertvector(iota + (start + int(i)), simd::VF) + 0.5f;
+            const simd::VF dx = rowBase.x + t * f.colStep.x;
+            const simd::VF dy = rowBase.y + t * f.colStep.y;
+            const simd::VF dz = rowBase.z + t * f.colStep.z;
+            const simd::VF len2 = (dx * dx + dy * dy) + dz * dz;
+            simd::Store(sc.a + i, dz / simd::Sqrt(len2));
         }
         skyTable_(count, sc.a, rowOut + start);
     }
@@ -426,49 +491,45 @@ void FlirChannel::ShadeSkyRun(const FrameShading& f, const glm::vec3& rowBase, i
 void FlirChannel::ShadeSea(const FrameShading& f, ShadeBlock& sc, size_t count, float* out) const {
     // Emissivity at the local view angle (Masuda's wind average for the unresolved slopes), sky
     // reflected about the resolved normal (a ray reflected into the sea meets the next wave's
-    // sky); sand where the sea lies on the beach and foam over both (SurfInfraredRadiance4);
+    // sky); sand where the sea lies on the beach and foam over both (SurfInfraredRadiance);
     // through the path. The records past count (the last lane group's unused lanes) repeat the
     // last sample, so that those lanes compute finite values that are never stored.
-    for (size_t i = count; i % 4 != 0; ++i)
-        for (float* r : {sc.seaP, sc.seaN, sc.seaA}) std::copy_n(r + 4 * (count - 1), 4, r + 4 * i);
-    const auto Lanes = [](const float* records, F4& x, F4& y, F4& z, F4& w) {
-        x = _mm_load_ps(records), y = _mm_load_ps(records + 4), z = _mm_load_ps(records + 8),
-        w = _mm_load_ps(records + 12);
-        _MM_TRANSPOSE4_PS(x, y, z, w);
-    };
-    const F4 eyeX = Set4(f.eye.x), eyeY = Set4(f.eye.y), eyeZ = Set4(f.eye.z);
-    for (size_t i = 0; i < count; i += 4) {
-        F4 nx, ny, nz, px, py, pz, unused;
-        Lanes(sc.seaN + 4 * i, nx, ny, nz, unused);
-        Lanes(sc.seaP + 4 * i, px, py, pz, unused);
-        const F4 invN = _mm_div_ps(Set4(1.0f), _mm_sqrt_ps(Dot4(nx, ny, nz, nx, ny, nz)));
-        nx = _mm_mul_ps(nx, invN), ny = _mm_mul_ps(ny, invN), nz = _mm_mul_ps(nz, invN);
-        const F4 tx = _mm_sub_ps(eyeX, px), ty = _mm_sub_ps(eyeY, py), tz = _mm_sub_ps(eyeZ, pz);
-        const F4 range2 = Dot4(tx, ty, tz, tx, ty, tz);
-        const F4 range = _mm_sqrt_ps(range2);
-        const F4 invRange = _mm_div_ps(Set4(1.0f), range);
-        const F4 ndv = _mm_mul_ps(Dot4(nx, ny, nz, tx, ty, tz), invRange);
-        const F4 rz =
-            _mm_sub_ps(_mm_mul_ps(_mm_mul_ps(Set4(2.0f), ndv), nz), _mm_mul_ps(tz, invRange));
-        _mm_store_ps(sc.a + i, Max4(ndv, _mm_setzero_ps()));  // cos θ_view
-        _mm_store_ps(sc.b + i, Abs4(rz));                     // reflected ray's cos θ_zenith
-        _mm_store_ps(sc.c + i, _mm_sqrt_ps(range));           // √range
+    using simd::VF;
+    for (size_t i = count; i % simd::kLanes != 0; ++i) {
+        std::copy_n(sc.seaPN + 8 * (count - 1), 8, sc.seaPN + 8 * i);
+        std::copy_n(sc.seaA + 4 * (count - 1), 4, sc.seaA + 4 * i);
+    }
+    for (size_t i = 0; i < count; i += simd::kLanes) {
+        VF nx, ny, nz, px, py, pz, unused;
+        RecordLanes(sc.seaPN + 8 * i + 4, 8, nx, ny, nz, unused);
+        RecordLanes(sc.seaPN + 8 * i, 8, px, py, pz, unused);
+        const VF invN = 1.0f / simd::Sqrt(simd::Dot(nx, ny, nz, nx, ny, nz));
+        nx = nx * invN, ny = ny * invN, nz = nz * invN;
+        const VF tx = f.eye.x - px, ty = f.eye.y - py, tz = f.eye.z - pz;
+        const VF range = simd::Sqrt(simd::Dot(tx, ty, tz, tx, ty, tz));
+        const VF invRange = 1.0f / range;
+        const VF ndv = simd::Dot(nx, ny, nz, tx, ty, tz) * invRange;
+        const VF rz = (2.0f * ndv) * nz - tz * invRange;
+        simd::Store(sc.a + i, simd::Max(ndv, VF{}));  // cos θ_view
+        simd::Store(sc.b + i, Abs(rz));               // reflected ray's cos θ_zenith
+        simd::Store(sc.c + i, simd::Sqrt(range));     // √range
     }
     seaEmissivity_(count, sc.a, sc.d);
     skyTable_(count, sc.b, sc.e);
     pathTau_(count, sc.c, sc.a);
-    const F4 seaB = Set4(f.seaB), airB = Set4(f.airB);
-    const F4 one = Set4(1.0f);
-    for (size_t i = 0; i < count; i += 4) {
-        F4 depth, wet, foam, unused;
-        Lanes(sc.seaA + 4 * i, depth, wet, foam, unused);
-        const F4 L = SurfInfraredRadiance4(f.surf, _mm_load_ps(sc.d + i), seaB,
-                                           _mm_load_ps(sc.e + i), depth, wet, foam);
-        const F4 tau = _mm_load_ps(sc.a + i);
-        _mm_store_ps(sc.b + i,
-                     _mm_add_ps(_mm_mul_ps(tau, L), _mm_mul_ps(_mm_sub_ps(one, tau), airB)));
+    const VF seaB = simd::Splat(f.seaB);
+    for (size_t i = 0; i < count; i += simd::kLanes) {
+        VF depth, wet, foam, unused;
+        RecordLanes(sc.seaA + 4 * i, 4, depth, wet, foam, unused);
+        const VF L = SurfInfraredRadiance(f.surf, simd::Load(sc.d + i), seaB, simd::Load(sc.e + i),
+                                          depth, wet, foam);
+        const VF tau = simd::Load(sc.a + i);
+        simd::Store(sc.b + i, tau * L + (1.0f - tau) * f.airB);
     }
-    for (size_t i = 0; i < count; ++i) out[sc.seaK[i]] = sc.b[i];
+    const float* L = sc.b;
+    for (size_t r = 0; r < sc.seaRuns; L += sc.seaRunLength[r], ++r)
+        std::copy_n(L, sc.seaRunLength[r], out + sc.seaRunK[r]);
+    sc.seaRuns = 0;
 }
 
 uint64_t FlirChannel::ShadeRows(const FrameShading& f, int y0, int y1, float* out) {
@@ -483,6 +544,9 @@ uint64_t FlirChannel::ShadeRows(const FrameShading& f, int y0, int y1, float* ou
     // time), model positions and normals.
     size_t skyCount = 0, seaCount = 0;
     TriangleCache tri;
+    // Mesh 0's primitives (all of them when there are no models).
+    const std::vector<uint32_t>& bases = f.vis.primitiveBase;
+    SeaGather sea(f.meshes[0], bases[0], (bases.size() > 1 ? bases[1] : kNoPrimitive) - bases[0]);
     for (int y = y0; y < y1; ++y) {
         const double ndcY = 1.0 - 2.0 * (y + 0.5) / f.sampleHeight;
         const glm::vec3 rowBase(f.forward + f.up * ndcY - f.right);
@@ -491,36 +555,38 @@ uint64_t FlirChannel::ShadeRows(const FrameShading& f, int y0, int y1, float* ou
         const float* b1 = f.vis.b1.data() + row;
         const float* b2 = f.vis.b2.data() + row;
         const uint32_t kRow = uint32_t(size_t(y - y0) * size_t(sw));
-        for (int x = 0; x < sw; ++x) {
+        for (int x = 0; x < sw;) {
             const uint32_t k = kRow + uint32_t(x), prim = prims[x];
+            if (sea.IsSea(prim)) {
+                const int x0 = x;
+                x = sea.Gather<kChunk>(prims, b1, b2, x, sw, sc.seaPN, sc.seaA, seaCount);
+                sc.seaRunK[sc.seaRuns] = k;
+                sc.seaRunLength[sc.seaRuns++] = uint32_t(x - x0);
+                if (seaCount == kChunk) ShadeSea(f, sc, seaCount, out), seaCount = 0;
+                continue;
+            }
             if (prim == kNoPrimitive) {
-                // A run of sky (most rows above the horizon): shaded straight into out.
-                int end = x + 1;
-                while (end < sw && prims[end] == kNoPrimitive) ++end;
+                // A run of sky (most rows above the horizon): shaded straight into out; a short
+                // one gathered with the block's other short runs.
+                const int end = SkyRunEnd(prims, x, sw);
                 if (end - x >= kMinSkyRun) {
                     ShadeSkyRun(f, rowBase, x, end, sc, out + kRow);
-                    x = end - 1;
+                    x = end;
                     continue;
                 }
-                const glm::vec3 d = rowBase + (float(x) + 0.5f) * f.colStep;
-                sc.skyK[skyCount] = k;
-                sc.skyZ[skyCount] = d.z;
-                sc.skyLength[skyCount] = glm::dot(d, d);
-                if (++skyCount == kChunk) ShadeSky(sc, skyCount, out), skyCount = 0;
+                for (; x < end; ++x) {
+                    const glm::vec3 d = rowBase + (float(x) + 0.5f) * f.colStep;
+                    sc.skyK[skyCount] = kRow + uint32_t(x);
+                    sc.skyZ[skyCount] = d.z;
+                    sc.skyLength[skyCount] = glm::dot(d, d);
+                    if (++skyCount == kChunk) ShadeSky(sc, skyCount, out), skyCount = 0;
+                }
                 continue;
             }
-            // The surface point goes straight into the next sea record; a model sample copies
-            // it out (the record is then reused).
-            float* p = sc.seaP + 4 * seaCount;
-            float* n = sc.seaN + 4 * seaCount;
+            alignas(16) float p[4], n[4];
             int mesh = 0;
             tri.Surface(f.vis.primitiveBase, f.meshes, prim, b1[x], b2[x], p, n, mesh);
-            if (mesh == 0) {
-                sc.seaK[seaCount] = k;
-                tri.Attributes(b1[x], b2[x], sc.seaA + 4 * seaCount);
-                if (++seaCount == kChunk) ShadeSea(f, sc, seaCount, out), seaCount = 0;
-                continue;
-            }
+            ++x;
             const glm::vec3 position(p[0], p[1], p[2]);
             glm::vec3 normal = glm::normalize(glm::vec3(n[0], n[1], n[2]));
             if (glm::dot(normal, f.eye - position) < 0.0f) normal = -normal;

@@ -34,21 +34,25 @@ struct SurfInfrared {
 // sand appears only where the column d is thinner than the swash film that OTW uses for the
 // waterline, and the two channels put the waterline in the same place. Written so that without
 // sand (film 1) and foam (c = 0) the result is the water term bit for bit.
+// V: a GCC float vector type (simd::VF of the shading loops, or simd4::F4), the same operations
+// per lane at any width.
+template <class V>
+inline V SurfInfraredRadiance(const SurfInfrared& s, V epsWater, V seaB, V skyR, V depth, V wet,
+                              V foam) {
+    const V one = V{} + 1.0f;
+    const V water = epsWater * seaB + (one - epsWater) * skyR;
+    const V epsF = V{} + s.foamEmissivity;
+    const V white = epsF * s.foamB + (one - epsF) * skyR;
+    const V sand = s.sandDry + (s.sandWet - s.sandDry) * wet;
+    const V d = depth * (1.0f / kSwashFilm_m);
+    const V film = d < one ? d : one;  // _mm_min_ps(d, 1)
+    const V surface = water + (sand - water) * (one - film);
+    return surface + (white - surface) * foam;
+}
 inline simd4::F4 SurfInfraredRadiance4(const SurfInfrared& s, simd4::F4 epsWater, simd4::F4 seaB,
                                        simd4::F4 skyR, simd4::F4 depth, simd4::F4 wet,
                                        simd4::F4 foam) {
-    using namespace simd4;
-    const F4 one = Set4(1.0f);
-    const F4 water =
-        _mm_add_ps(_mm_mul_ps(epsWater, seaB), _mm_mul_ps(_mm_sub_ps(one, epsWater), skyR));
-    const F4 epsF = Set4(s.foamEmissivity);
-    const F4 white =
-        _mm_add_ps(_mm_mul_ps(epsF, Set4(s.foamB)), _mm_mul_ps(_mm_sub_ps(one, epsF), skyR));
-    const F4 sand = _mm_add_ps(Set4(s.sandDry), _mm_mul_ps(Set4(s.sandWet - s.sandDry), wet));
-    const F4 film = _mm_min_ps(_mm_mul_ps(depth, Set4(1.0f / kSwashFilm_m)), one);
-    const F4 surface =
-        _mm_add_ps(water, _mm_mul_ps(_mm_sub_ps(sand, water), _mm_sub_ps(one, film)));
-    return _mm_add_ps(surface, _mm_mul_ps(_mm_sub_ps(white, surface), foam));
+    return SurfInfraredRadiance(s, epsWater, seaB, skyR, depth, wet, foam);
 }
 
 }  // namespace seasense::channels

@@ -1,6 +1,8 @@
 // Table inversion of the standard normal CDF for per-pixel noise.
 #include "sensors/thermal/normal_deviates.h"
 
+#include <immintrin.h>
+
 #include <array>
 #include <bit>
 #include <cmath>
@@ -111,10 +113,63 @@ void NormalPair(uint64_t bits, float& z0, float& z1) {
     z1 = FromBits(t, uint32_t(bits));
 }
 
+#if defined(__AVX2__)
+namespace {
+
+// z · c mod 2⁶⁴ in each 64-bit lane, from 32-bit products: lo·lo + ((hi·lo + lo·hi) << 32).
+inline __m256i MulLo64(__m256i z, uint64_t c) {
+    const __m256i cLo = _mm256_set1_epi64x(int64_t(c & 0xffffffffu));
+    const __m256i cHi = _mm256_set1_epi64x(int64_t(c >> 32));
+    const __m256i cross =
+        _mm256_add_epi64(_mm256_mul_epu32(_mm256_srli_epi64(z, 32), cLo), _mm256_mul_epu32(z, cHi));
+    return _mm256_add_epi64(_mm256_mul_epu32(z, cLo), _mm256_slli_epi64(cross, 32));
+}
+
+// scene::Mix64 of four lanes.
+inline __m256i Mix64x4(__m256i z) {
+    z = _mm256_add_epi64(z, _mm256_set1_epi64x(int64_t(0x9e3779b97f4a7c15ULL)));
+    z = MulLo64(_mm256_xor_si256(z, _mm256_srli_epi64(z, 30)), 0xbf58476d1ce4e5b9ULL);
+    z = MulLo64(_mm256_xor_si256(z, _mm256_srli_epi64(z, 27)), 0x94d049bb133111ebULL);
+    return _mm256_xor_si256(z, _mm256_srli_epi64(z, 31));
+}
+
+// FromBits of eight lanes of 32 bits; false (and nothing written) when a lane needs the tail
+// beyond the table's last cell.
+inline bool FromBits8(const QuantileTable& t, __m256i bits, float* z) {
+    const __m256i v = _mm256_srli_epi32(bits, 1);
+    const __m256i k = _mm256_srli_epi32(v, kFractionBits);
+    if (!_mm256_testz_si256(_mm256_cmpeq_epi32(k, _mm256_set1_epi32(kTableSize - 1)),
+                            _mm256_set1_epi32(-1)))
+        return false;
+    const __m256 f = _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_and_si256(
+                                       v, _mm256_set1_epi32(int32_t((1u << kFractionBits) - 1)))),
+                                   _mm256_set1_ps(1.0f / (1u << kFractionBits)));
+    const __m256 a = _mm256_i32gather_ps(t.value.data(), k, 4);
+    const __m256 b = _mm256_i32gather_ps(t.value.data() + 1, k, 4);
+    const __m256 zAbs = _mm256_add_ps(a, _mm256_mul_ps(f, _mm256_sub_ps(b, a)));
+    _mm256_storeu_ps(z, _mm256_xor_ps(zAbs, _mm256_castsi256_ps(_mm256_slli_epi32(bits, 31))));
+    return true;
+}
+
+}  // namespace
+#endif
+
 void NormalPairsRow(uint64_t key, uint64_t counter0, size_t count, float* z) {
     const QuantileTable& t = Table();
     size_t i = 0;
-    for (uint64_t c = counter0; i + 1 < count; ++c, i += 2) {
+#if defined(__AVX2__)
+    // Four pairs at a time: lane l hashes counter c + l; its 64 bits give z[2l] (high half) and
+    // z[2l + 1] (low half), the scalar loop's order.
+    const __m256i keys = _mm256_set1_epi64x(int64_t(key));
+    for (uint64_t c = counter0; i + 8 <= count; c += 4) {
+        const __m256i counters =
+            _mm256_add_epi64(_mm256_set1_epi64x(int64_t(c)), _mm256_setr_epi64x(0, 1, 2, 3));
+        const __m256i bits = Mix64x4(_mm256_xor_si256(keys, counters));
+        if (!FromBits8(t, _mm256_shuffle_epi32(bits, _MM_SHUFFLE(2, 3, 0, 1)), z + i)) break;
+        i += 8;
+    }
+#endif
+    for (uint64_t c = counter0 + i / 2; i + 1 < count; ++c, i += 2) {
         const uint64_t bits = scene::Mix64(key ^ c);
         z[i] = FromBits(t, uint32_t(bits >> 32));
         z[i + 1] = FromBits(t, uint32_t(bits));

@@ -1,7 +1,7 @@
 // Analytic optics/detector MTFs and the OTF-derived sampling kernel of the thermal imager.
 #include "sensors/thermal/optics_kernel.h"
 
-#include <emmintrin.h>
+#include <immintrin.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -204,9 +204,10 @@ namespace {
 // ⌊a / b⌋ for b > 0.
 int FloorDiv(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
 
-// Vectors per step of the tap loop (KernelSteps), and the pixels of the widest step (eight
-// lanes), which the phase arrays are padded to.
-constexpr int kGroups = 4;
+// Vectors per step of the tap loop (KernelSteps): eight accumulators, so that a tap pair's
+// broadcast and column offsets serve 64 pixels (eight lanes); and the pixels of the widest step,
+// which the phase arrays are padded to.
+constexpr int kGroups = 8;
 constexpr int kPixelsPerStep = 8 * kGroups;
 
 // The folded rows and tap pairs of one row, as SampleKernelRow lays them out.
@@ -329,6 +330,23 @@ void SampleKernelRow(const Image& samples, const SamplingKernel& kernel, int y, 
             // Even and odd samples of eight columns at a time.
             float* even = row - mMin;
             float* odd = row + phaseStride - mMin;
+#if defined(__AVX2__)
+            for (; m + 8 <= mHi; m += 8) {
+                // (s0 s2 s8 s10 | s4 s6 s12 s14) and the odd ones, put in order by vpermpd.
+                const __m256 s0 =
+                    _mm256_add_ps(_mm256_loadu_ps(a + 2 * m), _mm256_loadu_ps(b + 2 * m));
+                const __m256 s1 =
+                    _mm256_add_ps(_mm256_loadu_ps(a + 2 * m + 8), _mm256_loadu_ps(b + 2 * m + 8));
+                const auto Ordered = [](__m256 v) {
+                    return _mm256_castpd_ps(
+                        _mm256_permute4x64_pd(_mm256_castps_pd(v), _MM_SHUFFLE(3, 1, 2, 0)));
+                };
+                _mm256_storeu_ps(even + m,
+                                 Ordered(_mm256_shuffle_ps(s0, s1, _MM_SHUFFLE(2, 0, 2, 0))));
+                _mm256_storeu_ps(odd + m,
+                                 Ordered(_mm256_shuffle_ps(s0, s1, _MM_SHUFFLE(3, 1, 3, 1))));
+            }
+#endif
             for (; m + 4 <= mHi; m += 4) {
                 const __m128 s0 = _mm_add_ps(_mm_loadu_ps(a + 2 * m), _mm_loadu_ps(b + 2 * m));
                 const __m128 s1 =

@@ -99,9 +99,11 @@ class ThermalDisplay {
     std::array<std::array<uint8_t, 3>, 256> palette_;
     bool initialized_ = false;
     double low_ = 0.0, high_ = kAdcMaxCount;
-    std::vector<float> lut_;      // kAdcLevels entries in [0, 1]
-    std::vector<uint8_t> index_;  // kAdcLevels entries, after polarity
-    std::vector<float> target_;   // scratch: this frame's target mapping
+    std::vector<float> lut_;  // kAdcLevels entries in [0, 1]
+    // kAdcLevels entries, after polarity, and three zero bytes (Render reads 32 bits at a
+    // level's offset).
+    std::vector<uint8_t> index_;
+    std::vector<float> target_;  // scratch: this frame's target mapping
 };
 
 }  // namespace seasense::sensors

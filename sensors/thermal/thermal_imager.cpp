@@ -38,6 +38,12 @@ constexpr uint64_t kStreamCalibration = uint64_t(2) << 40;  // + calibration fra
 // give a pixel zero or inverted response.
 constexpr double kMinPixelGain = 0.01;
 
+// Four pixels as floats, doubles and 32-bit integers (GCC vector types: the AVX build computes
+// the four doubles in one vector, the SSE2 build in two, the same operation per lane).
+typedef float Floats4 __attribute__((vector_size(16)));
+typedef double D4 __attribute__((vector_size(32)));
+typedef int32_t I4 __attribute__((vector_size(16)));
+
 inline float Gaussian(uint64_t seed, uint64_t stream, uint64_t counter) {
     return NormalFromBits(uint32_t(scene::HashBits(seed, stream, counter) >> 32));
 }
@@ -260,13 +266,15 @@ void ThermalImager::Process(const Image& samples, double time_s, int64_t noiseFr
     //   L = τ·blurred, lagged = y + α(L − y) (L on a settled frame), E = kE·lagged,
     //   s = gain·E + offset + float(noiseScale·σ·z)  (s = E + float(σ·z) for an ideal response),
     //   counts = Quantize(adcGain·s + adcOffset).
-    const __m128d tau2 = _mm_set1_pd(tau), alpha2 = _mm_set1_pd(alpha), kE2 = _mm_set1_pd(kE);
-    const __m128d adcGain2 = _mm_set1_pd(adcGain_), adcOffset2 = _mm_set1_pd(adcOffset_);
-    const __m128d zero2 = _mm_setzero_pd(), top2 = _mm_set1_pd(double(kAdcMaxCount));
-    const __m128d half2 = _mm_set1_pd(0.5);
+    const double top = double(kAdcMaxCount);
     const __m128 sigma4 = _mm_set1_ps(sigma);
     const bool settled = alpha == 1.0;
-    tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
+    // The frame's constants by value: read through the closure, the compiler reloads them for
+    // every pixel group (the row stores might alias them).
+    const double adcGain = adcGain_, adcOffset = adcOffset_;
+    tbb::parallel_for(tbb::blocked_range<int>(0, h), [&, w, tau, alpha, kE, ideal, noisy, settled,
+                                                      sigma4, top, adcGain, adcOffset,
+                                                      key](const tbb::blocked_range<int>& rows) {
         RowScratch& scratch = scratch_.local();
         scratch.noise.resize(size_t(w) + 4);
         float* z = scratch.noise.data();
@@ -296,42 +304,27 @@ void ThermalImager::Process(const Image& samples, double time_s, int64_t noiseFr
                     gain4 = LoadLanes(gain_.data() + row + size_t(x), lanes, 0.0f);
                     offset4 = LoadLanes(offset_.data() + row + size_t(x), lanes, 0.0f);
                 }
-                __m128d lagged[2], signal[2];
-                for (int half = 0; half < 2; ++half) {
-                    // Lanes 2·half, 2·half + 1 as doubles.
-                    const auto Half = [half](__m128 v) {
-                        return _mm_cvtps_pd(half ? _mm_movehl_ps(v, v) : v);
-                    };
-                    const __m128d L = _mm_mul_pd(tau2, Half(blurred));
-                    __m128d lag = L;
-                    if (!settled) {
-                        const __m128d prev = Half(y4);
-                        lag = _mm_add_pd(prev, _mm_mul_pd(alpha2, _mm_sub_pd(L, prev)));
-                    }
-                    const __m128d E = _mm_mul_pd(kE2, lag);
-                    __m128d sv;
-                    if (ideal)
-                        sv = _mm_add_pd(E, Half(noise));
-                    else
-                        sv = _mm_add_pd(_mm_add_pd(_mm_mul_pd(Half(gain4), E), Half(offset4)),
-                                        Half(noise));
-                    lagged[half] = lag;
-                    signal[half] = sv;
-                }
-                const auto Floats = [](const __m128d* v) {
-                    return _mm_movelh_ps(_mm_cvtpd_ps(v[0]), _mm_cvtpd_ps(v[1]));
+                // The four lanes as doubles (one AVX vector, or two SSE2 ones).
+                const auto Doubles = [](__m128 v) {
+                    return __builtin_convertvector(Floats4(v), D4);
                 };
-                StoreLanes(rad + x, lanes, Floats(lagged));
-                StoreLanes(sig + x, lanes, Floats(signal));
-                // Quantize: NaN and v ≤ 0 → 0 (maxpd returns its second operand for NaN),
-                // v ≥ 16383 → 16383, else ⌊v + ½⌋.
-                alignas(16) int32_t q[4];
-                for (int half = 0; half < 2; ++half) {
-                    __m128d v = _mm_add_pd(_mm_mul_pd(adcGain2, signal[half]), adcOffset2);
-                    v = _mm_min_pd(_mm_max_pd(v, zero2), top2);
-                    _mm_storel_epi64(reinterpret_cast<__m128i*>(q + 2 * half),
-                                     _mm_cvttpd_epi32(_mm_add_pd(v, half2)));
+                const D4 L = tau * Doubles(blurred);
+                D4 lagged = L;
+                if (!settled) {
+                    const D4 prev = Doubles(y4);
+                    lagged = prev + alpha * (L - prev);
                 }
+                const D4 E = kE * lagged;
+                const D4 signal = ideal ? E + Doubles(noise)
+                                        : (Doubles(gain4) * E + Doubles(offset4)) + Doubles(noise);
+                StoreLanes(rad + x, lanes, __m128(__builtin_convertvector(lagged, Floats4)));
+                StoreLanes(sig + x, lanes, __m128(__builtin_convertvector(signal, Floats4)));
+                // Quantize: NaN and v ≤ 0 → 0 (as maxpd(v, 0)), v ≥ 16383 → 16383 (minpd(v,
+                // 16383)), else ⌊v + ½⌋.
+                D4 v = adcGain * signal + adcOffset;
+                v = v > 0.0 ? v : D4{};
+                v = v < top ? v : D4{} + top;
+                const I4 q = __builtin_convertvector(v + 0.5, I4);
                 for (size_t k = 0; k < lanes; ++k) cnt[size_t(x) + k] = uint16_t(q[k]);
             }
         }
