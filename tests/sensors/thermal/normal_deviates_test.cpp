@@ -71,7 +71,9 @@ TEST(NormalDeviates, RowOfPairsEqualsPairByPair) {
             ASSERT_EQ(row[i], z[i % 2]) << count << " " << i;
             tail += std::abs(row[i]) > 3.85f;
         }
-        if (count == 200000) EXPECT_GT(tail, 5u);
+        if (count == 200000) {
+            EXPECT_GT(tail, 5u);
+        }
     }
 }
 
