@@ -284,15 +284,19 @@ int RunHost(const RunOptions& opt) {
 
     const int64_t periodNs = opt.rate_hz > 0.0 ? int64_t(std::llround(1e9 / opt.rate_hz)) : 0;
     int64_t runStartNs = 0, lastPresentNs = 0, firstPresentNs = 0;
+    std::vector<uint8_t> seaBytes;  // kept between frames (1 MiB at 2 × 128²)
     const auto publish = [&](uint32_t index) {
         if (periodNs > 0) SleepUntilNs(runStartNs + int64_t(index) * periodNs);
         const scene::FrameState fs = world.Advance(spec.firstFrame + int64_t(index));
         // The sea's fields at the frame's time, synthesized once here for every renderer.
-        const std::shared_ptr<const scene::OceanSurfaceFrame> sea =
-            world.Ocean().Spectral() ? world.Ocean().At(fs.time_s) : nullptr;
+        seaBytes.clear();
+        if (world.Ocean().Spectral()) {
+            const scene::FftOceanFrame& fields = *world.Ocean().At(fs.time_s)->Fft();
+            seaBytes.resize(fields.EncodedBytes());
+            fields.Encode(seaBytes.data());
+        }
         uint8_t* bytes = lock.BeginPublish(index);
-        const size_t n =
-            sync::EncodeStateSlot(fs, sea ? sea->Fft() : nullptr, bytes, header.stateBytes);
+        const size_t n = sync::EncodeStateSlot(fs, seaBytes, bytes, header.stateBytes);
         lock.EndPublish(index, fs.frame, n);
     };
 

@@ -135,17 +135,15 @@ size_t StateSlotBytes(size_t entityCount, size_t seaBytes) {
     return EncodedFrameStateBytes(entityCount) + seaBytes;
 }
 
-size_t EncodeStateSlot(const scene::FrameState& state, const scene::FftOceanFrame* sea,
+size_t EncodeStateSlot(const scene::FrameState& state, std::span<const uint8_t> sea,
                        uint8_t* buffer, size_t capacity) {
     const size_t n = EncodeFrameState(state, buffer, capacity);
-    if (!sea) return n;
-    const size_t m = sea->EncodedBytes();
-    if (m > capacity - n)
-        throw RuntimeError("sea fields (" + std::to_string(m) +
+    if (sea.size() > capacity - n)
+        throw RuntimeError("sea fields (" + std::to_string(sea.size()) +
                            " bytes) do not fit the shared-memory state slot (" +
                            std::to_string(capacity) + " bytes)");
-    sea->Encode(buffer + n);
-    return n + m;
+    if (!sea.empty()) std::memcpy(buffer + n, sea.data(), sea.size());
+    return n + sea.size();
 }
 
 StateSlotContents DecodeStateSlot(const uint8_t* buffer, size_t bytes) {

@@ -21,11 +21,12 @@ scene::FrameState DecodeFrameState(const uint8_t* buffer, size_t bytes);
 size_t EncodedFrameStateBytes(size_t entityCount);
 
 // A state slot: the encoded frame state, then, for a spectral sea, the sea's fields at the
-// frame's time as the host synthesized them (scene::FftOceanFrame::Encode), so that the
-// renderers adopt one synthesis (scene::OceanSurface::Adopt) instead of each making the same
-// fields. sea may be null (no spectral sea). Returns the bytes used; RuntimeError when they do
-// not fit.
-size_t EncodeStateSlot(const scene::FrameState& state, const scene::FftOceanFrame* sea,
+// frame's time as the host synthesized them (the bytes of scene::FftOceanFrame::Encode), so that
+// the renderers adopt one synthesis (scene::OceanSurface::Adopt) instead of each making the same
+// fields. sea may be empty (no spectral sea). Returns the bytes used; RuntimeError when they do
+// not fit. (The codec carries the sea's bytes without reading them: this layer depends on no
+// scene model.)
+size_t EncodeStateSlot(const scene::FrameState& state, std::span<const uint8_t> sea,
                        uint8_t* buffer, size_t capacity);
 struct StateSlotContents {
     scene::FrameState state;
