@@ -540,7 +540,9 @@ void OceanSurface::Adopt(double t, std::span<const uint8_t> fields) const {
             "sea fields for t = " + std::to_string(in.Time_s()) + " s (" +
             std::to_string(in.CascadeCount()) + " cascades of " + std::to_string(in.GridSize()) +
             "² nodes) do not match this scenario's sea at t = " + std::to_string(t) + " s");
-    Complete(*frame, t);
+    // Isolated as in At: the textures' parallel loops must not run an outer task that could ask
+    // for a frame while this thread holds the lock.
+    tbb::this_task_arena::isolate([&] { Complete(*frame, t); });
     frames.push_back(frame);
 }
 
