@@ -284,19 +284,18 @@ int RunHost(const RunOptions& opt) {
 
     const int64_t periodNs = opt.rate_hz > 0.0 ? int64_t(std::llround(1e9 / opt.rate_hz)) : 0;
     int64_t runStartNs = 0, lastPresentNs = 0, firstPresentNs = 0;
-    std::vector<uint8_t> seaBytes;  // kept between frames (1 MiB at 2 × 128²)
     const auto publish = [&](uint32_t index) {
         if (periodNs > 0) SleepUntilNs(runStartNs + int64_t(index) * periodNs);
         const scene::FrameState fs = world.Advance(spec.firstFrame + int64_t(index));
-        // The sea's fields at the frame's time, synthesized once here for every renderer.
-        seaBytes.clear();
-        if (world.Ocean().Spectral()) {
-            const scene::FftOceanFrame& fields = *world.Ocean().At(fs.time_s)->Fft();
-            seaBytes.resize(fields.EncodedBytes());
-            fields.Encode(seaBytes.data());
-        }
+        // The sea's fields at the frame's time, synthesized once here for every renderer and
+        // encoded straight into the slot.
+        const std::shared_ptr<const scene::OceanSurfaceFrame> sea =
+            world.Ocean().Spectral() ? world.Ocean().At(fs.time_s) : nullptr;
+        const scene::FftOceanFrame* fields = sea ? sea->Fft() : nullptr;
         uint8_t* bytes = lock.BeginPublish(index);
-        const size_t n = sync::EncodeStateSlot(fs, seaBytes, bytes, header.stateBytes);
+        const size_t n = sync::EncodeStateSlot(
+            fs, fields ? fields->EncodedBytes() : 0, [&](uint8_t* out) { fields->Encode(out); },
+            bytes, header.stateBytes);
         lock.EndPublish(index, fs.frame, n);
     };
 

@@ -135,15 +135,23 @@ size_t StateSlotBytes(size_t entityCount, size_t seaBytes) {
     return EncodedFrameStateBytes(entityCount) + seaBytes;
 }
 
-size_t EncodeStateSlot(const scene::FrameState& state, std::span<const uint8_t> sea,
-                       uint8_t* buffer, size_t capacity) {
+size_t EncodeStateSlot(const scene::FrameState& state, size_t seaBytes,
+                       const std::function<void(uint8_t*)>& writeSea, uint8_t* buffer,
+                       size_t capacity) {
     const size_t n = EncodeFrameState(state, buffer, capacity);
-    if (sea.size() > capacity - n)
-        throw RuntimeError("sea fields (" + std::to_string(sea.size()) +
+    if (seaBytes > capacity - n)
+        throw RuntimeError("sea fields (" + std::to_string(seaBytes) +
                            " bytes) do not fit the shared-memory state slot (" +
                            std::to_string(capacity) + " bytes)");
-    if (!sea.empty()) std::memcpy(buffer + n, sea.data(), sea.size());
-    return n + sea.size();
+    if (seaBytes > 0) writeSea(buffer + n);
+    return n + seaBytes;
+}
+
+size_t EncodeStateSlot(const scene::FrameState& state, std::span<const uint8_t> sea,
+                       uint8_t* buffer, size_t capacity) {
+    return EncodeStateSlot(
+        state, sea.size(), [&](uint8_t* out) { std::memcpy(out, sea.data(), sea.size()); }, buffer,
+        capacity);
 }
 
 StateSlotContents DecodeStateSlot(const uint8_t* buffer, size_t bytes) {

@@ -3,6 +3,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <span>
 
 #include "scene/world/world.h"
@@ -28,6 +29,11 @@ size_t EncodedFrameStateBytes(size_t entityCount);
 // scene model.)
 size_t EncodeStateSlot(const scene::FrameState& state, std::span<const uint8_t> sea,
                        uint8_t* buffer, size_t capacity);
+// The same with the sea's seaBytes written in place by writeSea(destination), so that the host
+// encodes the fields straight into the slot instead of through a copy.
+size_t EncodeStateSlot(const scene::FrameState& state, size_t seaBytes,
+                       const std::function<void(uint8_t*)>& writeSea, uint8_t* buffer,
+                       size_t capacity);
 struct StateSlotContents {
     scene::FrameState state;
     std::span<const uint8_t> sea;  // empty: no sea fields (into the slot's bytes)

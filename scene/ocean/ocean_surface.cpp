@@ -484,6 +484,12 @@ SurfaceBounds OceanSurfaceFrame::LocalBoundsNear(double x, double y, double radi
             std::min(local.horizontal_m + kLocalBoundMargin_m, global.horizontal_m)};
 }
 
+std::shared_ptr<OceanSurfaceFrame> OceanSurface::Cached(double t) const {
+    for (const std::shared_ptr<OceanSurfaceFrame>& f : cache_->frames)
+        if (std::bit_cast<uint64_t>(f->t_s_) == std::bit_cast<uint64_t>(t)) return f;
+    return nullptr;
+}
+
 std::shared_ptr<OceanSurfaceFrame> OceanSurface::FreeFrame() const {
     std::vector<std::shared_ptr<OceanSurfaceFrame>>& frames = cache_->frames;
     std::shared_ptr<OceanSurfaceFrame> frame;
@@ -499,14 +505,12 @@ std::shared_ptr<OceanSurfaceFrame> OceanSurface::FreeFrame() const {
 std::shared_ptr<const OceanSurfaceFrame> OceanSurface::At(double t) const {
     CHECK(std::isfinite(t));
     std::lock_guard<std::mutex> lock(cache_->mutex);
-    std::vector<std::shared_ptr<OceanSurfaceFrame>>& frames = cache_->frames;
-    for (const std::shared_ptr<OceanSurfaceFrame>& f : frames)
-        if (std::bit_cast<uint64_t>(f->t_s_) == std::bit_cast<uint64_t>(t)) return f;
+    if (std::shared_ptr<OceanSurfaceFrame> cached = Cached(t)) return cached;
     std::shared_ptr<OceanSurfaceFrame> frame = FreeFrame();
     // Isolated: while this thread waits inside the synthesis' parallel loops it must not pick
     // up an outer task that could ask for a frame and block on the held lock.
     tbb::this_task_arena::isolate([&] { Fill(*frame, t, false); });
-    frames.push_back(frame);
+    cache_->frames.push_back(frame);
     return frame;
 }
 
@@ -523,9 +527,7 @@ void OceanSurface::Adopt(double t, std::span<const uint8_t> fields) const {
         return;
     }
     std::lock_guard<std::mutex> lock(cache_->mutex);
-    std::vector<std::shared_ptr<OceanSurfaceFrame>>& frames = cache_->frames;
-    for (const std::shared_ptr<OceanSurfaceFrame>& f : frames)
-        if (std::bit_cast<uint64_t>(f->t_s_) == std::bit_cast<uint64_t>(t)) return;
+    if (Cached(t)) return;
     // The oldest frame's buffers when free; decoded and checked before it enters the cache.
     std::shared_ptr<OceanSurfaceFrame> frame = FreeFrame();
     FftOceanFrame& in = frame->fft_;
@@ -543,7 +545,7 @@ void OceanSurface::Adopt(double t, std::span<const uint8_t> fields) const {
     // Isolated as in At: the textures' parallel loops must not run an outer task that could ask
     // for a frame while this thread holds the lock.
     tbb::this_task_arena::isolate([&] { Complete(*frame, t); });
-    frames.push_back(frame);
+    cache_->frames.push_back(frame);
 }
 
 std::shared_ptr<const OceanSurfaceFrame> OceanSurface::AtWithVelocity(double t) const {

@@ -257,6 +257,9 @@ class OceanSurface {
     void Fill(OceanSurfaceFrame& frame, double t_s, bool withVelocity) const;
     // Everything of Fill after the synthesis of frame.fft_ (made or adopted).
     void Complete(OceanSurfaceFrame& frame, double t_s) const;
+    // The cached frame at t_s (times compared bit for bit), else null; the cache's mutex must
+    // be held.
+    std::shared_ptr<OceanSurfaceFrame> Cached(double t_s) const;
     // A frame to fill for the cache (the oldest one's buffers when no one holds it); the
     // cache's mutex must be held.
     std::shared_ptr<OceanSurfaceFrame> FreeFrame() const;
