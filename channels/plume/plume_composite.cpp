@@ -42,6 +42,16 @@ constexpr float kSeaAlbedo = 0.06f;
 constexpr int kCell = 4;
 constexpr float kInterpolationTolerance = 0.02f;
 constexpr float kInterpolationTolerance_K = 10.0f;
+// A cell whose corners disagree but which no puff smaller than a cell reaches is blended all
+// the same when the blend of its corners at its centre pixel matches that pixel's own trace
+// within these: the field then varies linearly across the cell (the edge of a puff many cells
+// wide), which bilinear interpolation reproduces. For a twice-differentiable field the leading
+// error term of bilinear interpolation on a square of side h, ½[x(h − x) f_xx + y(h − y) f_yy],
+// is largest at the centre (de Boor, "A Practical Guide to Splines" (1978) ch. XVII, the
+// tensor-product error), so the centre's error estimates the cell's; a quarter of the
+// interpolation tolerance (half in temperature) leaves room for the higher terms.
+constexpr float kCentreTolerance = 0.25f * kInterpolationTolerance;
+constexpr float kCentreTolerance_K = 0.5f * kInterpolationTolerance_K;
 // A pixel whose samples' surface ranges differ by more than this ratio traces a second ray.
 constexpr float kDepthEdgeRatio = 1.1f;
 
@@ -804,9 +814,8 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                     }
                     const float depthInFront = DepthInFront(cx, cy, dNear);
                     bool clearSky = false;
-                    const bool smooth =
-                        Smooth(corner, cornerT, list.smallOpticalDepth > kInterpolationTolerance,
-                               clearSky);
+                    const bool fine = list.smallOpticalDepth > kInterpolationTolerance;
+                    bool smooth = Smooth(corner, cornerT, fine, clearSky);
                     // Where the cell is not smooth, its sky pixels are refined on 2 × 2-pixel
                     // sub-cells: sky traces at the 3 × 3 nodes every 2 pixels (made when the
                     // first sky pixel needs them), the same criteria with the puffs smaller
@@ -816,6 +825,8 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                     float subT[3][3];
                     bool subSmooth[2][2], subClear[2][2];
                     bool refined = false;
+                    // The centre pixel's sky trace (sub[1][1]) once made by CheckCentre.
+                    bool centreTraced = false;
                     // Counts `rays` rays about to be traced in one pass over the cell's list,
                     // whose data is gathered into contiguous arrays before its first pass (the
                     // traces are the same bit for bit either way; a trace over the list's
@@ -824,6 +835,29 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                         bins.Copy(list);
                         traces += uint64_t(rays);
                         tests += list.size();
+                    };
+                    constexpr int kHalf = kCell / 2;
+                    const auto TraceSub = [&](int a, int b) {
+                        Count(1);
+                        sub[b][a] = bins.Trace(
+                            list, PixelDirection(cx * kCell + a * kHalf, cy * kCell + b * kHalf),
+                            kPlumeSkyRange_m);
+                        subT[b][a] = std::exp(-sub[b][a].opticalDepth);
+                    };
+                    // Whether the corners' blend at the centre pixel matches its own trace
+                    // (kCentreTolerance); the trace is kept for the centre pixel and Refine.
+                    const auto CentreMatches = [&] {
+                        TraceSub(1, 1);
+                        centreTraced = true;
+                        const BandTrace blend = plume_detail::Bilinear(corner, 0.5f, 0.5f);
+                        if (!(std::abs(std::exp(-blend.opticalDepth) - subT[1][1]) <=
+                              kCentreTolerance))
+                            return false;
+                        // Temperatures where both see absorbing puffs (else both see none: a
+                        // blend has absorption wherever a corner has).
+                        const float tBlend = blend.temperature_K, tCentre = sub[1][1].temperature_K;
+                        if ((tBlend > 0.0f) != (tCentre > 0.0f)) return false;
+                        return std::abs(tBlend - tCentre) <= kCentreTolerance_K;
                     };
                     const auto Refine = [&] {
                         refined = true;
@@ -834,12 +868,8 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                                     subT[b][a] = cornerT[(b / 2) * 2 + a / 2];
                                     continue;
                                 }
-                                Count(1);
-                                sub[b][a] = bins.Trace(list,
-                                                       PixelDirection(cx * kCell + a * (kCell / 2),
-                                                                      cy * kCell + b * (kCell / 2)),
-                                                       kPlumeSkyRange_m);
-                                subT[b][a] = std::exp(-sub[b][a].opticalDepth);
+                                if (a == 1 && b == 1 && centreTraced) continue;
+                                TraceSub(a, b);
                             }
                         const bool subFine = list.halfSmallOpticalDepth > kInterpolationTolerance;
                         for (int sb = 0; sb < 2; ++sb)
@@ -928,6 +958,12 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                             if (rMin >= dFar) {
                                 // Every surface behind the plumes: the sky trace is the trace.
                                 if (clearSky) continue;
+                                if (!smooth && !fine && !centreTraced) smooth = CentreMatches();
+                                if (smooth && centreTraced && px == cx * kCell + kHalf &&
+                                    py == cy * kCell + kHalf) {
+                                    Defer(sub[1][1], px, py);
+                                    continue;
+                                }
                                 if (smooth) {
                                     blendFx[blended] = float(px - cx * kCell) / kCell;
                                     blendFy[blended] = float(py - cy * kCell) / kCell;
@@ -937,7 +973,6 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                                 }
                                 if (!refined) Refine();
                                 const int lx = px - cx * kCell, ly = py - cy * kCell;
-                                constexpr int kHalf = kCell / 2;
                                 const int sa = lx / kHalf, sb = ly / kHalf;
                                 const int ix = lx - sa * kHalf, iy = ly - sb * kHalf;
                                 if (ix == 0 && iy == 0) {

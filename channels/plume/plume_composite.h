@@ -117,9 +117,12 @@ inline constexpr float kPlumeSkyRange_m = 1.0e6f;
 // a cell, with the ranges of its samples' surfaces (sky: kPlumeSkyRange_m):
 //  - all surfaces nearer than the cell's puffs: nothing to do;
 //  - all surfaces beyond them: the sky trace, bilinear from traces at the corners of the cell
-//    when the corners' transmittances agree within 0.02 and their temperatures (where they see
-//    absorbing puffs) within 10 K, and the puffs smaller than a cell reaching it could add at
-//    most 0.02 in optical depth; else traced through the pixel centre;
+//    when the puffs smaller than a cell reaching it could add at most 0.02 in optical depth and
+//    either the corners' transmittances agree within 0.02 and their temperatures (where they
+//    see absorbing puffs) within 10 K, or the corners' blend at the cell's centre pixel matches
+//    that pixel's own trace within 0.005 and 5 K (a linear variation across the cell); else
+//    refined on 2 × 2-pixel sub-cells by the same corner criteria, and traced through the pixel
+//    centre where those fail;
 //  - otherwise one ray through the pixel centre to the nearest surface and, when the ranges
 //    differ by more than 10 %, to the farthest in the same pass; each sample takes the trace
 //    whose end is nearer its own range.
