@@ -738,6 +738,18 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
         return smooth;
     };
 
+    // Whether a blend of traces matches a pixel's own trace within kCentreTolerance in
+    // transmittance and kCentreTolerance_K in temperature (where both see absorbing puffs; else
+    // both must see none).
+    const auto BlendMatches = [](const BandTrace& blend, const BandTrace& own) {
+        if (!(std::abs(std::exp(-blend.opticalDepth) - std::exp(-own.opticalDepth)) <=
+              kCentreTolerance))
+            return false;
+        const float tBlend = blend.temperature_K, tOwn = own.temperature_K;
+        if ((tBlend > 0.0f) != (tOwn > 0.0f)) return false;
+        return std::abs(tBlend - tOwn) <= kCentreTolerance_K;
+    };
+
     // Pass 2, cells in parallel (a row of cells each); each pixel depends only on its own rays
     // and the cell's corner nodes. The rows' costs differ by orders of magnitude, so they are
     // handed out costliest first (by the puff entries of their cells that are not skipped,
@@ -849,15 +861,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                     const auto CentreMatches = [&] {
                         TraceSub(1, 1);
                         centreTraced = true;
-                        const BandTrace blend = plume_detail::Bilinear(corner, 0.5f, 0.5f);
-                        if (!(std::abs(std::exp(-blend.opticalDepth) - subT[1][1]) <=
-                              kCentreTolerance))
-                            return false;
-                        // Temperatures where both see absorbing puffs (else both see none: a
-                        // blend has absorption wherever a corner has).
-                        const float tBlend = blend.temperature_K, tCentre = sub[1][1].temperature_K;
-                        if ((tBlend > 0.0f) != (tCentre > 0.0f)) return false;
-                        return std::abs(tBlend - tCentre) <= kCentreTolerance_K;
+                        return BlendMatches(plume_detail::Bilinear(corner, 0.5f, 0.5f), sub[1][1]);
                     };
                     const auto Refine = [&] {
                         refined = true;
@@ -893,6 +897,80 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                         pendingTrace[pending] = t;
                         pendingPx[pending] = px, pendingPy[pending] = py;
                         ++pending;
+                    };
+                    // The pixels with one trace to their nearest surface (inside the puffs'
+                    // ranges, no depth edge), in the loop's order, made by SurfacePixels.
+                    int surfaces = 0, surfPx[kPixels], surfPy[kPixels];
+                    glm::vec3 surfDir[kPixels];
+                    float surfRange[kPixels];
+                    // Where every pixel of the cell is such a pixel, no puff smaller than a cell
+                    // reaches it and its ranges have no edge (SmoothRanges), the traces at its four
+                    // corner pixels are blended for the others when the blend matches the own
+                    // traces of two inner pixels (1, 1) and (2, 2) (BlendMatches): the optical
+                    // depth to a smooth surface through puffs wider than the cell is as smooth
+                    // across it as the sky's. Else every pixel is traced.
+                    const auto SurfacePixels = [&] {
+                        BandTrace own[kPixels];
+                        bool traced[kPixels] = {};
+                        const auto TraceOwn = [&](int k) {
+                            Count(1);
+                            own[k] = bins.Trace(list, surfDir[k], surfRange[k]);
+                            traced[k] = true;
+                        };
+                        constexpr int kLast = kCell - 1;
+                        // No depth edge between the pixels: each range within kDepthEdgeRatio
+                        // of the blend of the corners' (a smooth surface, however oblique).
+                        const auto SmoothRanges = [&] {
+                            const float r[4] = {surfRange[0], surfRange[kLast],
+                                                surfRange[kLast * kCell], surfRange[kPixels - 1]};
+                            for (int k = 0; k < kPixels; ++k) {
+                                const float fx = float(k % kCell) / kLast,
+                                            fy = float(k / kCell) / kLast;
+                                const float blend = (1.0f - fy) * ((1.0f - fx) * r[0] + fx * r[1]) +
+                                                    fy * ((1.0f - fx) * r[2] + fx * r[3]);
+                                if (!(std::abs(surfRange[k] - blend) <=
+                                      (kDepthEdgeRatio - 1.0f) * blend))
+                                    return false;
+                            }
+                            return true;
+                        };
+                        const BandTrace* const ends[4] = {&own[0], &own[kLast], &own[kLast * kCell],
+                                                          &own[kLast * kCell + kLast]};
+                        bool blend = false;
+                        if (surfaces == kPixels && !fine && SmoothRanges()) {
+                            {
+                                for (const int k : {0, kLast, kLast * kCell, kPixels - 1, kCell + 1,
+                                                    2 * kCell + 2})
+                                    TraceOwn(k);
+                                blend = true;
+                                for (const int k : {kCell + 1, 2 * kCell + 2})
+                                    blend =
+                                        blend && BlendMatches(plume_detail::Bilinear(
+                                                                  ends, float(k % kCell) / kLast,
+                                                                  float(k / kCell) / kLast),
+                                                              own[k]);
+                            }
+                        }
+                        // The others, blended four at a time (Bilinear4) or traced.
+                        int rest[kPixels], n = 0;
+                        for (int k = 0; k < surfaces; ++k) {
+                            if (!traced[k] && !blend) TraceOwn(k);
+                            if (traced[k])
+                                Defer(own[k], surfPx[k], surfPy[k]);
+                            else
+                                rest[n++] = k;
+                        }
+                        for (int j = 0; j < n; j += 4) {
+                            float fx[4], fy[4];
+                            for (int l = 0; l < 4; ++l) {
+                                const int k = rest[std::min(j + l, n - 1)];
+                                fx[l] = float(k % kCell) / kLast, fy[l] = float(k / kCell) / kLast;
+                            }
+                            BandTrace out[4];
+                            Bilinear4(ends, fx, fy, out);
+                            for (int l = 0; l < std::min(4, n - j); ++l)
+                                Defer(out[l], surfPx[rest[j + l]], surfPy[rest[j + l]]);
+                        }
                     };
                     for (int py = cy * kCell; py < std::min(H, (cy + 1) * kCell); ++py) {
                         for (int px = cx * kCell; px < std::min(W, (cx + 1) * kCell); ++px) {
@@ -1002,11 +1080,13 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                                 Apply(nearTrace, Dir(), px, py, range.data(), rMin, rMax,
                                       &farTrace);
                             } else {
-                                Count(1);
-                                Defer(bins.Trace(list, Dir(), rMin), px, py);
+                                surfPx[surfaces] = px, surfPy[surfaces] = py;
+                                surfDir[surfaces] = Dir(), surfRange[surfaces] = rMin;
+                                ++surfaces;
                             }
                         }
                     }
+                    if (surfaces > 0) SurfacePixels();
                     for (int k = 0; k < blended; k += 4) {
                         // A last group of fewer than four repeats its first pixel.
                         float fx[4], fy[4];
