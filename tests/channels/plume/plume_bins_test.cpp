@@ -171,39 +171,62 @@ TEST(PlumeScreenBins, GatherFromALargerListEqualsGatherFromTheTiles) {
 // A row of rectangles gathered in one pass (GatherRow) gets the lists that Gather makes for
 // each rectangle on its own: the same puffs in the same order, ranges and small-puff sums bit
 // for bit, for CompositePlumes' 4 × 4 cells (step 4, width 5) and for other steps and widths,
-// the rows running past the bin area's right and bottom edges.
+// the rows running past the bin area's right and bottom edges, in the visible and LWIR bands.
 TEST(PlumeScreenBins, GatherRowEqualsGatherPerRectangle) {
     const scene::PlumeField field = CommittedPlumes();
-    const ChannelCamera cam = NorthCamera({0.0, 0.0, 20.0}, 200, 150, 40.0, 3.0);
-    const PlumeScreenBins bins(field, cam, ObscurantBand::Visible);
-    PlumeScreenBins::List strip, single;
-    std::vector<PlumeScreenBins::List> row(12);
-    size_t nonEmpty = 0, compared = 0;
-    for (const auto [step, width, cells] : {std::array{4, 5, 8}, {3, 7, 11}, {5, 2, 7}}) {
-        const int stripWidth = (cells - 1) * step + width;
-        for (int y0 = 0; y0 < cam.height + PlumeScreenBins::kMargin; y0 += 4) {
-            for (int x0 = 0; x0 < cam.width + PlumeScreenBins::kMargin; x0 += stripWidth) {
-                bins.Gather(x0, y0, x0 + stripWidth, y0 + 5, 4.0f, false, strip);
-                bins.GatherRow(strip, x0, y0, y0 + 5, step, width, cells, 4.0f, row);
-                for (int c = 0; c < cells; ++c) {
-                    const int x = x0 + c * step;
-                    bins.Gather(x, y0, x + width, y0 + 5, 4.0f, false, single);
-                    const PlumeScreenBins::List& l = row[size_t(c)];
-                    ASSERT_EQ(l.count, single.count) << x << ", " << y0;
-                    EXPECT_EQ(l.index, single.index);
-                    EXPECT_EQ(std::memcmp(&l.near_m, &single.near_m, 4), 0);
-                    EXPECT_EQ(std::memcmp(&l.far_m, &single.far_m, 4), 0);
-                    EXPECT_EQ(std::memcmp(&l.smallOpticalDepth, &single.smallOpticalDepth, 4), 0);
-                    EXPECT_EQ(
-                        std::memcmp(&l.halfSmallOpticalDepth, &single.halfSmallOpticalDepth, 4), 0);
-                    nonEmpty += single.count > 0;
-                    ++compared;
-                }
-            }
+    // The 40° view, rows taken from their strip's list, and a 6° one on the fire where puffs
+    // span tens of tiles (there the ellipses' spans, not their rectangles, decide many lists),
+    // rows taken from the list of every kept puff. (A strip's own test, with the strip's half
+    // diagonal, can drop a puff whose ellipse meets only the disc round a cell at the strip's
+    // end, not the cell: no ray through the cell meets it, so the lists hold every puff that
+    // matters either way, but Gather per cell keeps it.)
+    ChannelCamera narrow = NorthCamera({0.0, 0.0, 20.0}, 200, 150, 6.0, 1.5);
+    scene::Attitude attitude;
+    attitude.heading_rad = std::atan2(-300.0, 2000.0);
+    attitude.pitch_rad = 1.5 * std::numbers::pi / 180.0;
+    narrow.worldFromCamera.worldFromBody = scene::WorldFromBodyRotation(attitude);
+    const ChannelCamera cameras[] = {NorthCamera({0.0, 0.0, 20.0}, 200, 150, 40.0, 3.0), narrow};
+    for (const ChannelCamera& cam : cameras) {
+        const bool wide = &cam == &cameras[0];
+        // The visible band's bins and the LWIR band's (other cutoffs, so other spans).
+        const PlumeScreenBins bands[2] = {{field, cam, ObscurantBand::Visible},
+                                          {field, cam, ObscurantBand::Lwir}};
+        PlumeScreenBins::List all[2], strip, single;
+        for (int b = 0; b < 2; ++b) {
+            for (uint32_t k = 0; k < bands[b].KeptPuffs(); ++k) all[b].index.push_back(k);
+            all[b].count = all[b].index.size();
         }
+        std::vector<PlumeScreenBins::List> row(12);
+        size_t nonEmpty = 0, compared = 0;
+        // GatherRow of bins for the strip at x0 against Gather per rectangle.
+        const auto check = [&](int b, int x0, int y0, int step, int width, int cells) {
+            const PlumeScreenBins& bins = bands[b];
+            bins.Gather(x0, y0, x0 + (cells - 1) * step + width, y0 + 5, 4.0f, false, strip);
+            bins.GatherRow(wide ? strip : all[b], x0, y0, y0 + 5, step, width, cells, 4.0f, row);
+            for (int c = 0; c < cells; ++c) {
+                const int x = x0 + c * step;
+                bins.Gather(x, y0, x + width, y0 + 5, 4.0f, false, single);
+                const PlumeScreenBins::List& l = row[size_t(c)];
+                ASSERT_EQ(l.count, single.count) << x << ", " << y0 << " band " << b;
+                EXPECT_EQ(l.index, single.index);
+                EXPECT_EQ(std::memcmp(&l.near_m, &single.near_m, 4), 0);
+                EXPECT_EQ(std::memcmp(&l.far_m, &single.far_m, 4), 0);
+                EXPECT_EQ(std::memcmp(&l.smallOpticalDepth, &single.smallOpticalDepth, 4), 0);
+                EXPECT_EQ(std::memcmp(&l.halfSmallOpticalDepth, &single.halfSmallOpticalDepth, 4),
+                          0);
+                nonEmpty += single.count > 0;
+                ++compared;
+            }
+        };
+        for (const auto [step, width, cells] : {std::array{4, 5, 8}, {3, 7, 11}, {5, 2, 7}}) {
+            const int stripWidth = (cells - 1) * step + width;
+            for (int y0 = 0; y0 < cam.height + PlumeScreenBins::kMargin; y0 += 4)
+                for (int x0 = 0; x0 < cam.width + PlumeScreenBins::kMargin; x0 += stripWidth)
+                    for (int b = 0; b < 2; ++b) check(b, x0, y0, step, width, cells);
+        }
+        EXPECT_GT(nonEmpty, 300u);
+        EXPECT_GT(nonEmpty * 10, compared);  // the plumes fill a good part of the view
     }
-    EXPECT_GT(nonEmpty, 300u);
-    EXPECT_GT(nonEmpty * 10, compared);  // the plumes fill a good part of the view
 }
 
 // A cell's list holds every puff whose cutoff ellipsoid (τ_max e^(−r²/2) = ε) a ray through
