@@ -631,8 +631,9 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                     // The cells of one tile column take their puffs from the list of the tile's
                     // block (a cell reaches one pixel beyond itself), in one GatherRow: a puff
                     // outside the row's pixel rows is passed over at the first test. (Gathering
-                    // the row's strip of the block first repeated GatherRow's ellipse test per
-                    // puff: 6 % of the FLIR frame.)
+                    // the row's strip of the block first tested every puff's ellipse twice, and
+                    // its test with the strip's half diagonal could drop a puff that Gather per
+                    // cell keeps: PlumeScreenBins.GatherRowEqualsGatherPerRectangle.)
                     constexpr int kCellsPerTile = kTile / kCell;
                     static_assert(kTile % kCell == 0);
                     if (cx % kCellsPerTile == 0)
