@@ -835,7 +835,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                     float subT[3][3];
                     bool subSmooth[2][2], subClear[2][2];
                     bool refined = false;
-                    // The centre pixel's sky trace (sub[1][1]) once made by CheckCentre.
+                    // The centre pixel's sky trace (sub[1][1]) once made by CentreMatches.
                     bool centreTraced = false;
                     // Counts `rays` rays about to be traced in one pass over the cell's list,
                     // whose data is gathered into contiguous arrays before its first pass (the
@@ -936,18 +936,15 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                                                           &own[kLast * kCell + kLast]};
                         bool blend = false;
                         if (surfaces == kPixels && !fine && SmoothRanges()) {
-                            {
-                                for (const int k : {0, kLast, kLast * kCell, kPixels - 1, kCell + 1,
-                                                    2 * kCell + 2})
-                                    TraceOwn(k);
-                                blend = true;
-                                for (const int k : {kCell + 1, 2 * kCell + 2})
-                                    blend =
-                                        blend && BlendMatches(plume_detail::Bilinear(
+                            for (const int k :
+                                 {0, kLast, kLast * kCell, kPixels - 1, kCell + 1, 2 * kCell + 2})
+                                TraceOwn(k);
+                            blend = true;
+                            for (const int k : {kCell + 1, 2 * kCell + 2})
+                                blend = blend && BlendMatches(plume_detail::Bilinear(
                                                                   ends, float(k % kCell) / kLast,
                                                                   float(k / kCell) / kLast),
                                                               own[k]);
-                            }
                         }
                         // The others, blended four at a time (Bilinear4) or traced.
                         int rest[kPixels], n = 0;
