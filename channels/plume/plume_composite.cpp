@@ -789,6 +789,22 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                 const auto DepthAt = [&](int sx, int sy) {
                     return depthRows[size_t(sy - sy0) * size_t(vis.width) + size_t(sx)];
                 };
+                // Whether every sample of whole cell cx sees the sky (ReadDepths' −1), four
+                // samples at a time (SSE2).
+                const auto CellSeesOnlySky = [&](int cx, const float* depths) {
+                    const __m128 zero = _mm_setzero_ps();
+                    __m128 sky = _mm_castsi128_ps(_mm_set1_epi32(-1));
+                    bool rest = true;
+                    for (int j = 0; j < rowSamples; ++j) {
+                        const float* d = depths + size_t(j) * size_t(vis.width) +
+                                         size_t(cx) * size_t(rowSamples);
+                        int i = 0;
+                        for (; i + 4 <= rowSamples; i += 4)
+                            sky = _mm_and_ps(sky, _mm_cmplt_ps(_mm_loadu_ps(d + i), zero));
+                        for (; i < rowSamples; ++i) rest &= d[i] < 0.0f;
+                    }
+                    return rest && _mm_movemask_ps(sky) == 0xf;
+                };
                 for (int cx = 0; cx < cellsX; ++cx) {
                     if (row.count[size_t(cx)] == 0) continue;
                     // Every pixel of the cell is skipped by the test minDepth ≥ depthInFront.
@@ -967,6 +983,49 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                                 Defer(out[l], surfPx[rest[j + l]], surfPy[rest[j + l]]);
                         }
                     };
+                    // The blended pixels four at a time, then every deferred pixel composited.
+                    const auto BlendAndApply = [&] {
+                        for (int k = 0; k < blended; k += 4) {
+                            // A last group of fewer than four repeats its first pixel.
+                            float fx[4], fy[4];
+                            for (int l = 0; l < 4; ++l) {
+                                const int m = k + l < blended ? k + l : k;
+                                fx[l] = blendFx[m], fy[l] = blendFy[m];
+                            }
+                            BandTrace out[4];
+                            Bilinear4(corner, fx, fy, out);
+                            for (int l = 0; l < std::min(4, blended - k); ++l)
+                                Defer(out[l], blendPx[k + l], blendPy[k + l]);
+                        }
+                        ApplyCell(pendingTrace, pendingPx, pendingPy, pending);
+                    };
+                    // A whole cell whose every sample sees the sky, clear or smooth (after the
+                    // centre test), takes what the loop below would give each of its pixels
+                    // (nothing, or the blend of its corners; the centre pixel its own trace),
+                    // in the same order, without the loop's tests per pixel.
+                    const bool wholeCell = (cx + 1) * kCell <= W && (cy + 1) * kCell <= H;
+                    if (wholeCell && kPlumeSkyRange_m > dNear && kPlumeSkyRange_m >= dFar &&
+                        CellSeesOnlySky(cx, depthRows.data())) {
+                        if (!clearSky && !smooth && !fine) smooth = CentreMatches();
+                        if (clearSky || smooth) {
+                            covered += uint64_t(kCellPixels);
+                            if (!clearSky)
+                                for (int ly = 0; ly < kCell; ++ly)
+                                    for (int lx = 0; lx < kCell; ++lx) {
+                                        const int px = cx * kCell + lx, py = cy * kCell + ly;
+                                        if (centreTraced && lx == kHalf && ly == kHalf) {
+                                            Defer(sub[1][1], px, py);
+                                            continue;
+                                        }
+                                        blendFx[blended] = float(lx) / kCell;
+                                        blendFy[blended] = float(ly) / kCell;
+                                        blendPx[blended] = px, blendPy[blended] = py;
+                                        ++blended;
+                                    }
+                            BlendAndApply();
+                            continue;
+                        }
+                    }
                     for (int py = cy * kCell; py < std::min(H, (cy + 1) * kCell); ++py) {
                         for (int px = cx * kCell; px < std::min(W, (cx + 1) * kCell); ++px) {
                             ++covered;
@@ -1082,19 +1141,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                         }
                     }
                     if (surfaces > 0) SurfacePixels();
-                    for (int k = 0; k < blended; k += 4) {
-                        // A last group of fewer than four repeats its first pixel.
-                        float fx[4], fy[4];
-                        for (int l = 0; l < 4; ++l) {
-                            const int m = k + l < blended ? k + l : k;
-                            fx[l] = blendFx[m], fy[l] = blendFy[m];
-                        }
-                        BandTrace out[4];
-                        Bilinear4(corner, fx, fy, out);
-                        for (int l = 0; l < std::min(4, blended - k); ++l)
-                            Defer(out[l], blendPx[k + l], blendPy[k + l]);
-                    }
-                    ApplyCell(pendingTrace, pendingPx, pendingPy, pending);
+                    BlendAndApply();
                 }
                 rowCovered[size_t(cy)] = covered;
                 rowTraces[size_t(cy)] += traces, rowTests[size_t(cy)] += tests;
