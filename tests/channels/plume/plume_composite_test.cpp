@@ -322,6 +322,31 @@ double ExactVisibleTransmittance(const scene::PlumeField& field, const glm::dvec
     return std::exp(-tau);
 }
 
+// CompositePlumes of field over a white image with Dark() light, so that each pixel holds its
+// transmittance, compared at every pixel with ExactVisibleTransmittance to range_m(x, y): the
+// stats and the largest difference; visit(range, T) sees each pixel's exact T.
+template <class Range, class Visit>
+std::pair<PlumeCompositeStats, double> CompositeAgainstExact(const scene::PlumeField& field,
+                                                             const ChannelCamera& cam,
+                                                             const VisibilityBuffer& vis,
+                                                             const Range& range_m,
+                                                             const Visit& visit) {
+    Image image(cam.SampleWidth(), cam.SampleHeight(), 3);
+    std::fill(image.pixels.begin(), image.pixels.end(), 1.0f);
+    const PlumeCompositeStats stats = CompositePlumes(field, cam, vis, Dark(), image);
+    const glm::dvec3 eye = cam.worldFromCamera.position_m;
+    double worst = 0.0;
+    for (int y = 0; y < cam.height; ++y) {
+        for (int x = 0; x < cam.width; ++x) {
+            const double s = range_m(x, y);
+            const double T = ExactVisibleTransmittance(field, eye, cam.SampleDirection(x, y), s);
+            worst = std::max(worst, std::abs(double(image.At(x, y)[0]) - T));
+            visit(s, T);
+        }
+    }
+    return {stats, worst};
+}
+
 // Committed plumes seen against the sky, where most pixels are blended from grid nodes or
 // refined (the centre test accepts cells across which a wide puff's edge varies linearly): every
 // pixel's transmittance is within the interpolation tolerance (0.02) of the exact line
@@ -330,21 +355,11 @@ TEST(PlumeComposite, CommittedPlumesWithinTheInterpolationToleranceOfTheExactInt
     const scene::PlumeField field = CommittedFourPlumes();
     const glm::dvec3 eye{0.0, 0.0, 10.0};
     const ChannelCamera cam = NorthCamera(eye, 240, 160, 1);
-    const VisibilityBuffer vis = SkyOnly(cam);
-    Image image(cam.SampleWidth(), cam.SampleHeight(), 3);
-    std::fill(image.pixels.begin(), image.pixels.end(), 1.0f);
-    const PlumeCompositeStats stats = CompositePlumes(field, cam, vis, Dark(), image);
-    EXPECT_LT(double(stats.traces), 0.5 * double(stats.pixelsCovered));
-    double worst = 0.0;
     int dark = 0;
-    for (int y = 0; y < cam.height; ++y) {
-        for (int x = 0; x < cam.width; ++x) {
-            const glm::dvec3 d = cam.SampleDirection(x, y);
-            const double T = ExactVisibleTransmittance(field, eye, d, kPlumeSkyRange_m);
-            worst = std::max(worst, std::abs(double(image.At(x, y)[0]) - T));
-            dark += T < 0.9;
-        }
-    }
+    const auto [stats, worst] = CompositeAgainstExact(
+        field, cam, SkyOnly(cam), [](int, int) { return double(kPlumeSkyRange_m); },
+        [&](double, double T) { dark += T < 0.9; });
+    EXPECT_LT(double(stats.traces), 0.5 * double(stats.pixelsCovered));
     EXPECT_GT(dark, 1000);
     EXPECT_LT(worst, 0.02);
 }
@@ -374,22 +389,13 @@ TEST(PlumeComposite, SurfacesInsideThePlumesWithinTheInterpolationToleranceOfThe
             vis.primitive[vis.Index(x, y)] = 0;
             vis.depth[vis.Index(x, y)] = float(cam.near_m / (s * glm::dot(d, forward)));
         }
-    Image image(cam.SampleWidth(), cam.SampleHeight(), 3);
-    std::fill(image.pixels.begin(), image.pixels.end(), 1.0f);
-    const PlumeCompositeStats stats = CompositePlumes(field, cam, vis, Dark(), image);
+    int darkSea = 0;
+    const auto [stats, worst] = CompositeAgainstExact(
+        field, cam, vis,
+        [&](int x, int y) { return range_m[size_t(y) * size_t(cam.width) + size_t(x)]; },
+        [&](double s, double T) { darkSea += s < kPlumeSkyRange_m && T < 0.98; });
     // Two thirds without blending the surfaces' corner traces.
     EXPECT_LT(double(stats.traces), 0.6 * double(stats.pixelsCovered));
-    double worst = 0.0;
-    int darkSea = 0;
-    for (int y = 0; y < cam.height; ++y) {
-        for (int x = 0; x < cam.width; ++x) {
-            const glm::dvec3 d = cam.SampleDirection(x, y);
-            const double s = range_m[size_t(y) * size_t(cam.width) + size_t(x)];
-            const double T = ExactVisibleTransmittance(field, eye, d, s);
-            worst = std::max(worst, std::abs(double(image.At(x, y)[0]) - T));
-            darkSea += s < kPlumeSkyRange_m && T < 0.98;
-        }
-    }
     EXPECT_GT(darkSea, 2000);
     EXPECT_LT(worst, 0.02);
 }
