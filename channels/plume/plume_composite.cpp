@@ -912,6 +912,37 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                         pendingPx[pending] = px, pendingPy[pending] = py;
                         ++pending;
                     };
+                    // Defers n pixels (px[l], py[l]) blended from corners at (fx[l], fy[l]),
+                    // four at a time (Bilinear4; a last group of fewer than four repeats its
+                    // first pixel).
+                    const auto DeferBlended = [&](const BandTrace* const corners[4],
+                                                  const float* fx, const float* fy, const int* px,
+                                                  const int* py, int n) {
+                        for (int k = 0; k < n; k += 4) {
+                            float gx[4], gy[4];
+                            for (int l = 0; l < 4; ++l) {
+                                const int m = k + l < n ? k + l : k;
+                                gx[l] = fx[m], gy[l] = fy[m];
+                            }
+                            BandTrace out[4];
+                            Bilinear4(corners, gx, gy, out);
+                            for (int l = 0; l < std::min(4, n - k); ++l)
+                                Defer(out[l], px[k + l], py[k + l]);
+                        }
+                    };
+                    // A sky pixel of a smooth cell: its own trace at the centre when the centre
+                    // test made one, else the blend of the cell's corners (made at the end).
+                    const auto BlendSky = [&](int px, int py) {
+                        const int lx = px - cx * kCell, ly = py - cy * kCell;
+                        if (centreTraced && lx == kHalf && ly == kHalf) {
+                            Defer(sub[1][1], px, py);
+                            return;
+                        }
+                        blendFx[blended] = float(lx) / kCell;
+                        blendFy[blended] = float(ly) / kCell;
+                        blendPx[blended] = px, blendPy[blended] = py;
+                        ++blended;
+                    };
                     // The pixels with one trace to their nearest surface (inside the puffs'
                     // ranges, no depth edge), in the loop's order, made by SurfacePixels.
                     int surfaces = 0, surfPx[kPixels], surfPy[kPixels];
@@ -962,41 +993,25 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                                                                   float(k / kCell) / kLast),
                                                               own[k]);
                         }
-                        // The others, blended four at a time (Bilinear4) or traced.
-                        int rest[kPixels], n = 0;
+                        // The others, blended or traced.
+                        int n = 0, restPx[kPixels], restPy[kPixels];
+                        float restFx[kPixels], restFy[kPixels];
                         for (int k = 0; k < surfaces; ++k) {
                             if (!traced[k] && !blend) TraceOwn(k);
-                            if (traced[k])
+                            if (traced[k]) {
                                 Defer(own[k], surfPx[k], surfPy[k]);
-                            else
-                                rest[n++] = k;
-                        }
-                        for (int j = 0; j < n; j += 4) {
-                            float fx[4], fy[4];
-                            for (int l = 0; l < 4; ++l) {
-                                const int k = rest[std::min(j + l, n - 1)];
-                                fx[l] = float(k % kCell) / kLast, fy[l] = float(k / kCell) / kLast;
+                                continue;
                             }
-                            BandTrace out[4];
-                            Bilinear4(ends, fx, fy, out);
-                            for (int l = 0; l < std::min(4, n - j); ++l)
-                                Defer(out[l], surfPx[rest[j + l]], surfPy[rest[j + l]]);
+                            restFx[n] = float(k % kCell) / kLast,
+                            restFy[n] = float(k / kCell) / kLast;
+                            restPx[n] = surfPx[k], restPy[n] = surfPy[k];
+                            ++n;
                         }
+                        DeferBlended(ends, restFx, restFy, restPx, restPy, n);
                     };
                     // The blended pixels four at a time, then every deferred pixel composited.
                     const auto BlendAndApply = [&] {
-                        for (int k = 0; k < blended; k += 4) {
-                            // A last group of fewer than four repeats its first pixel.
-                            float fx[4], fy[4];
-                            for (int l = 0; l < 4; ++l) {
-                                const int m = k + l < blended ? k + l : k;
-                                fx[l] = blendFx[m], fy[l] = blendFy[m];
-                            }
-                            BandTrace out[4];
-                            Bilinear4(corner, fx, fy, out);
-                            for (int l = 0; l < std::min(4, blended - k); ++l)
-                                Defer(out[l], blendPx[k + l], blendPy[k + l]);
-                        }
+                        DeferBlended(corner, blendFx, blendFy, blendPx, blendPy, blended);
                         ApplyCell(pendingTrace, pendingPx, pendingPy, pending);
                     };
                     // A whole cell whose every sample sees the sky, clear or smooth (after the
@@ -1010,18 +1025,9 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                         if (clearSky || smooth) {
                             covered += uint64_t(kCellPixels);
                             if (!clearSky)
-                                for (int ly = 0; ly < kCell; ++ly)
-                                    for (int lx = 0; lx < kCell; ++lx) {
-                                        const int px = cx * kCell + lx, py = cy * kCell + ly;
-                                        if (centreTraced && lx == kHalf && ly == kHalf) {
-                                            Defer(sub[1][1], px, py);
-                                            continue;
-                                        }
-                                        blendFx[blended] = float(lx) / kCell;
-                                        blendFy[blended] = float(ly) / kCell;
-                                        blendPx[blended] = px, blendPy[blended] = py;
-                                        ++blended;
-                                    }
+                                for (int py = cy * kCell; py < (cy + 1) * kCell; ++py)
+                                    for (int px = cx * kCell; px < (cx + 1) * kCell; ++px)
+                                        BlendSky(px, py);
                             BlendAndApply();
                             continue;
                         }
@@ -1091,16 +1097,8 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                                 // Every surface behind the plumes: the sky trace is the trace.
                                 if (clearSky) continue;
                                 if (!smooth && !fine && !centreTraced) smooth = CentreMatches();
-                                if (smooth && centreTraced && px == cx * kCell + kHalf &&
-                                    py == cy * kCell + kHalf) {
-                                    Defer(sub[1][1], px, py);
-                                    continue;
-                                }
                                 if (smooth) {
-                                    blendFx[blended] = float(px - cx * kCell) / kCell;
-                                    blendFy[blended] = float(py - cy * kCell) / kCell;
-                                    blendPx[blended] = px, blendPy[blended] = py;
-                                    ++blended;
+                                    BlendSky(px, py);
                                     continue;
                                 }
                                 if (!refined) Refine();
