@@ -364,17 +364,8 @@ inline bool PlumeScreenBins::Reaches(uint32_t k, int x0, int y0, int x1, int y1,
     return cx >= lo && cx <= hi;
 }
 
-inline void PlumeScreenBins::Add(uint32_t k, float smallPixels, List& out) const {
-    const Footprint& fp = footprint_[k];
-    out.index.push_back(k);
-    out.near_m = std::min(out.near_m, fp.near_m);
-    out.far_m = std::max(out.far_m, fp.far_m);
-    if (fp.sigmaPixels < smallPixels) out.smallOpticalDepth += fp.tauMax;
-    if (fp.sigmaPixels < 0.5f * smallPixels) out.halfSmallOpticalDepth += fp.tauMax;
-}
-
 inline void PlumeScreenBins::AddRange(uint32_t k, float smallPixels, std::span<List> out) const {
-    // Add for each list, with the puff's tests made once.
+    // The puff's small-puff tests made once for all the lists.
     const Footprint& fp = footprint_[k];
     const bool small = fp.sigmaPixels < smallPixels,
                halfSmall = fp.sigmaPixels < 0.5f * smallPixels;
@@ -385,6 +376,10 @@ inline void PlumeScreenBins::AddRange(uint32_t k, float smallPixels, std::span<L
         if (small) o.smallOpticalDepth += fp.tauMax;
         if (halfSmall) o.halfSmallOpticalDepth += fp.tauMax;
     }
+}
+
+inline void PlumeScreenBins::Add(uint32_t k, float smallPixels, List& out) const {
+    AddRange(k, smallPixels, std::span<List>(&out, 1));
 }
 
 inline void PlumeScreenBins::Take(uint32_t k, int x0, int y0, int x1, int y1, float rho,

@@ -168,7 +168,8 @@ class PlumeScreenBins {
     // list.
     bool Reaches(uint32_t k, int x0, int y0, int x1, int y1, float rho) const;
     void Add(uint32_t k, float smallPixels, List& out) const;
-    // Add(k, smallPixels, list) for every list of out.
+    // Puts puff k in every list of out (its index, ranges and small-puff sums); Add is this for
+    // one list.
     void AddRange(uint32_t k, float smallPixels, std::span<List> out) const;
     uint32_t inert_ = 0;
     // Starts out's list for the rectangle and adds puff k to it if it Reaches the rectangle.
