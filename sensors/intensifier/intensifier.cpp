@@ -71,13 +71,6 @@ inline VD SqrtVD(VD v) {
     return VD{std::sqrt(v[0]), std::sqrt(v[1]), std::sqrt(v[2]), std::sqrt(v[3])};
 #endif
 }
-// scene::Mix64 on each lane.
-inline VU Mix64Lanes(VU z) {
-    z += 0x9e3779b97f4a7c15ULL;
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-}
 // Σ term(L[x]) over the span in the order of x: the terms (a function of four doubles, lane for
 // lane) four at a time.
 template <class Term>
@@ -358,7 +351,8 @@ void Intensifier::Process(const Image& samples, double time_s, int64_t frame) {
         noise.z.resize(size_t(count + 4));
         for (int j = 0; j < count; j += 4) {
             const VU counter = VU{0, 1, 2, 3} + uint64_t(i0 + size_t(span.begin + j));
-            const VU bits = Mix64Lanes(counter ^ key);  // scene::HashBits(seed, frame, pixel)
+            const VU bits =
+                scene::Mix64Lanes(counter ^ key);  // scene::HashBits(seed, frame, pixel)
             std::memcpy(&noise.bits[size_t(j)], &bits, sizeof bits);
             const auto low =
                 __builtin_convertvector(bits, uint32_t __attribute__((vector_size(16))));

@@ -91,16 +91,8 @@ void NormalsFromBits(const uint32_t* bits, size_t count, float* z) {
         const simd::VF f =
             __builtin_convertvector(simd::VI(v & ((1u << kFractionBits) - 1)), simd::VF) *
             (1.0f / (1u << kFractionBits));
-#if defined(__AVX2__)
-        const simd::VF t0 = _mm256_i32gather_ps(t.value.data(), __m256i(k), 4);
-        const simd::VF t1 = _mm256_i32gather_ps(t.value.data() + 1, __m256i(k), 4);
-#else
-        simd::VF t0, t1;
-        for (size_t l = 0; l < simd::kLanes; ++l) {
-            t0[l] = t.value[k[l]];
-            t1[l] = t.value[k[l] + 1];
-        }
-#endif
+        const simd::VF t0 = simd::Gather(t.value.data(), simd::VI(k));
+        const simd::VF t1 = simd::Gather(t.value.data() + 1, simd::VI(k));
         const simd::VF zl = t0 + f * (t1 - t0);
         simd::Store(z + i, simd::VF(simd::VI(zl) ^ simd::VI(b << 31)));
     }
