@@ -86,17 +86,24 @@ float CoxMunkSlopeVariance(double windSpeed_mps) {
 // scalar code's operations in the scalar code's order, so a sample's result does not depend on
 // its neighbours, the batch size, the lane count or the thread count.
 
-// Normalizes count directions in place: v · (1 / √(v·v)), as glm::normalize.
+// Normalizes the vectors (x, y, z) of the lanes: v · (1 / √(v·v)), as glm::normalize.
+inline void NormalizeLanes(simd::VF& x, simd::VF& y, simd::VF& z) {
+    using namespace simd;
+    const VF inv = 1.0f / Sqrt(Dot(x, y, z, x, y, z));
+    x = x * inv, y = y * inv, z = z * inv;
+}
+
+// Normalizes count directions in place (NormalizeLanes).
 void Normalize(size_t count, float* x, float* y, float* z) {
     using namespace simd;
     for (size_t i = 0; i < count; i += kLanes) {
         const size_t lanes = std::min(kLanes, count - i);
-        const VF dx = Load(x + i, lanes, 0.0f), dy = Load(y + i, lanes, 0.0f),
-                 dz = Load(z + i, lanes, 1.0f);
-        const VF inv = 1.0f / Sqrt(Dot(dx, dy, dz, dx, dy, dz));
-        Store(x + i, dx * inv, lanes);
-        Store(y + i, dy * inv, lanes);
-        Store(z + i, dz * inv, lanes);
+        VF dx = Load(x + i, lanes, 0.0f), dy = Load(y + i, lanes, 0.0f),
+           dz = Load(z + i, lanes, 1.0f);
+        NormalizeLanes(dx, dy, dz);
+        Store(x + i, dx, lanes);
+        Store(y + i, dy, lanes);
+        Store(z + i, dz, lanes);
     }
 }
 
@@ -168,11 +175,9 @@ struct SeaShading {
         static_assert(kChunk % kLanes == 0);
         for (size_t i = 0; i < count; i += kLanes) {
             const size_t lanes = std::min(kLanes, count - i);
-            // The normal normalized as glm::normalize does, v · (1 / √(v·v)).
             VF Nx = Load(nx + i, lanes, 0.0f), Ny = Load(ny + i, lanes, 0.0f),
                Nz = Load(nz + i, lanes, 1.0f);
-            const VF invN = 1.0f / Sqrt(Dot(Nx, Ny, Nz, Nx, Ny, Nz));
-            Nx = Nx * invN, Ny = Ny * invN, Nz = Nz * invN;
+            NormalizeLanes(Nx, Ny, Nz);
             const VF tx = eye.x - Load(px + i, lanes, 0.0f);
             const VF ty = eye.y - Load(py + i, lanes, 0.0f);
             const VF tz = eye.z - Load(pz + i, lanes, 0.0f);
