@@ -48,6 +48,7 @@ void BM_FiveChannelRenderer(benchmark::State& state) {
     // shading, overlays, plumes) and the sensor model, and of the render the sea mesh, the
     // raster and the shading pass.
     double renderMs = 0.0, sensorMs = 0.0, meshMs = 0.0, rasterMs = 0.0, shadeMs = 0.0;
+    double shadowRays = 0.0;
     for (auto _ : state) {
         state.PauseTiming();
         const scene::FrameState fs = world.Advance(frame++);
@@ -66,6 +67,7 @@ void BM_FiveChannelRenderer(benchmark::State& state) {
                                          ? pipeline->Nvg().Otw().Stats()
                                          : pipeline->Otw().Stats();
             meshMs += s.meshMs, rasterMs += s.rasterMs, shadeMs += s.shadeMs;
+            shadowRays += double(s.shadowRays);
         }
     }
     const double n = double(state.iterations());
@@ -74,6 +76,7 @@ void BM_FiveChannelRenderer(benchmark::State& state) {
     state.counters["mesh_ms"] = meshMs / n;
     state.counters["raster_ms"] = rasterMs / n;
     state.counters["shade_ms"] = shadeMs / n;
+    state.counters["shadow_rays"] = shadowRays / n;
 }
 BENCHMARK(BM_FiveChannelRenderer)
     ->ArgNames({"channel", "threads"})
