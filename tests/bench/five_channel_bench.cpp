@@ -118,5 +118,35 @@ void BM_FiveChannelHost(benchmark::State& state) {
 }
 BENCHMARK(BM_FiveChannelHost)->Unit(benchmark::kMillisecond);
 
+// A renderer's own sea work per frame in `run`: decoding the slot the host wrote and adopting
+// its sea fields (OceanSurface::Adopt: decode, check, mip chains and bounds), 1 thread. Each
+// iteration adopts a new frame's fields into the renderer's world.
+void BM_FiveChannelAdopt(benchmark::State& state) {
+    const scene::Scenario& sc = FiveChannel();
+    const scene::World host(sc), renderer(sc);
+    tbb::task_arena arena(1);
+    constexpr int kFrames = 8;
+    std::vector<std::vector<uint8_t>> slots(kFrames);
+    for (int f = 0; f < kFrames; ++f) {
+        const scene::FrameState fs = host.Advance(f);
+        const auto sea = host.Ocean().At(fs.time_s);
+        const scene::FftOceanFrame* fields = sea->Fft();
+        slots[size_t(f)].resize(
+            sync::StateSlotBytes(fs.entityPoses.size(), fields->EncodedBytes()));
+        sync::EncodeStateSlot(
+            fs, fields->EncodedBytes(), [&](uint8_t* out) { fields->Encode(out); },
+            slots[size_t(f)].data(), slots[size_t(f)].size());
+    }
+    int f = 0;
+    for (auto _ : state) {
+        const std::vector<uint8_t>& bytes = slots[size_t(f++ % kFrames)];
+        arena.execute([&] {
+            const sync::StateSlotContents slot = sync::DecodeStateSlot(bytes.data(), bytes.size());
+            renderer.Ocean().Adopt(slot.state.time_s, slot.sea);
+        });
+    }
+}
+BENCHMARK(BM_FiveChannelAdopt)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 }  // namespace
 }  // namespace seasense::channels
