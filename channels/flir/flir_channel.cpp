@@ -169,64 +169,24 @@ UniformTable::UniformTable(std::vector<float> nodes, float xMax)
       scale_(float(nodes_.size() - 1) / xMax),
       last_(float(nodes_.size() - 1)) {
     CHECK(nodes_.size() >= 2 && xMax > 0.0f);
-    cells_.resize(2 * (nodes_.size() - 1));
-    for (size_t i = 0; i + 1 < nodes_.size(); ++i) {
-        cells_[2 * i] = nodes_[i];
-        cells_[2 * i + 1] = nodes_[i + 1];
-    }
 }
 
 void UniformTable::operator()(size_t count, const float* x, float* out) const {
-    // Each lane's cell (node i, node i + 1) by one 64-bit load: on this project's AMD cores two
-    // eight-lane gathers were slower than the loads (BM_UniformTableLanes).
-    const auto Cell = [&](int32_t c) {
-        return reinterpret_cast<const __m64*>(cells_.data() + 2 * size_t(c));
-    };
-#if defined(__AVX2__)
-    // Eight lanes: the four-lane arithmetic below lane for lane.
-    const __m256 scale = _mm256_set1_ps(scale_), last = _mm256_set1_ps(last_),
-                 lastCell = _mm256_set1_ps(float(nodes_.size() - 2));
+    // operator() lane for lane: clamp(x·scale, 0, last) as std::clamp (min(max(u, 0), last)),
+    // the cell's two nodes by simd::GatherPair.
+    // Members in locals: the stores below could alias them as far as the compiler knows.
+    using simd::VF, simd::VI;
+    const float* nodes = nodes_.data();
+    const VF scale = simd::Splat(scale_), last = simd::Splat(last_),
+             lastCell = simd::Splat(float(nodes_.size() - 2));
     for (size_t i = 0; i < count; i += simd::kLanes) {
         const size_t lanes = std::min(simd::kLanes, count - i);
-        const __m256 u = _mm256_min_ps(
-            _mm256_max_ps(_mm256_setzero_ps(),
-                          _mm256_mul_ps(__m256(simd::Load(x + i, lanes, 0.0f)), scale)),
-            last);
-        const __m256i cell = _mm256_cvttps_epi32(_mm256_min_ps(u, lastCell));
-        alignas(32) int32_t c[8];
-        _mm256_store_si256(reinterpret_cast<__m256i*>(c), cell);
-        // (a0 b0 a1 b1 | a4 b4 a5 b5) and (a2 b2 a3 b3 | a6 b6 a7 b7).
-        const __m256 c01 =
-            _mm256_set_m128(_mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), Cell(c[4])), Cell(c[5])),
-                            _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), Cell(c[0])), Cell(c[1])));
-        const __m256 c23 =
-            _mm256_set_m128(_mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), Cell(c[6])), Cell(c[7])),
-                            _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), Cell(c[2])), Cell(c[3])));
-        const __m256 a = _mm256_shuffle_ps(c01, c23, _MM_SHUFFLE(2, 0, 2, 0));
-        const __m256 b = _mm256_shuffle_ps(c01, c23, _MM_SHUFFLE(3, 1, 3, 1));
-        const __m256 f = _mm256_sub_ps(u, _mm256_cvtepi32_ps(cell));
-        simd::Store(out + i, simd::VF(_mm256_add_ps(a, _mm256_mul_ps(_mm256_sub_ps(b, a), f))),
-                    lanes);
+        const VF u = simd::Min(simd::Max(simd::Load(x + i, lanes, 0.0f) * scale, VF{}), last);
+        const VI cell = __builtin_convertvector(simd::Min(u, lastCell), VI);
+        VF a, b;
+        simd::GatherPair(nodes, cell, a, b);
+        simd::Store(out + i, a + (b - a) * (u - __builtin_convertvector(cell, VF)), lanes);
     }
-#else
-    const F4 scale = Set4(scale_), last = Set4(last_), lastCell = Set4(float(nodes_.size() - 2));
-    for (size_t i = 0; i < count; i += 4) {
-        const size_t lanes = std::min<size_t>(4, count - i);
-        // clamp(x·scale, 0, last) as std::clamp: min(max(u, 0), last).
-        const F4 u = _mm_min_ps(
-            Max4(_mm_mul_ps(LoadLanes(x + i, lanes, 0.0f), scale), _mm_setzero_ps()), last);
-        const I4 cell = _mm_cvttps_epi32(_mm_min_ps(u, lastCell));
-        alignas(16) int32_t c[4];
-        _mm_store_si128(reinterpret_cast<__m128i*>(c), cell);
-        // Each lane's two nodes in one 64-bit load: (a0 b0 a1 b1) and (a2 b2 a3 b3).
-        const F4 c01 = _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), Cell(c[0])), Cell(c[1]));
-        const F4 c23 = _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), Cell(c[2])), Cell(c[3]));
-        const F4 a = _mm_shuffle_ps(c01, c23, _MM_SHUFFLE(2, 0, 2, 0));
-        const F4 b = _mm_shuffle_ps(c01, c23, _MM_SHUFFLE(3, 1, 3, 1));
-        const F4 f = _mm_sub_ps(u, _mm_cvtepi32_ps(cell));
-        StoreLanes(out + i, lanes, _mm_add_ps(a, _mm_mul_ps(_mm_sub_ps(b, a), f)));
-    }
-#endif
 }
 
 FlirChannel::FlirChannel(const scene::World& world, const scene::ChannelSettings& settings)

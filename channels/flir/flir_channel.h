@@ -102,7 +102,7 @@ class OrientationTemperatures {
 };
 
 // A function tabulated at uniformly spaced nodes x_i = i·xMax/(n − 1), linear between them;
-// arguments are clamped to [0, xMax]. Inline (also four lanes wide) for per-sample shading.
+// arguments are clamped to [0, xMax]. Inline, and simd::kLanes at a time, for per-sample shading.
 class UniformTable {
   public:
     UniformTable() = default;
@@ -120,9 +120,6 @@ class UniformTable {
 
   private:
     std::vector<float> nodes_{0.0f, 0.0f};
-    // Cell i as the pair (node i, node i + 1), for one 64-bit load per lane in the four-lane
-    // lookup.
-    std::vector<float> cells_{0.0f, 0.0f};
     float scale_ = 1.0f;  // (n − 1) / xMax
     float last_ = 1.0f;   // n − 1
 };

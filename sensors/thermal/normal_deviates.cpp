@@ -91,8 +91,8 @@ void NormalsFromBits(const uint32_t* bits, size_t count, float* z) {
         const simd::VF f =
             __builtin_convertvector(simd::VI(v & ((1u << kFractionBits) - 1)), simd::VF) *
             (1.0f / (1u << kFractionBits));
-        const simd::VF t0 = simd::Gather(t.value.data(), simd::VI(k));
-        const simd::VF t1 = simd::Gather(t.value.data() + 1, simd::VI(k));
+        simd::VF t0, t1;
+        simd::GatherPair(t.value.data(), simd::VI(k), t0, t1);
         const simd::VF zl = t0 + f * (t1 - t0);
         simd::Store(z + i, simd::VF(simd::VI(zl) ^ simd::VI(b << 31)));
     }
@@ -136,8 +136,8 @@ inline bool FromBits8(const QuantileTable& t, __m256i bits, float* z) {
     const __m256 f = _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_and_si256(
                                        v, _mm256_set1_epi32(int32_t((1u << kFractionBits) - 1)))),
                                    _mm256_set1_ps(1.0f / (1u << kFractionBits)));
-    const __m256 a = _mm256_i32gather_ps(t.value.data(), k, 4);
-    const __m256 b = _mm256_i32gather_ps(t.value.data() + 1, k, 4);
+    simd::VF a, b;
+    simd::GatherPair(t.value.data(), simd::VI(k), a, b);
     const __m256 zAbs = _mm256_add_ps(a, _mm256_mul_ps(f, _mm256_sub_ps(b, a)));
     _mm256_storeu_ps(z, _mm256_xor_ps(zAbs, _mm256_castsi256_ps(_mm256_slli_epi32(bits, 31))));
     return true;
