@@ -225,6 +225,9 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
         frame.Gerstner().Local(req.eye_m.x, req.eye_m.y, frame.Time_s());
     const bool gerstner = frame.Gerstner().WaveCount() > 0;
     const bool surf = frame.Surf() != nullptr;
+    // Seaward of this cross-shore distance a vertex is the deep sea's plus the tide.
+    const double openSea =
+        req.openSeaShortcut ? frame.OpenSeaFrom_m() : std::numeric_limits<double>::infinity();
     if (surf)
         out.surfFoam.resize(out.positions.size());
     else
@@ -249,10 +252,14 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
             SurfWaves::TermsOptions options;
             options.velocity = false;
             options.dominant = SurfWaves::Dominant::kWhereBroken;
-            if (!surf) {
+            if (!surf || frame.Surf()->Bathy().Frame().ShoreFromWorld(x0, y0).s_m >= openSea) {
                 frame.AccumulateFft(x0, y0, filter, s);
                 if (gerstner)
                     local.Accumulate(float(rx), float(ry), gerstnerWeights.data(), s.data());
+                if (surf) {
+                    frame.AddOpenSea(s);
+                    out.surfFoam[v] = 0.0f;  // deeper than FadeDeep_m
+                }
             } else if (frame.DryLandSums(x0, y0, s, &options.seabedZ_m)) {
                 out.surfFoam[v] = 0.0f;  // dry sand, never wet: no foam
             } else {

@@ -4,7 +4,6 @@
 
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
-#include <xmmintrin.h>
 
 #include <algorithm>
 #include <bit>
@@ -17,6 +16,7 @@
 #include "scene/core/check.h"
 #include "scene/core/error.h"
 #include "scene/core/rng.h"
+#include "scene/core/simd_lanes.h"
 #include "scene/ocean/sea_state.h"
 
 namespace seasense::scene {
@@ -57,17 +57,17 @@ void AddBilinear(const Texture& c, int level, double qx, double qy, float weight
     const GeometrySums& e = t[size_t(i1) * size_t(n) + size_t(j1)].v;
     const float w00 = weight * (1.0f - wx) * (1.0f - wy), w10 = weight * wx * (1.0f - wy);
     const float w01 = weight * (1.0f - wx) * wy, w11 = weight * wx * wy;
-    // sums[k] += ((w00 a + w10 b) + w01 d) + w11 e, four terms at a time (SSE): the same
-    // single-precision operations in the same order as one term at a time, so the same bits.
-    static_assert(kGeometryTerms == 8);
-    const __m128 v00 = _mm_set1_ps(w00), v10 = _mm_set1_ps(w10);
-    const __m128 v01 = _mm_set1_ps(w01), v11 = _mm_set1_ps(w11);
-    for (size_t k = 0; k < size_t(kGeometryTerms); k += 4) {
-        const __m128 term = _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(v00, _mm_loadu_ps(&a[k])),
-                                                             _mm_mul_ps(v10, _mm_loadu_ps(&b[k]))),
-                                                  _mm_mul_ps(v01, _mm_loadu_ps(&d[k]))),
-                                       _mm_mul_ps(v11, _mm_loadu_ps(&e[k])));
-        _mm_storeu_ps(&sums[k], _mm_add_ps(_mm_loadu_ps(&sums[k]), term));
+    // sums[k] += ((w00 a + w10 b) + w01 d) + w11 e, a vector of terms at a time (all eight with
+    // AVX, four with SSE2): the same single-precision operations in the same order as one term
+    // at a time, so the same bits.
+    static_assert(kGeometryTerms % simd::kLanes == 0);
+    const simd::VF v00 = simd::Splat(w00), v10 = simd::Splat(w10);
+    const simd::VF v01 = simd::Splat(w01), v11 = simd::Splat(w11);
+    for (size_t k = 0; k < size_t(kGeometryTerms); k += simd::kLanes) {
+        const simd::VF term =
+            ((v00 * simd::Load(&a[k]) + v10 * simd::Load(&b[k])) + v01 * simd::Load(&d[k])) +
+            v11 * simd::Load(&e[k]);
+        simd::Store(&sums[k], simd::Load(&sums[k]) + term);
     }
 }
 
@@ -195,6 +195,17 @@ void OceanSurfaceFrame::AddSurf(double x0, double y0, const SurfaceTerms& s,
         sums[kTermSlopeX] = float(bed.y);
         sums[kTermSlopeY] = float(bed.z);
     }
+}
+
+void OceanSurfaceFrame::AddOpenSea(GeometrySums& sums) const {
+    CHECK(surf_);
+    // AddSurf's additions of SurfWaves::Terms' all-deep result (SurfaceTerms{}, the swash's 0
+    // added to its height), without the seabed lookup.
+    const SurfaceTerms zero;
+    sums[kTermHeight] += float(zero.displacement.z + surf_->Bathy().Tide_m());
+    for (const GeometryTerm k :
+         {kTermDispX, kTermDispY, kTermSlopeX, kTermSlopeY, kTermDispXX, kTermDispYY, kTermDispXY})
+        sums[k] += float(0.0);
 }
 
 bool OceanSurfaceFrame::DryLandSums(double x0, double y0, GeometrySums& sums,
@@ -390,15 +401,35 @@ void OceanSurface::Complete(OceanSurfaceFrame& frame, double t) const {
     frame.maxHorizontal_m_ += gerstner_.MaxHorizontal_m();
     frame.surf_ = surf_;
     frame.surfReach_m_ = 0.0;
+    frame.openSeaFrom_m_ = kInf;
     if (surf_) {
         // Over the whole surface: the surf bound at every depth, the whole seabed.
         // One table per frame serves every BoundsNear (each view asks for a few discs).
         frame.surfBounds_ = surf_->MakeBoundTable(frame.cascadeBounds_, frame.GerstnerBound());
         frame.surfReach_m_ = surf_->BoundAtDepths(-kInf, frame.surfBounds_).horizontal_m;
+        frame.openSeaFrom_m_ = frame.OpenSeaFrom(*surf_);
         const SurfaceBounds all = frame.BoundsNear(0.0, 0.0, kInf);
         frame.maxHeight_m_ = all.height_m;
         frame.maxHorizontal_m_ = all.horizontal_m;
     }
+}
+
+double OceanSurfaceFrame::OpenSeaFrom(const SurfWaves& surf) const {
+    // The deep sea (FFT cascades and Gerstner waves at full weight) moves a point at most D
+    // horizontally and lowers it at most H below the tide: each cascade's largest |η| and |D|
+    // over its full-resolution texels (its mips and the bilinear and trilinear blends average
+    // them; BuildTextures), each Gerstner wave's A and Q A / tanh kh. The mesh sums them in
+    // float, ~1e-6 relative: the margin is far above that.
+    const SurfWaves::Bound deep = surfBounds_.deep;
+    const double margin = 0.01 + 1e-3 * (deep.height_m + deep.horizontal_m);
+    // Seaward of s1 the still-water depth is at least h everywhere (Bathymetry::DeepSeawardOf_m):
+    // there DryLandSums finds water (h > 0), Weights(h) are the deep defaults and AllDeep
+    // (h ≥ FadeDeep_m), Swash_m is 0 (h ≥ 2 R2), and the seabed lies below tide − H − margin,
+    // under the lowest the deep sea reaches. A rest position D + margin seaward of s1 then has
+    // its displaced point (within D of it) seaward of s1 too, where the clamp cannot apply.
+    double h = std::max(surf.FadeDeep_m(), deep.height_m + margin);
+    if (surf.Swash().active) h = std::max(h, 2.0 * surf.Swash().runup2_m);
+    return surf.Bathy().DeepSeawardOf_m(h) + deep.horizontal_m + margin;
 }
 
 SurfWaves::Bound OceanSurfaceFrame::GerstnerBound() const {

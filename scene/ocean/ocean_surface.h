@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <span>
@@ -110,6 +111,9 @@ class OceanSurfaceFrame {
     // and info from Surf()->Terms at the frame time) and the tide, and clamps the height to the
     // seabed under the displaced point.
     void AddSurf(double x0, double y0, const SurfaceTerms& surfTerms, GeometrySums& sums) const;
+    // AddSurf for a rest position seaward of OpenSeaFrom_m, the same bits: the surf terms there
+    // are zero (the tide added to the height, +0 to the rest) and the clamp cannot apply.
+    void AddOpenSea(GeometrySums& sums) const;
     // With a surf zone: whether rest position (x0, y0) is dry land that no water reaches at any
     // time (seabed above the tide plus the swash maximum), and if so the surface there, sums set
     // to exactly what the deep sea, the surf terms and AddSurf's seabed clamp give (the seabed
@@ -117,6 +121,14 @@ class OceanSurfaceFrame {
     // (as SurfWaves::Terms looks it up) is written to seabedZ_m if given, for
     // SurfWaves::TermsOptions::seabedZ_m.
     bool DryLandSums(double x0, double y0, GeometrySums& sums, double* seabedZ_m = nullptr) const;
+
+    // With a surf zone: the cross-shore distance (shore frame s, m) seaward of which the mesh's
+    // surf path at a rest position is the deep sea's alone, bit for bit: DryLandSums finds water,
+    // SurfWaves::Terms finds every part of the sea at full weight, no surf component and no swash
+    // (the depth is at least FadeDeep_m and twice the swash's run-up), and AddSurf's seabed clamp
+    // cannot apply (the seabed under any point the deep sea can carry there lies lower than its
+    // deepest trough). +∞ without a surf zone or with a depth grid. See Complete for the bounds.
+    double OpenSeaFrom_m() const { return openSeaFrom_m_; }
 
     // The surf components (nullptr without environment.ocean.surf).
     const SurfWaves* Surf() const { return surf_.get(); }
@@ -163,6 +175,8 @@ class OceanSurfaceFrame {
     // Cascade c's bound over the lookups at rest positions within radius_m of (x, y).
     SurfWaves::Bound CascadeBoundNear(size_t c, double x, double y, double radius_m) const;
     SurfWaves::Bound GerstnerBound() const;
+    // OpenSeaFrom_m for the frame's bounds (surfBounds_ made).
+    double OpenSeaFrom(const SurfWaves& surf) const;
 
     double t_s_ = 0.0;
     GerstnerOcean gerstner_;
@@ -175,6 +189,7 @@ class OceanSurfaceFrame {
     std::vector<SurfWaves::Bound> cascadeBounds_;  // per cascade: max |η|, max |D|
     SurfWaves::BoundTable surfBounds_;  // SurfWaves::BoundAtDepths of this frame's bounds
     double surfReach_m_ = 0.0;          // largest horizontal displacement anywhere, with the surf
+    double openSeaFrom_m_ = std::numeric_limits<double>::infinity();
     double significantHeight_m_ = 0.0;
 };
 

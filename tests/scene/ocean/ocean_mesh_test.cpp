@@ -466,6 +466,77 @@ TEST(OceanMesh, SurfTermsOptionsOfTheMeshChangeNothingItUses) {
     EXPECT_GT(foamy, 500);
 }
 
+// Every vertex, normal, Jacobian and foam value of mesh a is b's, bit for bit.
+void ExpectSameMesh(const OceanMesh& a, const OceanMesh& b) {
+    ASSERT_EQ(a.positions.size(), b.positions.size());
+    ASSERT_EQ(a.ringStart, b.ringStart);
+    ASSERT_EQ(a.surfFoam.size(), b.surfFoam.size());
+    const auto bits = [](const auto& v) {
+        std::vector<uint32_t> out(sizeof(v[0]) / 4 * v.size());
+        std::memcpy(out.data(), v.data(), out.size() * 4);
+        return out;
+    };
+    ASSERT_EQ(bits(a.positions), bits(b.positions));
+    ASSERT_EQ(bits(a.normals), bits(b.normals));
+    ASSERT_EQ(bits(a.jacobian), bits(b.jacobian));
+    ASSERT_EQ(bits(a.surfFoam), bits(b.surfFoam));
+}
+
+TEST(OceanMesh, OpenSeaShortcutIsTheWholeSurfPathBitForBit) {
+    // Seaward of OceanSurfaceFrame::OpenSeaFrom_m the mesh adds the deep sea and the tide
+    // without the surf terms, the dry-land test or the seabed clamp's lookup. Meshes with and
+    // without that shortcut must be the same bits: configs/surf.yaml (a barred beach, swash,
+    // land to the west) and configs/five-channel.yaml (the beach 600 m ahead), from eyes far
+    // offshore, near the shortcut's edge, in the fade, in the surf and on the beach, looking
+    // seaward, along and onto the shore, at three times each; many vertices on both sides.
+    size_t open = 0, surfPath = 0;
+    for (const char* config : {"configs/surf.yaml", "configs/five-channel.yaml"}) {
+        const Scenario sc = LoadScenario(std::filesystem::path(SEASENSE_SOURCE_DIR) / config);
+        const OceanSurface sea(sc.environment.ocean);
+        const ShoreFrame& shore = sea.Surf()->Bathy().Frame();
+        for (const double t : {2.0, 19.25, 47.5}) {
+            const auto frame = sea.At(t);
+            const double from = frame->OpenSeaFrom_m();
+            ASSERT_TRUE(std::isfinite(from));
+            ASSERT_GT(from, sea.Surf()->Bathy().DeepSeawardOf_m(sea.Surf()->FadeDeep_m()));
+            for (const double s : {1500.0, from + 40.0, from - 30.0, 330.0, 60.0, -30.0}) {
+                const glm::dvec2 p = shore.WorldFromShore(s, 25.0);
+                const glm::dvec3 eye(p.x, p.y, s > 0.0 ? 2.0 : 9.0);
+                const double seaward = std::atan2(shore.Seaward().x, shore.Seaward().y);
+                for (const double look : {0.0, 0.5 * kPi, 0.8 * kPi, kPi}) {
+                    OceanMeshRequest req = View(eye, seaward + look, 0.6);
+                    req.widenByReach = true;
+                    OceanMesh fast, whole;
+                    BuildOceanMesh(*frame, req, fast);
+                    req.openSeaShortcut = false;
+                    BuildOceanMesh(*frame, req, whole);
+                    ExpectSameMesh(fast, whole);
+                    if (HasFatalFailure()) {
+                        ADD_FAILURE() << config << " t " << t << " s " << s << " look " << look;
+                        return;
+                    }
+                    for (int j = 0; j < fast.rings; ++j)
+                        for (uint32_t v = fast.ringStart[size_t(j)];
+                             v < fast.ringStart[size_t(j) + 1]; ++v) {
+                            const int64_t c =
+                                fast.ringFirstColumn[size_t(j)] +
+                                int64_t(v - fast.ringStart[size_t(j)]) * fast.ringStride[size_t(j)];
+                            const double az = 2.0 * kPi * double(c) / fast.circleSegments;
+                            const double r = fast.radii_m[size_t(j)];
+                            const double rest = shore
+                                                    .ShoreFromWorld(eye.x + r * std::sin(az),
+                                                                    eye.y + r * std::cos(az))
+                                                    .s_m;
+                            ++(rest >= from ? open : surfPath);
+                        }
+                }
+            }
+        }
+    }
+    EXPECT_GT(open, 200000u);
+    EXPECT_GT(surfPath, 200000u);
+}
+
 TEST(OceanMesh, SurfMeshAndFrameBitIdenticalForAnyThreadCount) {
     const auto build = [](int threads) {
         tbb::task_arena arena(threads);
