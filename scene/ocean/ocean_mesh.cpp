@@ -223,11 +223,12 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
     out.jacobian.resize(out.positions.size());
     const GerstnerOcean::LocalFrame local =
         frame.Gerstner().Local(req.eye_m.x, req.eye_m.y, frame.Time_s());
-    const bool gerstner = frame.Gerstner().WaveCount() > 0;
+    const size_t waveCount = frame.Gerstner().WaveCount();
+    const bool gerstner = waveCount > 0;
     const bool surf = frame.Surf() != nullptr;
     // Seaward of this cross-shore distance a vertex is the deep sea's plus the tide.
     const double openSea =
-        req.openSeaShortcut ? frame.OpenSeaFrom_m() : std::numeric_limits<double>::infinity();
+        req.shortcuts ? frame.OpenSeaFrom_m() : std::numeric_limits<double>::infinity();
     if (surf)
         out.surfFoam.resize(out.positions.size());
     else
@@ -239,6 +240,15 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
         const FftFilter filter = frame.Filter(fp);
         std::array<float, kMaxWaves> gerstnerWeights;  // the ring's footprint weights
         local.FootprintWeights(fp, gerstnerWeights.data());
+        // A ring whose footprint weights are all 0 (far rings: waves shorter than twice the
+        // footprint) gets +0 in every Gerstner term (LocalFrame::Accumulate skips such waves),
+        // and x + 0 (or + w · 0) is x for every x but −0, which the sums never hold: they start
+        // at +0 and only ever add, and a rounded sum is −0 only when both addends are.
+        const bool ringGerstner =
+            gerstner &&
+            (!req.shortcuts || std::any_of(gerstnerWeights.begin(),
+                                           gerstnerWeights.begin() + std::ptrdiff_t(waveCount),
+                                           [](float w) { return !(w <= 0.0f); }));
         const int columns = int(ringStart[size_t(j) + 1] - ringStart[size_t(j)]);
         const size_t c0 = size_t(ringFirst[size_t(j)] - colLo), sj = size_t(stride[size_t(j)]);
         for (int i = 0; i < columns; ++i) {
@@ -254,7 +264,7 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
             options.dominant = SurfWaves::Dominant::kWhereBroken;
             if (!surf || frame.Surf()->Bathy().Frame().ShoreFromWorld(x0, y0).s_m >= openSea) {
                 frame.AccumulateFft(x0, y0, filter, s);
-                if (gerstner)
+                if (ringGerstner)
                     local.Accumulate(float(rx), float(ry), gerstnerWeights.data(), s.data());
                 if (surf) {
                     frame.AddOpenSea(s);
@@ -268,9 +278,9 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
                 const SurfaceTerms st = frame.Surf()->Terms(x0, y0, frame.Time_s(), &info, options);
                 frame.AccumulateFft(x0, y0, filter, s, info.weights.cascade.data());
                 const double wg = info.weights.gerstner;
-                if (gerstner && wg == 1.0) {
+                if (ringGerstner && wg == 1.0) {
                     local.Accumulate(float(rx), float(ry), gerstnerWeights.data(), s.data());
-                } else if (gerstner && wg > 0.0) {
+                } else if (ringGerstner && wg > 0.0) {
                     GeometrySums g{};
                     local.Accumulate(float(rx), float(ry), gerstnerWeights.data(), g.data());
                     for (int k = 0; k < kGeometryTerms; ++k)

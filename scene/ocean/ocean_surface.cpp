@@ -138,9 +138,12 @@ void OceanSurfaceFrame::BuildTextures() {
 
 namespace {
 
+// Half the step of SeabedWithSlope's differences, m.
+constexpr double kSlopeStep_m = 0.05;
+
 // Seabed under the displaced point and its slope (central differences over 0.1 m), for the clamp.
 glm::dvec3 SeabedWithSlope(const Bathymetry& b, double x, double y) {
-    constexpr double d = 0.05;
+    constexpr double d = kSlopeStep_m;
     return {b.SeabedZ_m(x, y), (b.SeabedZ_m(x + d, y) - b.SeabedZ_m(x - d, y)) / (2.0 * d),
             (b.SeabedZ_m(x, y + d) - b.SeabedZ_m(x, y - d)) / (2.0 * d)};
 }
@@ -226,7 +229,12 @@ bool OceanSurfaceFrame::DryLandSums(double x0, double y0, GeometrySums& sums,
         if (seabedZ_m) *seabedZ_m = zBed;
         return false;
     }
-    const glm::dvec3 bed = SeabedWithSlope(bathy, x0, y0);
+    // On the level land behind the beach the five seabed samples are one constant, zBed (the
+    // same lookup at the same shore point), and both differences (z − z) / 0.1 = +0 exactly. The
+    // samples lie within 0.05 m of the point; 0.1 m covers the shore frame's rounding.
+    const glm::dvec3 bed = bathy.LevelLandAround(p.s_m, 2.0 * kSlopeStep_m)
+                               ? glm::dvec3(zBed, 0.0, 0.0)
+                               : SeabedWithSlope(bathy, x0, y0);
     sums = GeometrySums{};
     sums[kTermHeight] = float(bed.x);
     sums[kTermSlopeX] = float(bed.y);

@@ -54,6 +54,14 @@ class Bathymetry {
     // where the seabed never gets that deep.
     double DeepSeawardOf_m(double depth_m) const;
 
+    // Whether every point within radius_m of cross-shore distance s_m (any u) lies on the level
+    // ground landward of the beach, where SeabedZ_m is exactly ProfileZ_m(s_m), one constant:
+    // no depth grid, no sandbar reaching it.
+    bool LevelLandAround(double s_m, double radius_m) const {
+        return !settings_.depthGrid && s_m + radius_m < sLand_m_ &&
+               !(barSMax_m_ >= barSMin_m_ && s_m + radius_m >= barSMin_m_);
+    }
+
     // The plane beach alone: seabed elevation of the littoral slopes at cross-shore distance s
     // (no sandbars, no grid), floored at −oceanDepth_m.
     double ProfileZ_m(double s_m) const;
