@@ -29,6 +29,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -303,13 +304,25 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
 
     if (sameShape) return;
     // Vertex of world column c (a multiple of the ring's stride) on ring j.
+    // One remainder, and the stride (a power of two) as a mask and a shift: the integer
+    // divisions were most of the index buffer's cost.
+    std::vector<int> strideShift(static_cast<size_t>(rings));
+    for (int j = 0; j < rings; ++j) {
+        const int sj = stride[size_t(j)];
+        CHECK(sj > 0 && (sj & (sj - 1)) == 0);
+        strideShift[size_t(j)] = std::countr_zero(unsigned(sj));
+    }
     const auto vertex = [&](int j, int64_t c) {
         const uint32_t n = ringStart[size_t(j) + 1] - ringStart[size_t(j)];
-        const int64_t sj = stride[size_t(j)];
-        const bool whole = int64_t(n) * sj == circle;
-        const int64_t col = whole ? ((c % circle) + circle) % circle : c - ringFirst[size_t(j)];
-        CHECK(col % sj == 0);
-        const int64_t i = col / sj;
+        const int shift = strideShift[size_t(j)];
+        const bool whole = int64_t(n) << shift == circle;
+        int64_t col = c - ringFirst[size_t(j)];
+        if (whole) {
+            col = c % circle;  // wrapped into [0, circle)
+            if (col < 0) col += circle;
+        }
+        CHECK((col & ((int64_t(1) << shift) - 1)) == 0);
+        const int64_t i = col >> shift;
         CHECK(i >= 0 && i < int64_t(n));
         return ringStart[size_t(j)] + uint32_t(i);
     };

@@ -159,6 +159,43 @@ TEST(OceanMesh, GridIsWatertight) {
     }
 }
 
+TEST(OceanMesh, ASectorOneColumnShortOfTheCircleAcrossNorthWrapsItsColumns) {
+    // Columns lo … hi − 1 with hi − lo = circle − 1 and lo < 0: each ring holds every column
+    // (stored as a whole circle) while its bands do not, so the triangles' negative columns
+    // must wrap. Every triangle joins columns at most one apart around the circle, of one ring
+    // or two neighbouring ones, and every vertex is used.
+    const OceanSurface sea(Beaufort5());
+    OceanMeshRequest req = View({0.0, 0.0, 2.0}, 0.0, 1.0);
+    const int circle = int(std::ceil(2.0 * kPi / req.angularStep_rad));
+    const double dphi = 2.0 * kPi / circle;
+    req.azimuthMin_rad = -kPi + 0.5 * dphi;
+    req.azimuthMax_rad = kPi - 1.5 * dphi;
+    OceanMesh m;
+    BuildOceanMesh(*sea.At(1.0), req, m);
+    ASSERT_EQ(m.circleSegments, circle);
+    ASSERT_TRUE(m.fullCircle);
+    const auto place = [&](uint32_t v) {
+        const int j =
+            int(std::upper_bound(m.ringStart.begin(), m.ringStart.end(), v) - m.ringStart.begin()) -
+            1;
+        const int64_t c = m.ringFirstColumn[size_t(j)] +
+                          int64_t(v - m.ringStart[size_t(j)]) * m.ringStride[size_t(j)];
+        return std::pair<int, int64_t>(j, ((c % circle) + circle) % circle);
+    };
+    std::vector<bool> used(m.positions.size(), false);
+    for (size_t t = 0; t < m.indices.size(); t += 3)
+        for (int e = 0; e < 3; ++e) {
+            used[m.indices[t + size_t(e)]] = true;
+            const auto [ja, ca] = place(m.indices[t + size_t(e)]);
+            const auto [jb, cb] = place(m.indices[t + size_t((e + 1) % 3)]);
+            ASSERT_LE(std::abs(ja - jb), 1);
+            const int64_t apart =
+                std::min((ca - cb + circle) % circle, (cb - ca + circle) % circle);
+            ASSERT_LE(apart, 1) << "triangle " << t / 3;
+        }
+    EXPECT_EQ(std::count(used.begin(), used.end(), false), 0);
+}
+
 // With widenByReach each band is widened by asin(D / r) (at most 20°): a sea point drawn in
 // the view's sector comes from a rest position inside the band's columns. Checked against the
 // surface's actual displacement (OceanSurfaceFrame::Terms, unfiltered) at rest positions where
