@@ -2,12 +2,14 @@
 // waves, the inverse-displacement query, a per-time frame cache and the sea's statistics.
 #include "scene/ocean/ocean_surface.h"
 
+#include <immintrin.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <mutex>
 #include <numbers>
@@ -38,6 +40,29 @@ constexpr uint64_t kSurfPhaseStream = 0x53555246'00000002ULL;
 // (x0 + Δ/2) / (2^l Δ) − ½, taken as ((x0 + Δ/2) / Δ) · 2^−l − ½ from (qx, qy) = (x0 + Δ/2) / Δ,
 // which the levels of one cascade share. The same bits: a correctly rounded quotient scaled by a
 // power of two is the correctly rounded quotient by the scaled divisor (no underflow here).
+// Adds w00 a + w10 b + w01 d + w11 e to sums, the texels a = (i0, j0), b = (i1, j0),
+// d = (i0, j1), e = (i1, j1) of a level of n × n texels (row-major, kGeometryTerms floats each):
+// sums[k] += ((w00 a + w10 b) + w01 d) + w11 e, a vector of terms at a time (all eight with
+// AVX, four with SSE2): the same single-precision operations in the same order as one term at
+// a time, so the same bits.
+void AddTexels(const float* texels, int n, int i0, int j0, float w00, float w10, float w01,
+               float w11, GeometrySums& sums) {
+    const int i1 = (i0 + 1) & (n - 1), j1 = (j0 + 1) & (n - 1);
+    const float* a = texels + (size_t(i0) * size_t(n) + size_t(j0)) * kGeometryTerms;
+    const float* b = texels + (size_t(i1) * size_t(n) + size_t(j0)) * kGeometryTerms;
+    const float* d = texels + (size_t(i0) * size_t(n) + size_t(j1)) * kGeometryTerms;
+    const float* e = texels + (size_t(i1) * size_t(n) + size_t(j1)) * kGeometryTerms;
+    static_assert(kGeometryTerms % simd::kLanes == 0);
+    const simd::VF v00 = simd::Splat(w00), v10 = simd::Splat(w10);
+    const simd::VF v01 = simd::Splat(w01), v11 = simd::Splat(w11);
+    for (size_t k = 0; k < size_t(kGeometryTerms); k += simd::kLanes) {
+        const simd::VF term =
+            ((v00 * simd::Load(a + k) + v10 * simd::Load(b + k)) + v01 * simd::Load(d + k)) +
+            v11 * simd::Load(e + k);
+        simd::Store(&sums[k], simd::Load(&sums[k]) + term);
+    }
+}
+
 template <class Texture>
 void AddBilinear(const Texture& c, int level, double qx, double qy, float weight,
                  GeometrySums& sums) {
@@ -49,26 +74,29 @@ void AddBilinear(const Texture& c, int level, double qx, double qy, float weight
     const float wx = float(u - fu), wy = float(v - fv);
     // Power-of-two periodic wrap; two's complement makes the mask right for negative indices.
     const int i0 = int(int64_t(fu) & (n - 1)), j0 = int(int64_t(fv) & (n - 1));
-    const int i1 = (i0 + 1) & (n - 1), j1 = (j0 + 1) & (n - 1);
-    const auto* t = c.levels[size_t(level)].data();
-    const GeometrySums& a = t[size_t(i0) * size_t(n) + size_t(j0)].v;
-    const GeometrySums& b = t[size_t(i1) * size_t(n) + size_t(j0)].v;
-    const GeometrySums& d = t[size_t(i0) * size_t(n) + size_t(j1)].v;
-    const GeometrySums& e = t[size_t(i1) * size_t(n) + size_t(j1)].v;
     const float w00 = weight * (1.0f - wx) * (1.0f - wy), w10 = weight * wx * (1.0f - wy);
     const float w01 = weight * (1.0f - wx) * wy, w11 = weight * wx * wy;
-    // sums[k] += ((w00 a + w10 b) + w01 d) + w11 e, a vector of terms at a time (all eight with
-    // AVX, four with SSE2): the same single-precision operations in the same order as one term
-    // at a time, so the same bits.
-    static_assert(kGeometryTerms % simd::kLanes == 0);
-    const simd::VF v00 = simd::Splat(w00), v10 = simd::Splat(w10);
-    const simd::VF v01 = simd::Splat(w01), v11 = simd::Splat(w11);
-    for (size_t k = 0; k < size_t(kGeometryTerms); k += simd::kLanes) {
-        const simd::VF term =
-            ((v00 * simd::Load(&a[k]) + v10 * simd::Load(&b[k])) + v01 * simd::Load(&d[k])) +
-            v11 * simd::Load(&e[k]);
-        simd::Store(&sums[k], simd::Load(&sums[k]) + term);
-    }
+    AddTexels(c.levels[size_t(level)].data()->v.data(), n, i0, j0, w00, w10, w01, w11, sums);
+}
+
+// Four doubles and four floats as GCC vectors (two SSE2 registers, or one AVX register, for
+// the doubles): each operation is the IEEE operation per lane.
+using D4 = double __attribute__((vector_size(32)));
+using F4 = float __attribute__((vector_size(16)));
+
+D4 LoadD4(const double* p) {
+    D4 v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+}
+
+D4 Floor4(D4 v) {
+#if defined(__AVX__)
+    return _mm256_floor_pd(v);
+#else
+    for (int k = 0; k < 4; ++k) v[k] = std::floor(v[k]);
+    return v;
+#endif
 }
 
 }  // namespace
@@ -258,12 +286,75 @@ FftFilter OceanSurfaceFrame::Filter(float footprint_m) const {
         lod = std::min(lod, float(top));
         f.level[c] = int(lod);
         f.frac[c] = lod - float(f.level[c]);
+        const auto add = [&](int level, float factor) {
+            const int l = f.lookups++;
+            f.cascade[size_t(l)] = int(c);
+            f.texel[size_t(l)] = t.texel_m;
+            f.halfTexel[size_t(l)] = 0.5 * t.texel_m;
+            f.scale[size_t(l)] = 1.0 / double(1 << level);
+            f.n[size_t(l)] = t.n >> level;
+            f.size[size_t(l)] = double(f.n[size_t(l)]);
+            f.invSize[size_t(l)] = 1.0 / f.size[size_t(l)];
+            f.factor[size_t(l)] = factor;
+            f.texels[size_t(l)] = t.levels[size_t(level)].data()->v.data();
+        };
+        add(f.level[c], 1.0f - f.frac[c]);
+        if (f.frac[c] > 0.0f) add(f.level[c] + 1, f.frac[c]);
+    }
+    static_assert(sizeof(Texel) == sizeof(GeometrySums));  // texels read as rows of floats
+    // Pad to whole groups of four with the last lookup (read, never added).
+    for (int l = f.lookups; l % 4 != 0; ++l) {
+        const size_t last = size_t(f.lookups - 1);
+        f.cascade[size_t(l)] = f.cascade[last];
+        f.texel[size_t(l)] = f.texel[last];
+        f.halfTexel[size_t(l)] = f.halfTexel[last];
+        f.scale[size_t(l)] = f.scale[last];
+        f.n[size_t(l)] = f.n[last];
+        f.size[size_t(l)] = f.size[last];
+        f.invSize[size_t(l)] = f.invSize[last];
+        f.factor[size_t(l)] = f.factor[last];
+        f.texels[size_t(l)] = f.texels[last];
     }
     return f;
 }
 
 void OceanSurfaceFrame::AccumulateFft(double x0, double y0, const FftFilter& filter,
                                       GeometrySums& sums, const double* cascadeWeights) const {
+    // AddBilinear's operations, lane for lane, four lookups at a time; the texels are then added
+    // one lookup after the other in AccumulateFftOneByOne's order.
+    for (int g = 0; g < filter.lookups; g += 4) {
+        const size_t l = size_t(g);
+        const D4 texel = LoadD4(&filter.texel[l]), half = LoadD4(&filter.halfTexel[l]);
+        const D4 scale = LoadD4(&filter.scale[l]);
+        const D4 u = ((x0 + half) / texel) * scale - 0.5;
+        const D4 v = ((y0 + half) / texel) * scale - 0.5;
+        const D4 fu = Floor4(u), fv = Floor4(v);
+        const F4 wx = __builtin_convertvector(u - fu, F4), wy = __builtin_convertvector(v - fv, F4);
+        // int64_t(fu) & (n − 1) exactly, in double: fu − n ⌊fu · 1/n⌋ (n a power of two, fu a
+        // whole number: every step is exact), in [0, n).
+        const D4 size = LoadD4(&filter.size[l]), invSize = LoadD4(&filter.invSize[l]);
+        const D4 iu = fu - size * Floor4(fu * invSize), iv = fv - size * Floor4(fv * invSize);
+        // × 1 is exact: unweighted cascades add the same bits as without weights.
+        F4 w, weight;
+        for (int k = 0; k < 4; ++k) {
+            w[k] = cascadeWeights ? float(cascadeWeights[filter.cascade[l + size_t(k)]]) : 1.0f;
+            weight[k] = filter.factor[l + size_t(k)] * w[k];
+        }
+        const F4 one = F4{} + 1.0f;
+        const F4 w00 = weight * (one - wx) * (one - wy), w10 = weight * wx * (one - wy);
+        const F4 w01 = weight * (one - wx) * wy, w11 = weight * wx * wy;
+        const int end = std::min(4, filter.lookups - g);
+        for (int k = 0; k < end; ++k) {
+            if (w[k] == 0.0f) continue;
+            AddTexels(filter.texels[l + size_t(k)], filter.n[l + size_t(k)], int(iu[k]), int(iv[k]),
+                      w00[k], w10[k], w01[k], w11[k], sums);
+        }
+    }
+}
+
+void OceanSurfaceFrame::AccumulateFftOneByOne(double x0, double y0, const FftFilter& filter,
+                                              GeometrySums& sums,
+                                              const double* cascadeWeights) const {
     for (size_t c = 0; c < textures_.size(); ++c) {
         // × 1 is exact: unweighted cascades add the same bits as without weights.
         const float w = cascadeWeights ? float(cascadeWeights[c]) : 1.0f;

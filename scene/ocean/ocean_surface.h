@@ -59,6 +59,18 @@ struct FftFilter {
     static constexpr int kMaxCascades = 8;
     std::array<int, kMaxCascades> level{};
     std::array<float, kMaxCascades> frac{};
+    // What OceanSurfaceFrame::Filter derives for AccumulateFft (valid with the frame that made
+    // it): the texel lookups in the order they add, per cascade level[c] with factor
+    // 1 − frac[c], then level[c] + 1 with frac[c] where frac[c] > 0; per lookup its cascade,
+    // texel size Δ and Δ/2, 2^−level, the level's size n (and as doubles n and 1/n) and texels
+    // (row-major, kGeometryTerms floats each). Padded to a multiple of four lookups with copies
+    // of the last, which are never added.
+    static constexpr int kMaxLookups = 2 * kMaxCascades;
+    int lookups = 0;
+    std::array<double, kMaxLookups> texel{}, halfTexel{}, scale{}, size{}, invSize{};
+    std::array<int, kMaxLookups> cascade{}, n{};
+    std::array<float, kMaxLookups> factor{};
+    std::array<const float*, kMaxLookups> texels{};
 };
 
 // The surface at one instant: an immutable snapshot once made by OceanSurface.
@@ -97,8 +109,12 @@ class OceanSurfaceFrame {
     // The same with the levels of a footprint resolved once (e.g. per mesh ring).
     FftFilter Filter(float footprint_m) const;
     // With cascadeWeights (one per cascade, e.g. SurfWeights::cascade) each cascade is scaled.
+    // The lookups' coordinates and weights four at a time.
     void AccumulateFft(double x0, double y0, const FftFilter& filter, GeometrySums& sums,
                        const double* cascadeWeights = nullptr) const;
+    // The same one lookup at a time (the scalar form; tests compare the two bit for bit).
+    void AccumulateFftOneByOne(double x0, double y0, const FftFilter& filter, GeometrySums& sums,
+                               const double* cascadeWeights = nullptr) const;
 
     // Unit upward normal of the surface at rest position (x0, y0) (world m) band-limited to a
     // footprint (m), FFT cascades and Gerstner waves together: for shading finer than the mesh
