@@ -23,6 +23,12 @@
 // shimmer. Rotation moves nothing: azimuths are multiples of 2π / circleSegments, fixed in the
 // world, and the ring radii depend only on eye height, wave height and angular step, not on
 // where the view looks; contiguous channels with equal angular steps get identical vertices.
+//
+// Work a vertex provably does not need is skipped, never changing a bit (OceanMeshRequest::
+// shortcuts turns this off for the tests that compare): with a surf zone, rest positions
+// seaward of OceanSurfaceFrame::OpenSeaFrom_m (most of a view from deep water) add the deep
+// sea and the tide without the dry-land test, the surf terms or the seabed clamp's lookup; and
+// rings whose Gerstner footprint weights are all 0 sum no Gerstner wave.
 #include "scene/ocean/ocean_mesh.h"
 
 #include <tbb/parallel_for.h>
