@@ -23,12 +23,19 @@
 // shimmer. Rotation moves nothing: azimuths are multiples of 2π / circleSegments, fixed in the
 // world, and the ring radii depend only on eye height, wave height and angular step, not on
 // where the view looks; contiguous channels with equal angular steps get identical vertices.
+//
+// Work a vertex provably does not need is skipped, never changing a bit (OceanMeshRequest::
+// shortcuts turns this off for the tests that compare): with a surf zone, rest positions
+// seaward of OceanSurfaceFrame::OpenSeaFrom_m (most of a view from deep water) add the deep
+// sea and the tide without the dry-land test, the surf terms or the seabed clamp's lookup; and
+// rings whose Gerstner footprint weights are all 0 sum no Gerstner wave.
 #include "scene/ocean/ocean_mesh.h"
 
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -223,8 +230,12 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
     out.jacobian.resize(out.positions.size());
     const GerstnerOcean::LocalFrame local =
         frame.Gerstner().Local(req.eye_m.x, req.eye_m.y, frame.Time_s());
-    const bool gerstner = frame.Gerstner().WaveCount() > 0;
+    const size_t waveCount = frame.Gerstner().WaveCount();
+    const bool gerstner = waveCount > 0;
     const bool surf = frame.Surf() != nullptr;
+    // Seaward of this cross-shore distance a vertex is the deep sea's plus the tide.
+    const double openSea =
+        req.shortcuts ? frame.OpenSeaFrom_m() : std::numeric_limits<double>::infinity();
     if (surf)
         out.surfFoam.resize(out.positions.size());
     else
@@ -236,6 +247,15 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
         const FftFilter filter = frame.Filter(fp);
         std::array<float, kMaxWaves> gerstnerWeights;  // the ring's footprint weights
         local.FootprintWeights(fp, gerstnerWeights.data());
+        // A ring whose footprint weights are all 0 (far rings: waves shorter than twice the
+        // footprint) gets +0 in every Gerstner term (LocalFrame::Accumulate skips such waves),
+        // and x + 0 (or + w · 0) is x for every x but −0, which the sums never hold: they start
+        // at +0 and only ever add, and a rounded sum is −0 only when both addends are.
+        const bool ringGerstner =
+            gerstner &&
+            (!req.shortcuts || std::any_of(gerstnerWeights.begin(),
+                                           gerstnerWeights.begin() + std::ptrdiff_t(waveCount),
+                                           [](float w) { return !(w <= 0.0f); }));
         const int columns = int(ringStart[size_t(j) + 1] - ringStart[size_t(j)]);
         const size_t c0 = size_t(ringFirst[size_t(j)] - colLo), sj = size_t(stride[size_t(j)]);
         for (int i = 0; i < columns; ++i) {
@@ -249,10 +269,14 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
             SurfWaves::TermsOptions options;
             options.velocity = false;
             options.dominant = SurfWaves::Dominant::kWhereBroken;
-            if (!surf) {
+            if (!surf || frame.Surf()->Bathy().Frame().ShoreFromWorld(x0, y0).s_m >= openSea) {
                 frame.AccumulateFft(x0, y0, filter, s);
-                if (gerstner)
+                if (ringGerstner)
                     local.Accumulate(float(rx), float(ry), gerstnerWeights.data(), s.data());
+                if (surf) {
+                    frame.AddOpenSea(s);
+                    out.surfFoam[v] = 0.0f;  // deeper than FadeDeep_m
+                }
             } else if (frame.DryLandSums(x0, y0, s, &options.seabedZ_m)) {
                 out.surfFoam[v] = 0.0f;  // dry sand, never wet: no foam
             } else {
@@ -261,9 +285,9 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
                 const SurfaceTerms st = frame.Surf()->Terms(x0, y0, frame.Time_s(), &info, options);
                 frame.AccumulateFft(x0, y0, filter, s, info.weights.cascade.data());
                 const double wg = info.weights.gerstner;
-                if (gerstner && wg == 1.0) {
+                if (ringGerstner && wg == 1.0) {
                     local.Accumulate(float(rx), float(ry), gerstnerWeights.data(), s.data());
-                } else if (gerstner && wg > 0.0) {
+                } else if (ringGerstner && wg > 0.0) {
                     GeometrySums g{};
                     local.Accumulate(float(rx), float(ry), gerstnerWeights.data(), g.data());
                     for (int k = 0; k < kGeometryTerms; ++k)
@@ -286,13 +310,25 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
 
     if (sameShape) return;
     // Vertex of world column c (a multiple of the ring's stride) on ring j.
+    // One remainder, and the stride (a power of two) as a mask and a shift: the integer
+    // divisions were most of the index buffer's cost.
+    std::vector<int> strideShift(static_cast<size_t>(rings));
+    for (int j = 0; j < rings; ++j) {
+        const int sj = stride[size_t(j)];
+        CHECK(sj > 0 && (sj & (sj - 1)) == 0);
+        strideShift[size_t(j)] = std::countr_zero(unsigned(sj));
+    }
     const auto vertex = [&](int j, int64_t c) {
         const uint32_t n = ringStart[size_t(j) + 1] - ringStart[size_t(j)];
-        const int64_t sj = stride[size_t(j)];
-        const bool whole = int64_t(n) * sj == circle;
-        const int64_t col = whole ? ((c % circle) + circle) % circle : c - ringFirst[size_t(j)];
-        CHECK(col % sj == 0);
-        const int64_t i = col / sj;
+        const int shift = strideShift[size_t(j)];
+        const bool whole = int64_t(n) << shift == circle;
+        int64_t col = c - ringFirst[size_t(j)];
+        if (whole) {
+            col = c % circle;  // wrapped into [0, circle)
+            if (col < 0) col += circle;
+        }
+        CHECK((col & ((int64_t(1) << shift) - 1)) == 0);
+        const int64_t i = col >> shift;
         CHECK(i >= 0 && i < int64_t(n));
         return ringStart[size_t(j)] + uint32_t(i);
     };

@@ -42,6 +42,11 @@ struct OceanMeshRequest {
     // configs/surf.yaml, against D ≈ 3 m), which 20° covers beyond ~2.3 m. So near the eye this
     // is the old margin, not a proof.
     bool widenByReach = false;
+    // False (tests only): no shortcut that provably changes no bit (see ocean_mesh.cpp): every
+    // vertex of a surf zone through the whole surf path, also where
+    // OceanSurfaceFrame::OpenSeaFrom_m proves it the deep sea's, and the Gerstner waves summed
+    // also on rings where each wave's footprint weight is 0.
+    bool shortcuts = true;
 };
 
 // The coarsest column stride of a ring near the eye with OceanMeshRequest::widenByReach.

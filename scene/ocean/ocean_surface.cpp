@@ -2,13 +2,14 @@
 // waves, the inverse-displacement query, a per-time frame cache and the sea's statistics.
 #include "scene/ocean/ocean_surface.h"
 
+#include <immintrin.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
-#include <xmmintrin.h>
 
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <mutex>
 #include <numbers>
@@ -17,6 +18,7 @@
 #include "scene/core/check.h"
 #include "scene/core/error.h"
 #include "scene/core/rng.h"
+#include "scene/core/simd_lanes.h"
 #include "scene/ocean/sea_state.h"
 
 namespace seasense::scene {
@@ -38,6 +40,29 @@ constexpr uint64_t kSurfPhaseStream = 0x53555246'00000002ULL;
 // (x0 + Δ/2) / (2^l Δ) − ½, taken as ((x0 + Δ/2) / Δ) · 2^−l − ½ from (qx, qy) = (x0 + Δ/2) / Δ,
 // which the levels of one cascade share. The same bits: a correctly rounded quotient scaled by a
 // power of two is the correctly rounded quotient by the scaled divisor (no underflow here).
+// Adds w00 a + w10 b + w01 d + w11 e to sums, the texels a = (i0, j0), b = (i1, j0),
+// d = (i0, j1), e = (i1, j1) of a level of n × n texels (row-major, kGeometryTerms floats each):
+// sums[k] += ((w00 a + w10 b) + w01 d) + w11 e, a vector of terms at a time (all eight with
+// AVX, four with SSE2): the same single-precision operations in the same order as one term at
+// a time, so the same bits.
+void AddTexels(const float* texels, int n, int i0, int j0, float w00, float w10, float w01,
+               float w11, GeometrySums& sums) {
+    const int i1 = (i0 + 1) & (n - 1), j1 = (j0 + 1) & (n - 1);
+    const float* a = texels + (size_t(i0) * size_t(n) + size_t(j0)) * kGeometryTerms;
+    const float* b = texels + (size_t(i1) * size_t(n) + size_t(j0)) * kGeometryTerms;
+    const float* d = texels + (size_t(i0) * size_t(n) + size_t(j1)) * kGeometryTerms;
+    const float* e = texels + (size_t(i1) * size_t(n) + size_t(j1)) * kGeometryTerms;
+    static_assert(kGeometryTerms % simd::kLanes == 0);
+    const simd::VF v00 = simd::Splat(w00), v10 = simd::Splat(w10);
+    const simd::VF v01 = simd::Splat(w01), v11 = simd::Splat(w11);
+    for (size_t k = 0; k < size_t(kGeometryTerms); k += simd::kLanes) {
+        const simd::VF term =
+            ((v00 * simd::Load(a + k) + v10 * simd::Load(b + k)) + v01 * simd::Load(d + k)) +
+            v11 * simd::Load(e + k);
+        simd::Store(&sums[k], simd::Load(&sums[k]) + term);
+    }
+}
+
 template <class Texture>
 void AddBilinear(const Texture& c, int level, double qx, double qy, float weight,
                  GeometrySums& sums) {
@@ -49,26 +74,29 @@ void AddBilinear(const Texture& c, int level, double qx, double qy, float weight
     const float wx = float(u - fu), wy = float(v - fv);
     // Power-of-two periodic wrap; two's complement makes the mask right for negative indices.
     const int i0 = int(int64_t(fu) & (n - 1)), j0 = int(int64_t(fv) & (n - 1));
-    const int i1 = (i0 + 1) & (n - 1), j1 = (j0 + 1) & (n - 1);
-    const auto* t = c.levels[size_t(level)].data();
-    const GeometrySums& a = t[size_t(i0) * size_t(n) + size_t(j0)].v;
-    const GeometrySums& b = t[size_t(i1) * size_t(n) + size_t(j0)].v;
-    const GeometrySums& d = t[size_t(i0) * size_t(n) + size_t(j1)].v;
-    const GeometrySums& e = t[size_t(i1) * size_t(n) + size_t(j1)].v;
     const float w00 = weight * (1.0f - wx) * (1.0f - wy), w10 = weight * wx * (1.0f - wy);
     const float w01 = weight * (1.0f - wx) * wy, w11 = weight * wx * wy;
-    // sums[k] += ((w00 a + w10 b) + w01 d) + w11 e, four terms at a time (SSE): the same
-    // single-precision operations in the same order as one term at a time, so the same bits.
-    static_assert(kGeometryTerms == 8);
-    const __m128 v00 = _mm_set1_ps(w00), v10 = _mm_set1_ps(w10);
-    const __m128 v01 = _mm_set1_ps(w01), v11 = _mm_set1_ps(w11);
-    for (size_t k = 0; k < size_t(kGeometryTerms); k += 4) {
-        const __m128 term = _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(v00, _mm_loadu_ps(&a[k])),
-                                                             _mm_mul_ps(v10, _mm_loadu_ps(&b[k]))),
-                                                  _mm_mul_ps(v01, _mm_loadu_ps(&d[k]))),
-                                       _mm_mul_ps(v11, _mm_loadu_ps(&e[k])));
-        _mm_storeu_ps(&sums[k], _mm_add_ps(_mm_loadu_ps(&sums[k]), term));
-    }
+    AddTexels(c.levels[size_t(level)].data()->v.data(), n, i0, j0, w00, w10, w01, w11, sums);
+}
+
+// Four doubles and four floats as GCC vectors (two SSE2 registers, or one AVX register, for
+// the doubles): each operation is the IEEE operation per lane.
+using D4 = double __attribute__((vector_size(32)));
+using F4 = float __attribute__((vector_size(16)));
+
+D4 LoadD4(const double* p) {
+    D4 v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+}
+
+D4 Floor4(D4 v) {
+#if defined(__AVX__)
+    return _mm256_floor_pd(v);
+#else
+    for (int k = 0; k < 4; ++k) v[k] = std::floor(v[k]);
+    return v;
+#endif
 }
 
 }  // namespace
@@ -138,9 +166,12 @@ void OceanSurfaceFrame::BuildTextures() {
 
 namespace {
 
+// Half the step of SeabedWithSlope's differences, m.
+constexpr double kSlopeStep_m = 0.05;
+
 // Seabed under the displaced point and its slope (central differences over 0.1 m), for the clamp.
 glm::dvec3 SeabedWithSlope(const Bathymetry& b, double x, double y) {
-    constexpr double d = 0.05;
+    constexpr double d = kSlopeStep_m;
     return {b.SeabedZ_m(x, y), (b.SeabedZ_m(x + d, y) - b.SeabedZ_m(x - d, y)) / (2.0 * d),
             (b.SeabedZ_m(x, y + d) - b.SeabedZ_m(x, y - d)) / (2.0 * d)};
 }
@@ -197,6 +228,17 @@ void OceanSurfaceFrame::AddSurf(double x0, double y0, const SurfaceTerms& s,
     }
 }
 
+void OceanSurfaceFrame::AddOpenSea(GeometrySums& sums) const {
+    CHECK(surf_);
+    // AddSurf's additions of SurfWaves::Terms' all-deep result (SurfaceTerms{}, the swash's 0
+    // added to its height), without the seabed lookup.
+    const SurfaceTerms zero;
+    sums[kTermHeight] += float(zero.displacement.z + surf_->Bathy().Tide_m());
+    for (const GeometryTerm k :
+         {kTermDispX, kTermDispY, kTermSlopeX, kTermSlopeY, kTermDispXX, kTermDispYY, kTermDispXY})
+        sums[k] += float(0.0);
+}
+
 bool OceanSurfaceFrame::DryLandSums(double x0, double y0, GeometrySums& sums,
                                     double* seabedZ_m) const {
     CHECK(surf_);
@@ -215,7 +257,12 @@ bool OceanSurfaceFrame::DryLandSums(double x0, double y0, GeometrySums& sums,
         if (seabedZ_m) *seabedZ_m = zBed;
         return false;
     }
-    const glm::dvec3 bed = SeabedWithSlope(bathy, x0, y0);
+    // On the level land behind the beach the five seabed samples are one constant, zBed (the
+    // same lookup at the same shore point), and both differences (z − z) / 0.1 = +0 exactly. The
+    // samples lie within 0.05 m of the point; 0.1 m covers the shore frame's rounding.
+    const glm::dvec3 bed = bathy.LevelLandAround(p.s_m, 2.0 * kSlopeStep_m)
+                               ? glm::dvec3(zBed, 0.0, 0.0)
+                               : SeabedWithSlope(bathy, x0, y0);
     sums = GeometrySums{};
     sums[kTermHeight] = float(bed.x);
     sums[kTermSlopeX] = float(bed.y);
@@ -239,12 +286,75 @@ FftFilter OceanSurfaceFrame::Filter(float footprint_m) const {
         lod = std::min(lod, float(top));
         f.level[c] = int(lod);
         f.frac[c] = lod - float(f.level[c]);
+        const auto add = [&](int level, float factor) {
+            const int l = f.lookups++;
+            f.cascade[size_t(l)] = int(c);
+            f.texel[size_t(l)] = t.texel_m;
+            f.halfTexel[size_t(l)] = 0.5 * t.texel_m;
+            f.scale[size_t(l)] = 1.0 / double(1 << level);
+            f.n[size_t(l)] = t.n >> level;
+            f.size[size_t(l)] = double(f.n[size_t(l)]);
+            f.invSize[size_t(l)] = 1.0 / f.size[size_t(l)];
+            f.factor[size_t(l)] = factor;
+            f.texels[size_t(l)] = t.levels[size_t(level)].data()->v.data();
+        };
+        add(f.level[c], 1.0f - f.frac[c]);
+        if (f.frac[c] > 0.0f) add(f.level[c] + 1, f.frac[c]);
+    }
+    static_assert(sizeof(Texel) == sizeof(GeometrySums));  // texels read as rows of floats
+    // Pad to whole groups of four with the last lookup (read, never added).
+    for (int l = f.lookups; l % 4 != 0; ++l) {
+        const size_t last = size_t(f.lookups - 1);
+        f.cascade[size_t(l)] = f.cascade[last];
+        f.texel[size_t(l)] = f.texel[last];
+        f.halfTexel[size_t(l)] = f.halfTexel[last];
+        f.scale[size_t(l)] = f.scale[last];
+        f.n[size_t(l)] = f.n[last];
+        f.size[size_t(l)] = f.size[last];
+        f.invSize[size_t(l)] = f.invSize[last];
+        f.factor[size_t(l)] = f.factor[last];
+        f.texels[size_t(l)] = f.texels[last];
     }
     return f;
 }
 
 void OceanSurfaceFrame::AccumulateFft(double x0, double y0, const FftFilter& filter,
                                       GeometrySums& sums, const double* cascadeWeights) const {
+    // AddBilinear's operations, lane for lane, four lookups at a time; the texels are then added
+    // one lookup after the other in AccumulateFftOneByOne's order.
+    for (int g = 0; g < filter.lookups; g += 4) {
+        const size_t l = size_t(g);
+        const D4 texel = LoadD4(&filter.texel[l]), half = LoadD4(&filter.halfTexel[l]);
+        const D4 scale = LoadD4(&filter.scale[l]);
+        const D4 u = ((x0 + half) / texel) * scale - 0.5;
+        const D4 v = ((y0 + half) / texel) * scale - 0.5;
+        const D4 fu = Floor4(u), fv = Floor4(v);
+        const F4 wx = __builtin_convertvector(u - fu, F4), wy = __builtin_convertvector(v - fv, F4);
+        // int64_t(fu) & (n − 1) exactly, in double: fu − n ⌊fu · 1/n⌋ (n a power of two, fu a
+        // whole number: every step is exact), in [0, n).
+        const D4 size = LoadD4(&filter.size[l]), invSize = LoadD4(&filter.invSize[l]);
+        const D4 iu = fu - size * Floor4(fu * invSize), iv = fv - size * Floor4(fv * invSize);
+        // × 1 is exact: unweighted cascades add the same bits as without weights.
+        F4 w, weight;
+        for (int k = 0; k < 4; ++k) {
+            w[k] = cascadeWeights ? float(cascadeWeights[filter.cascade[l + size_t(k)]]) : 1.0f;
+            weight[k] = filter.factor[l + size_t(k)] * w[k];
+        }
+        const F4 one = F4{} + 1.0f;
+        const F4 w00 = weight * (one - wx) * (one - wy), w10 = weight * wx * (one - wy);
+        const F4 w01 = weight * (one - wx) * wy, w11 = weight * wx * wy;
+        const int end = std::min(4, filter.lookups - g);
+        for (int k = 0; k < end; ++k) {
+            if (w[k] == 0.0f) continue;
+            AddTexels(filter.texels[l + size_t(k)], filter.n[l + size_t(k)], int(iu[k]), int(iv[k]),
+                      w00[k], w10[k], w01[k], w11[k], sums);
+        }
+    }
+}
+
+void OceanSurfaceFrame::AccumulateFftOneByOne(double x0, double y0, const FftFilter& filter,
+                                              GeometrySums& sums,
+                                              const double* cascadeWeights) const {
     for (size_t c = 0; c < textures_.size(); ++c) {
         // × 1 is exact: unweighted cascades add the same bits as without weights.
         const float w = cascadeWeights ? float(cascadeWeights[c]) : 1.0f;
@@ -390,15 +500,35 @@ void OceanSurface::Complete(OceanSurfaceFrame& frame, double t) const {
     frame.maxHorizontal_m_ += gerstner_.MaxHorizontal_m();
     frame.surf_ = surf_;
     frame.surfReach_m_ = 0.0;
+    frame.openSeaFrom_m_ = kInf;
     if (surf_) {
         // Over the whole surface: the surf bound at every depth, the whole seabed.
         // One table per frame serves every BoundsNear (each view asks for a few discs).
         frame.surfBounds_ = surf_->MakeBoundTable(frame.cascadeBounds_, frame.GerstnerBound());
         frame.surfReach_m_ = surf_->BoundAtDepths(-kInf, frame.surfBounds_).horizontal_m;
+        frame.openSeaFrom_m_ = frame.OpenSeaFrom(*surf_);
         const SurfaceBounds all = frame.BoundsNear(0.0, 0.0, kInf);
         frame.maxHeight_m_ = all.height_m;
         frame.maxHorizontal_m_ = all.horizontal_m;
     }
+}
+
+double OceanSurfaceFrame::OpenSeaFrom(const SurfWaves& surf) const {
+    // The deep sea (FFT cascades and Gerstner waves at full weight) moves a point at most D
+    // horizontally and lowers it at most H below the tide: each cascade's largest |η| and |D|
+    // over its full-resolution texels (its mips and the bilinear and trilinear blends average
+    // them; BuildTextures), each Gerstner wave's A and Q A / tanh kh. The mesh sums them in
+    // float, ~1e-6 relative: the margin is far above that.
+    const SurfWaves::Bound deep = surfBounds_.deep;
+    const double margin = 0.01 + 1e-3 * (deep.height_m + deep.horizontal_m);
+    // Seaward of s1 the still-water depth is at least h everywhere (Bathymetry::DeepSeawardOf_m):
+    // there DryLandSums finds water (h > 0), Weights(h) are the deep defaults and AllDeep
+    // (h ≥ FadeDeep_m), Swash_m is 0 (h ≥ 2 R2), and the seabed lies below tide − H − margin,
+    // under the lowest the deep sea reaches. A rest position D + margin seaward of s1 then has
+    // its displaced point (within D of it) seaward of s1 too, where the clamp cannot apply.
+    double h = std::max(surf.FadeDeep_m(), deep.height_m + margin);
+    if (surf.Swash().active) h = std::max(h, 2.0 * surf.Swash().runup2_m);
+    return surf.Bathy().DeepSeawardOf_m(h) + deep.horizontal_m + margin;
 }
 
 SurfWaves::Bound OceanSurfaceFrame::GerstnerBound() const {

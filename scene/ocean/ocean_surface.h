@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <span>
@@ -58,6 +59,18 @@ struct FftFilter {
     static constexpr int kMaxCascades = 8;
     std::array<int, kMaxCascades> level{};
     std::array<float, kMaxCascades> frac{};
+    // What OceanSurfaceFrame::Filter derives for AccumulateFft (valid with the frame that made
+    // it): the texel lookups in the order they add, per cascade level[c] with factor
+    // 1 − frac[c], then level[c] + 1 with frac[c] where frac[c] > 0; per lookup its cascade,
+    // texel size Δ and Δ/2, 2^−level, the level's size n (and as doubles n and 1/n) and texels
+    // (row-major, kGeometryTerms floats each). Padded to a multiple of four lookups with copies
+    // of the last, which are never added.
+    static constexpr int kMaxLookups = 2 * kMaxCascades;
+    int lookups = 0;
+    std::array<double, kMaxLookups> texel{}, halfTexel{}, scale{}, size{}, invSize{};
+    std::array<int, kMaxLookups> cascade{}, n{};
+    std::array<float, kMaxLookups> factor{};
+    std::array<const float*, kMaxLookups> texels{};
 };
 
 // The surface at one instant: an immutable snapshot once made by OceanSurface.
@@ -96,8 +109,12 @@ class OceanSurfaceFrame {
     // The same with the levels of a footprint resolved once (e.g. per mesh ring).
     FftFilter Filter(float footprint_m) const;
     // With cascadeWeights (one per cascade, e.g. SurfWeights::cascade) each cascade is scaled.
+    // The lookups' coordinates and weights four at a time.
     void AccumulateFft(double x0, double y0, const FftFilter& filter, GeometrySums& sums,
                        const double* cascadeWeights = nullptr) const;
+    // The same one lookup at a time (the scalar form; tests compare the two bit for bit).
+    void AccumulateFftOneByOne(double x0, double y0, const FftFilter& filter, GeometrySums& sums,
+                               const double* cascadeWeights = nullptr) const;
 
     // Unit upward normal of the surface at rest position (x0, y0) (world m) band-limited to a
     // footprint (m), FFT cascades and Gerstner waves together: for shading finer than the mesh
@@ -110,6 +127,9 @@ class OceanSurfaceFrame {
     // and info from Surf()->Terms at the frame time) and the tide, and clamps the height to the
     // seabed under the displaced point.
     void AddSurf(double x0, double y0, const SurfaceTerms& surfTerms, GeometrySums& sums) const;
+    // AddSurf for a rest position seaward of OpenSeaFrom_m, the same bits: the surf terms there
+    // are zero (the tide added to the height, +0 to the rest) and the clamp cannot apply.
+    void AddOpenSea(GeometrySums& sums) const;
     // With a surf zone: whether rest position (x0, y0) is dry land that no water reaches at any
     // time (seabed above the tide plus the swash maximum), and if so the surface there, sums set
     // to exactly what the deep sea, the surf terms and AddSurf's seabed clamp give (the seabed
@@ -117,6 +137,14 @@ class OceanSurfaceFrame {
     // (as SurfWaves::Terms looks it up) is written to seabedZ_m if given, for
     // SurfWaves::TermsOptions::seabedZ_m.
     bool DryLandSums(double x0, double y0, GeometrySums& sums, double* seabedZ_m = nullptr) const;
+
+    // With a surf zone: the cross-shore distance (shore frame s, m) seaward of which the mesh's
+    // surf path at a rest position is the deep sea's alone, bit for bit: DryLandSums finds water,
+    // SurfWaves::Terms finds every part of the sea at full weight, no surf component and no swash
+    // (the depth is at least FadeDeep_m and twice the swash's run-up), and AddSurf's seabed clamp
+    // cannot apply (the seabed under any point the deep sea can carry there lies lower than its
+    // deepest trough). +∞ without a surf zone or with a depth grid. See Complete for the bounds.
+    double OpenSeaFrom_m() const { return openSeaFrom_m_; }
 
     // The surf components (nullptr without environment.ocean.surf).
     const SurfWaves* Surf() const { return surf_.get(); }
@@ -163,6 +191,8 @@ class OceanSurfaceFrame {
     // Cascade c's bound over the lookups at rest positions within radius_m of (x, y).
     SurfWaves::Bound CascadeBoundNear(size_t c, double x, double y, double radius_m) const;
     SurfWaves::Bound GerstnerBound() const;
+    // OpenSeaFrom_m for the frame's bounds (surfBounds_ made).
+    double OpenSeaFrom(const SurfWaves& surf) const;
 
     double t_s_ = 0.0;
     GerstnerOcean gerstner_;
@@ -175,6 +205,7 @@ class OceanSurfaceFrame {
     std::vector<SurfWaves::Bound> cascadeBounds_;  // per cascade: max |η|, max |D|
     SurfWaves::BoundTable surfBounds_;  // SurfWaves::BoundAtDepths of this frame's bounds
     double surfReach_m_ = 0.0;          // largest horizontal displacement anywhere, with the surf
+    double openSeaFrom_m_ = std::numeric_limits<double>::infinity();
     double significantHeight_m_ = 0.0;
 };
 

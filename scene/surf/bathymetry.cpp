@@ -159,6 +159,29 @@ double Bathymetry::MaxSeabedZWithin_m(double x, double y, double radius_m) const
     return z;
 }
 
+double Bathymetry::DeepSeawardOf_m(double depth_m) const {
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    // The profile's pieces are each monotone in floating point too (rounding is monotone); where
+    // they meet, the two sides' values differ by rounding (~1e-15 m), which the margin covers.
+    constexpr double kMargin_m = 1e-6;
+    const double z = settings_.tide_m - depth_m - kMargin_m;  // the seabed must lie at or below
+    if (settings_.depthGrid || !(-oceanDepth_m_ <= z)) return kInf;
+    // Bisection between a landward s where the profile is too high and a seaward one where it
+    // is low enough: keeps the seaward end, at which (and beyond which) the profile is low enough.
+    double lo = std::min(sLand_m_, 0.0) - 1.0, hi = std::max(sOffshore_m_, 1.0);
+    if (ProfileZ_m(lo) <= z) return kInf;  // level land that deep: not a beach this code knows
+    while (!(ProfileZ_m(hi) <= z)) {
+        hi = 2.0 * hi;
+        if (!std::isfinite(hi)) return kInf;
+    }
+    for (int i = 0; i < 100 && hi - lo > 1e-9 * std::max(1.0, std::abs(hi)); ++i) {
+        const double mid = 0.5 * (lo + hi);
+        (ProfileZ_m(mid) <= z ? hi : lo) = mid;
+    }
+    // Sandbars lift the seabed only within [barSMin, barSMax] (BarLift).
+    return barSMax_m_ >= barSMin_m_ ? std::max(hi, std::nextafter(barSMax_m_, kInf)) : hi;
+}
+
 double Bathymetry::SeabedZ_m(double x, double y) const {
     if (settings_.depthGrid) {
         const DepthGridSettings& g = *settings_.depthGrid;

@@ -48,6 +48,20 @@ class Bathymetry {
     // grid never exceeds its largest node in the disc's bounding box. +∞ radius: the whole bed.
     double MaxSeabedZWithin_m(double x, double y, double radius_m) const;
 
+    // A cross-shore distance s (m) seaward of which the still-water depth is at least depth_m
+    // everywhere: DepthAtShore_m(s', u) ≥ depth_m for every s' ≥ s and every u (the plane
+    // profile falls monotonically seaward, no sandbar lies seaward of s). +∞ with a depth grid or
+    // where the seabed never gets that deep.
+    double DeepSeawardOf_m(double depth_m) const;
+
+    // Whether every point within radius_m of cross-shore distance s_m (any u) lies on the level
+    // ground landward of the beach, where SeabedZ_m is exactly ProfileZ_m(s_m), one constant:
+    // no depth grid, no sandbar reaching it.
+    bool LevelLandAround(double s_m, double radius_m) const {
+        return !settings_.depthGrid && s_m + radius_m < sLand_m_ &&
+               !(barSMax_m_ >= barSMin_m_ && s_m + radius_m >= barSMin_m_);
+    }
+
     // The plane beach alone: seabed elevation of the littoral slopes at cross-shore distance s
     // (no sandbars, no grid), floored at −oceanDepth_m.
     double ProfileZ_m(double s_m) const;

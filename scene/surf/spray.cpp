@@ -36,29 +36,12 @@ SprayField::SprayField(const SurfWaves& surf, const SpraySettings& settings,
                        const glm::dvec3& wind_mps)
     : surf_(surf), settings_(settings), wind_mps_(wind_mps) {
     CHECK(settings_.cell_m > 0.0 && settings_.interval_s > 0.0 && settings_.lifetime_s > 0.0);
-    // Walk up from the shore to the deepest depth where the bound 2 Σ A_j √(cg0/cg) reaches γ h
-    // (energy-flux shoaling; the surf only draws its components shallower than FadeDeep_m).
-    const double deep = surf_.Bathy().OceanDepth_m();
-    const double top = std::min(surf_.FadeDeep_m(), deep);
-    std::vector<double> cg0;
-    for (const SurfComponent& c : surf_.Components())
-        cg0.push_back(GroupSpeed(WavenumberForOmega(c.omega_radps, deep), deep));
-    constexpr double kStep_m = 0.1;
-    for (double h = kStep_m; h <= top; h += kStep_m) {
-        double sum = 0.0;
-        for (size_t j = 0; j < cg0.size(); ++j) {
-            const SurfComponent& c = surf_.Components()[j];
-            sum += c.amplitude_m *
-                   std::sqrt(cg0[j] / GroupSpeed(WavenumberForOmega(c.omega_radps, h), h));
-        }
-        if (2.0 * sum >= surf_.BreakerIndex() * h) maxBreakDepth_m_ = h + kStep_m;
-    }
 }
 
 std::vector<SprayParticle> SprayField::Particles(const glm::dvec3& eye, double t,
                                                  SprayStats* stats) const {
     std::vector<SprayParticle> out;
-    if (!settings_.enabled || maxBreakDepth_m_ <= 0.0 || settings_.maxParticles == 0) {
+    if (!settings_.enabled || surf_.MaxBreakingDepth_m() <= 0.0 || settings_.maxParticles == 0) {
         if (stats) *stats = {};
         return out;
     }
@@ -89,7 +72,7 @@ std::vector<SprayParticle> SprayField::Particles(const glm::dvec3& eye, double t
              ix <= int64_t(std::floor((eye.x + halfX) / c)); ++ix) {
             const double cx = (double(ix) + 0.5) * c;
             const double h = surf_.Bathy().Depth_m(cx, cy);
-            if (h <= 0.0 || h > maxBreakDepth_m_) continue;
+            if (h <= 0.0 || h > surf_.MaxBreakingDepth_m()) continue;
             ++acc.cells;
             const uint64_t cell = seed ^ Mix64(CellKey(ix, iy));
             for (int64_t n = n0; n <= n1; ++n) {

@@ -64,15 +64,14 @@ class SprayField {
                                          SprayStats* stats = nullptr) const;
 
     // Deepest still-water depth (m) at which 2 Σ A_j (each shoaled by energy flux at that depth)
-    // reaches γ h: no breaking deeper (the envelope 2A ≤ 2 Σ A_j, refraction only lowers it).
-    double MaxBreakingDepth_m() const { return maxBreakDepth_m_; }
+    // reaches γ h: no breaking deeper (SurfWaves::MaxBreakingDepth_m).
+    double MaxBreakingDepth_m() const { return surf_.MaxBreakingDepth_m(); }
     const SpraySettings& Settings() const { return settings_; }
 
   private:
     const SurfWaves& surf_;
     SpraySettings settings_;
     glm::dvec3 wind_mps_;
-    double maxBreakDepth_m_ = 0.0;
 };
 
 }  // namespace seasense::scene

@@ -218,6 +218,20 @@ SurfWaves::SurfWaves(const Bathymetry& bathymetry, std::vector<SurfComponent> co
     }
     BuildShelters();
     BuildSwash();
+    // Walk up from the shore to the deepest depth where the bound 2 Σ A_j √(cg0/cg) reaches γ h
+    // (energy-flux shoaling; the surf only draws its components shallower than FadeDeep_m).
+    // Each component's deep group speed is its track's cg0.
+    const double top = std::min(fadeDeep_m_, depthForDeep);
+    constexpr double kStep_m = 0.1;
+    for (double h = kStep_m; h <= top; h += kStep_m) {
+        double sum = 0.0;
+        for (size_t j = 0; j < components_.size(); ++j) {
+            const SurfComponent& c = components_[j];
+            sum += c.amplitude_m *
+                   std::sqrt(tracks_[j].cg0 / GroupSpeed(WavenumberForOmega(c.omega_radps, h), h));
+        }
+        if (2.0 * sum >= settings_.breakerIndex * h) maxBreakDepth_m_ = h + kStep_m;
+    }
 }
 
 // --- Sandbar shelter (see surf_waves.h).

@@ -183,6 +183,12 @@ class SurfWaves {
     // never break before the shore.
     double BreakerLine_m() const { return sBreak_m_; }
 
+    // Deepest still-water depth (m, in 0.1 m steps; 0 if none) at which 2 Σ A_j, each deep-water
+    // amplitude shoaled by energy flux to that depth, reaches γ h: no component breaks deeper (the
+    // envelope 2A ≤ 2 Σ A_j, refraction only lowers it). Made once here rather than per spray
+    // field: each channel's frame made a SprayField (~1.2 M instructions of dispersion solves).
+    double MaxBreakingDepth_m() const { return maxBreakDepth_m_; }
+
     // --- Swash run-up (seed 003: "the cusp surf sporadically washes farther up inland in various
     // places and then retreats"). Published scale (Stockdon, Holman, Howd & Sallenger, Coastal
     // Eng. 53, 573 (2006), eqs. 10-12, deep-water Hs H0, peak wavelength L0 = g Tp²/2π,
@@ -294,6 +300,7 @@ class SurfWaves {
     std::vector<double> lanePhase_;  // [i · lanes_ + m]
     double shelterSeaward_m_ = 0.0;  // with shelters: none seaward of this cross-shore s
     double sBreak_m_ = 0.0;
+    double maxBreakDepth_m_ = 0.0;
     std::vector<double> breakTime_s_;  // group travel time from the breaker line, per s sample
 };
 

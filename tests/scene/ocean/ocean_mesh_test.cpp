@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cmath>
@@ -156,6 +157,43 @@ TEST(OceanMesh, GridIsWatertight) {
         EXPECT_GT(uses.size(), 10000u);
         EXPECT_LT(border, uses.size() / 20);
     }
+}
+
+TEST(OceanMesh, ASectorOneColumnShortOfTheCircleAcrossNorthWrapsItsColumns) {
+    // Columns lo … hi − 1 with hi − lo = circle − 1 and lo < 0: each ring holds every column
+    // (stored as a whole circle) while its bands do not, so the triangles' negative columns
+    // must wrap. Every triangle joins columns at most one apart around the circle, of one ring
+    // or two neighbouring ones, and every vertex is used.
+    const OceanSurface sea(Beaufort5());
+    OceanMeshRequest req = View({0.0, 0.0, 2.0}, 0.0, 1.0);
+    const int circle = int(std::ceil(2.0 * kPi / req.angularStep_rad));
+    const double dphi = 2.0 * kPi / circle;
+    req.azimuthMin_rad = -kPi + 0.5 * dphi;
+    req.azimuthMax_rad = kPi - 1.5 * dphi;
+    OceanMesh m;
+    BuildOceanMesh(*sea.At(1.0), req, m);
+    ASSERT_EQ(m.circleSegments, circle);
+    ASSERT_TRUE(m.fullCircle);
+    const auto place = [&](uint32_t v) {
+        const int j =
+            int(std::upper_bound(m.ringStart.begin(), m.ringStart.end(), v) - m.ringStart.begin()) -
+            1;
+        const int64_t c = m.ringFirstColumn[size_t(j)] +
+                          int64_t(v - m.ringStart[size_t(j)]) * m.ringStride[size_t(j)];
+        return std::pair<int, int64_t>(j, ((c % circle) + circle) % circle);
+    };
+    std::vector<bool> used(m.positions.size(), false);
+    for (size_t t = 0; t < m.indices.size(); t += 3)
+        for (int e = 0; e < 3; ++e) {
+            used[m.indices[t + size_t(e)]] = true;
+            const auto [ja, ca] = place(m.indices[t + size_t(e)]);
+            const auto [jb, cb] = place(m.indices[t + size_t((e + 1) % 3)]);
+            ASSERT_LE(std::abs(ja - jb), 1);
+            const int64_t apart =
+                std::min((ca - cb + circle) % circle, (cb - ca + circle) % circle);
+            ASSERT_LE(apart, 1) << "triangle " << t / 3;
+        }
+    EXPECT_EQ(std::count(used.begin(), used.end(), false), 0);
 }
 
 // With widenByReach each band is widened by asin(D / r) (at most 20°): a sea point drawn in
@@ -359,7 +397,8 @@ TEST(OceanMesh, LocalBoundsHoldAtEveryVertexDrawnFromTheDisc) {
 
 TEST(OceanMesh, DryLandShortcutIsTheFullEvaluationBitForBit) {
     // Where OceanSurfaceFrame::DryLandSums claims dry land, the mesh skips the surf terms, the
-    // faded deep sea and the clamp test: its sums must be exactly what that whole path (as
+    // faded deep sea and the clamp test (and on the level land behind the beach the seabed's
+    // slope samples): its sums must be exactly what that whole path (as
     // BuildOceanMesh's surf branch evaluates it) gives, across the swash zone and up the beach,
     // at times with the swash high and low.
     // configs/surf.yaml: sea state 4 onto a barred beach (land to the west) with swash.
@@ -368,7 +407,7 @@ TEST(OceanMesh, DryLandShortcutIsTheFullEvaluationBitForBit) {
     const OceanSurface sea(sc.environment.ocean);
     ASSERT_TRUE(sea.Surf()->Swash().active);
     const Bathymetry& b = sea.Surf()->Bathy();
-    int dry = 0, wet = 0, clampedWet = 0;
+    int dry = 0, wet = 0, clampedWet = 0, level = 0;
     for (const double t : {3.0, 17.5, 41.0}) {
         const auto frame = sea.At(t);
         const glm::dvec2 eye(40.0, 25.0);
@@ -392,6 +431,7 @@ TEST(OceanMesh, DryLandShortcutIsTheFullEvaluationBitForBit) {
                     continue;
                 }
                 ++dry;
+                if (b.LevelLandAround(b.Frame().ShoreFromWorld(x, y).s_m, 0.1)) ++level;
                 EXPECT_GT(b.SeabedZ_m(x, y), b.Tide_m() + sea.Surf()->Swash().max_m);
                 for (int k = 0; k < kGeometryTerms; ++k)
                     ASSERT_EQ(std::bit_cast<uint32_t>(fast[size_t(k)]),
@@ -401,6 +441,7 @@ TEST(OceanMesh, DryLandShortcutIsTheFullEvaluationBitForBit) {
         }
     }
     EXPECT_GT(dry, 1000);
+    EXPECT_GT(level, 500);  // the level land behind the beach (no slope samples)
     EXPECT_GT(wet, 1000);
     EXPECT_GT(clampedWet, 10);  // the swash zone's own clamp stays on the full path
 }
@@ -464,6 +505,96 @@ TEST(OceanMesh, SurfTermsOptionsOfTheMeshChangeNothingItUses) {
     EXPECT_GT(broken, 1000);
     EXPECT_GT(unbroken, 1000);
     EXPECT_GT(foamy, 500);
+}
+
+// Every vertex, normal, Jacobian and foam value of mesh a is b's, bit for bit.
+void ExpectSameMesh(const OceanMesh& a, const OceanMesh& b) {
+    ASSERT_EQ(a.positions.size(), b.positions.size());
+    ASSERT_EQ(a.ringStart, b.ringStart);
+    ASSERT_EQ(a.surfFoam.size(), b.surfFoam.size());
+    const auto bits = [](const auto& v) {
+        std::vector<uint32_t> out(sizeof(v[0]) / 4 * v.size());
+        std::memcpy(out.data(), v.data(), out.size() * 4);
+        return out;
+    };
+    ASSERT_EQ(bits(a.positions), bits(b.positions));
+    ASSERT_EQ(bits(a.normals), bits(b.normals));
+    ASSERT_EQ(bits(a.jacobian), bits(b.jacobian));
+    ASSERT_EQ(bits(a.surfFoam), bits(b.surfFoam));
+}
+
+TEST(OceanMesh, ShortcutsAreTheWholePathBitForBit) {
+    // Seaward of OceanSurfaceFrame::OpenSeaFrom_m the mesh adds the deep sea and the tide
+    // without the surf terms, the dry-land test or the seabed clamp's lookup, and on rings where
+    // every Gerstner wave's footprint weight is 0 it sums no Gerstner wave. Meshes with and
+    // without those shortcuts must be the same bits: configs/surf.yaml (a barred beach, swash,
+    // land to the west) and configs/five-channel.yaml (the beach 600 m ahead, a 120 m swell),
+    // from eyes far offshore, near the open sea's edge, in the fade, in the surf and on the
+    // beach, looking seaward, along and onto the shore, and the open sea without a surf zone,
+    // at three times each; many vertices on both sides of each shortcut.
+    size_t open = 0, surfPath = 0, noGerstner = 0, gerstner = 0;
+    const auto compare = [&](const OceanSurfaceFrame& frame, OceanMeshRequest req) {
+        OceanMesh fast, whole;
+        BuildOceanMesh(frame, req, fast);
+        req.shortcuts = false;
+        BuildOceanMesh(frame, req, whole);
+        ExpectSameMesh(fast, whole);
+        const ShoreFrame* shore = frame.Surf() ? &frame.Surf()->Bathy().Frame() : nullptr;
+        const GerstnerOcean::LocalFrame local = frame.Gerstner().Local(0.0, 0.0, 0.0);
+        std::vector<float> weights(frame.Gerstner().WaveCount());
+        for (int j = 0; j < fast.rings; ++j) {
+            local.FootprintWeights(fast.footprint_m[size_t(j)], weights.data());
+            const uint32_t n = fast.ringStart[size_t(j) + 1] - fast.ringStart[size_t(j)];
+            const bool weighted =
+                std::any_of(weights.begin(), weights.end(), [](float w) { return w > 0.0f; });
+            ++(weighted ? gerstner : noGerstner);
+            for (uint32_t i = 0; shore && i < n; ++i) {
+                const int64_t c =
+                    fast.ringFirstColumn[size_t(j)] + int64_t(i) * fast.ringStride[size_t(j)];
+                const double az = 2.0 * kPi * double(c) / fast.circleSegments;
+                const double r = fast.radii_m[size_t(j)];
+                const glm::dvec2 rest(req.eye_m.x + r * std::sin(az),
+                                      req.eye_m.y + r * std::cos(az));
+                ++(shore->ShoreFromWorld(rest.x, rest.y).s_m >= frame.OpenSeaFrom_m() ? open
+                                                                                      : surfPath);
+            }
+        }
+    };
+    for (const char* config : {"configs/surf.yaml", "configs/five-channel.yaml"}) {
+        const Scenario sc = LoadScenario(std::filesystem::path(SEASENSE_SOURCE_DIR) / config);
+        const OceanSurface sea(sc.environment.ocean);
+        const ShoreFrame& shore = sea.Surf()->Bathy().Frame();
+        for (const double t : {2.0, 19.25, 47.5}) {
+            const auto frame = sea.At(t);
+            const double from = frame->OpenSeaFrom_m();
+            ASSERT_TRUE(std::isfinite(from));
+            ASSERT_GT(from, sea.Surf()->Bathy().DeepSeawardOf_m(sea.Surf()->FadeDeep_m()));
+            for (const double s : {1500.0, from + 40.0, from - 30.0, 330.0, 60.0, -30.0}) {
+                const glm::dvec2 p = shore.WorldFromShore(s, 25.0);
+                const glm::dvec3 eye(p.x, p.y, s > 0.0 ? 2.0 : 9.0);
+                const double seaward = std::atan2(shore.Seaward().x, shore.Seaward().y);
+                for (const double look : {0.0, 0.5 * kPi, 0.8 * kPi, kPi}) {
+                    OceanMeshRequest req = View(eye, seaward + look, 0.6);
+                    req.widenByReach = true;
+                    compare(*frame, req);
+                    if (HasFatalFailure()) {
+                        ADD_FAILURE() << config << " t " << t << " s " << s << " look " << look;
+                        return;
+                    }
+                }
+            }
+        }
+    }
+    const OceanSurface sea(Beaufort5());
+    for (const double t : {2.0, 19.25, 47.5})
+        for (const double z : {2.0, 30.0}) {
+            compare(*sea.At(t), View({30.0, -20.0, z}, 0.3 * t, 0.6));
+            ASSERT_FALSE(HasFatalFailure()) << "t " << t << " z " << z;
+        }
+    EXPECT_GT(open, 200000u);
+    EXPECT_GT(surfPath, 200000u);
+    EXPECT_GT(noGerstner, 1000u);  // rings
+    EXPECT_GT(gerstner, 1000u);
 }
 
 TEST(OceanMesh, SurfMeshAndFrameBitIdenticalForAnyThreadCount) {

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
+#include <array>
 #include <bit>
 #include <cmath>
 #include <numbers>
@@ -326,6 +327,46 @@ TEST(OceanSurface, FilteredLookupIsTheFieldAtFineFootprintsAndLosesVarianceAsItG
         }
     }
     EXPECT_LT(previous, 1e-6);
+}
+
+TEST(OceanSurface, LookupsFourAtATimeAreTheLookupsOneByOneBitForBit) {
+    // AccumulateFft computes the lookups' texel coordinates, wraps and weights four at a time:
+    // the same sums as one lookup at a time, bit for bit, at footprints from below the finest
+    // texel to beyond the coarsest mip (one and two levels per cascade), at points near and far
+    // (negative and 1e6 m coordinates wrap too), without and with cascade weights (0 skips a
+    // cascade), over one, two and three cascades.
+    for (const int cascades : {1, 2, 3}) {
+        OceanSettings o = Beaufort5(7, 64, false);
+        o.spectral->fft.cascadeCount = cascades;
+        const OceanSurface sea(o);
+        const auto frame = sea.At(3.25);
+        uint64_t state = 0x9e3779b97f4a7c15ULL;
+        const auto uniform = [&] {
+            state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+            return double(state >> 11) * 0x1.0p-53;
+        };
+        int compared = 0;
+        for (const float footprint : {0.0f, 0.07f, 0.4f, 1.0f, 3.3f, 17.0f, 250.0f, 1e5f}) {
+            const FftFilter filter = frame->Filter(footprint);
+            for (int i = 0; i < 400; ++i) {
+                const double range = i % 4 == 0 ? 1e6 : i % 4 == 1 ? 50.0 : 3000.0;
+                const double x = (2.0 * uniform() - 1.0) * range,
+                             y = (2.0 * uniform() - 1.0) * range;
+                const std::array<double, 3> w{uniform(), i % 3 == 0 ? 0.0 : 1.0, uniform()};
+                for (const double* weights : {static_cast<const double*>(nullptr), w.data()}) {
+                    GeometrySums a{}, b{};
+                    frame->AccumulateFft(x, y, filter, a, weights);
+                    frame->AccumulateFftOneByOne(x, y, filter, b, weights);
+                    for (int k = 0; k < kGeometryTerms; ++k)
+                        ASSERT_EQ(std::bit_cast<uint32_t>(a[size_t(k)]),
+                                  std::bit_cast<uint32_t>(b[size_t(k)]))
+                            << cascades << " " << footprint << " " << x << " " << y << " " << k;
+                    ++compared;
+                }
+            }
+        }
+        EXPECT_EQ(compared, 8 * 400 * 2);
+    }
 }
 
 TEST(OceanSurface, DetailNormalIsTheSurfaceNormalAtFineFootprints) {

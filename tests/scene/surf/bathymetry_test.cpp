@@ -173,6 +173,29 @@ TEST(Bathymetry, SeabedBoundOverADiscHoldsEverywhereInIt) {
                 b.ProfileZ_m(b.LandwardEdge_m() - 1.0), 1e-12);
 }
 
+// Seaward of DeepSeawardOf_m(h) the still water is at least h deep everywhere, bars included,
+// and a metre landward of it (off the bar) it is shallower: the bound is the profile's own.
+TEST(Bathymetry, DeepSeawardOfBoundsTheDepthEverywhereSeawardOfIt) {
+    const Bathymetry barred(BarredBeach(), 20.0), plane(EastFacingBeach(), 20.0);
+    for (const Bathymetry* b : {&barred, &plane}) {
+        for (const double h : {0.2, 0.5, 1.2, 3.0, 7.5, 15.0, 20.4}) {
+            const double s = b->DeepSeawardOf_m(h);
+            ASSERT_TRUE(std::isfinite(s)) << h;
+            for (double ds = 0.0; ds < 800.0; ds += 0.0625)
+                for (const double u : {0.0, 180.0, 200.0, 333.0})
+                    ASSERT_GE(b->DepthAtShore_m(s + ds, u), h) << h << " " << ds << " " << u;
+            // Off the bar (its flanks end at s = 135 + 1 mm) the profile sets it to within 1 m.
+            if (s > 136.0) EXPECT_LT(b->DepthAtShore_m(s - 1.0, 0.0), h) << h;
+        }
+        // Never that deep (the floor lies 20 m below mean sea level): no such distance.
+        EXPECT_EQ(b->DeepSeawardOf_m(b->Tide_m() + 20.0 + 0.01),
+                  std::numeric_limits<double>::infinity());
+    }
+    // On the barred beach a depth the bar's crest (1 m) rises above is found seaward of it.
+    EXPECT_GT(barred.DeepSeawardOf_m(1.2), 135.0);
+    EXPECT_LT(plane.DeepSeawardOf_m(1.2), 80.0);
+}
+
 TEST(Bathymetry, RegionsRepeatAlongTheShore) {
     const Bathymetry b(BarredBeach(), 20.0);
     EXPECT_DOUBLE_EQ(b.RegionPeriod_m(), 700.0);
