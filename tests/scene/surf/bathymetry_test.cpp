@@ -181,9 +181,11 @@ TEST(Bathymetry, DeepSeawardOfBoundsTheDepthEverywhereSeawardOfIt) {
         for (const double h : {0.2, 0.5, 1.2, 3.0, 7.5, 15.0, 20.4}) {
             const double s = b->DeepSeawardOf_m(h);
             ASSERT_TRUE(std::isfinite(s)) << h;
-            for (double ds = 0.0; ds < 800.0; ds += 0.0625)
-                for (const double u : {0.0, 180.0, 200.0, 333.0})
+            for (double ds = 0.0; ds < 800.0; ds += 0.0625) {
+                for (const double u : {0.0, 180.0, 200.0, 333.0}) {
                     ASSERT_GE(b->DepthAtShore_m(s + ds, u), h) << h << " " << ds << " " << u;
+                }
+            }
             // Off the bar (its flanks end at s = 135 + 1 mm) the profile sets it to within 1 m.
             if (s > 136.0) EXPECT_LT(b->DepthAtShore_m(s - 1.0, 0.0), h) << h;
         }
