@@ -187,7 +187,9 @@ TEST(Bathymetry, DeepSeawardOfBoundsTheDepthEverywhereSeawardOfIt) {
                 }
             }
             // Off the bar (its flanks end at s = 135 + 1 mm) the profile sets it to within 1 m.
-            if (s > 136.0) EXPECT_LT(b->DepthAtShore_m(s - 1.0, 0.0), h) << h;
+            if (s > 136.0) {
+                EXPECT_LT(b->DepthAtShore_m(s - 1.0, 0.0), h) << h;
+            }
         }
         // Never that deep (the floor lies 20 m below mean sea level): no such distance.
         EXPECT_EQ(b->DeepSeawardOf_m(b->Tide_m() + 20.0 + 0.01),
