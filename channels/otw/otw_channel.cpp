@@ -252,8 +252,11 @@ struct SeaShading {
             const size_t lanes = std::min(kLanes, count - i);
             const VF d = Load(depth + i, lanes, kDeepColumn_m);
             const VF w = Load(wet + i, lanes, 0.0f), c = Load(foam + i, lanes, 0.0f);
-            // The water path factor 1 + 1/cos θ_t, from cos θ_v as stored above.
-            const VF path = WaterPathFactor(cosV, float(radiometry::kSeaWaterIndexVisible));
+            // The water path factor 1 + 1/cos θ_t, from cos θ_v as stored above; over deep
+            // water (most of the sea) its lower bound gives the same radiance.
+            const VF path = BottomUnseenInEveryLane(shore, d)
+                                ? Splat(kMinWaterPathFactor)
+                                : WaterPathFactor(cosV, float(radiometry::kSeaWaterIndexVisible));
             const VF keyLit = Load(ch.keyCos + i) * sunVis;
             const auto channel = [&](const ShoreChannel& sh, const float* skyC, const float* horC,
                                      const float* ambC, float dw, float sunEC, float* outC) {
