@@ -479,6 +479,9 @@ struct FrameShading {
     const radiometry::AnalyticSky& sky;
     const OcclusionScene& occlusion;
     RayBoxTest casters;
+    // occlusion.MayOcclude along keyDir (to 1e30 m), prepared once: a shadow ray is traced
+    // only where casters.MayHit and this pass.
+    OccluderBoundsTest occluders;
     SeaShading sea;
     const std::vector<glm::dvec3>& reflectance;  // per entity
 
@@ -734,7 +737,7 @@ class BlockClassifier {
         const glm::vec3 nrm = v * (1.0f / std::sqrt((v.x * v.x + v.y * v.y) + v.z * v.z));
         for (int s = 0; s < count; ++s) {
             const glm::vec3 origin = ShadowRayOrigin(Store3(samples[s]), nrm);
-            if (f_.casters.MayHit(origin) && f_.occlusion.MayOcclude(origin, f_.keyDir, 1e30f)) {
+            if (f_.casters.MayHit(origin) && f_.occluders.MayOcclude(origin)) {
                 sc_.origins.push_back(origin);
                 sc_.originOwner.push_back(kSeaOwner | uint32_t(e));
             }
@@ -776,7 +779,7 @@ class BlockClassifier {
         sc_.modelLit.push_back(1);
         if (tri.shadowable) {
             const glm::vec3 o = ShadowRayOrigin(position, nrm);
-            if (f_.casters.MayHit(o) && f_.occlusion.MayOcclude(o, f_.keyDir, 1e30f)) {
+            if (f_.casters.MayHit(o) && f_.occluders.MayOcclude(o)) {
                 sc_.origins.push_back(o);
                 sc_.originOwner.push_back(uint32_t(e));
             }
@@ -796,7 +799,8 @@ class BlockClassifier {
 uint64_t TraceSunVisibility(const FrameShading& f, int n, BlockScratch& sc) {
     if (sc.origins.empty()) return 0;
     sc.vis.resize(sc.origins.size());
-    f.occlusion.DirectionalVisibility(sc.origins, f.keyDir, 0.0f, sc.vis);
+    // Every origin passed f.occluders (BlockClassifier): not tested again.
+    f.occlusion.DirectionalVisibility(sc.origins, f.keyDir, 0.0f, sc.vis, true);
     for (size_t r = 0; r < sc.origins.size(); ++r) {
         const uint32_t owner = sc.originOwner[r];
         if (owner & kSeaOwner)
@@ -1152,6 +1156,7 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
                          sky,
                          occlusion,
                          RayBoxTest(geometry_.CasterMin(), geometry_.CasterMax(), key.dir),
+                         occlusion.BoundsTest(key.dir, 1e30f),
                          SeaShading{eye,
                                     key.dir,
                                     key.E,
