@@ -23,6 +23,9 @@ namespace seasense::channels {
 
 namespace {
 
+using occlusion_detail::InverseDirection;
+using occlusion_detail::SlabHit;
+
 static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "vertex copy assumes packed float3");
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
@@ -34,10 +37,6 @@ constexpr size_t kBufferPadding_bytes = 16;
 // Origins per parallel work item. Packets are gathered inside a block only, so the packet
 // composition (and with it every result) does not depend on the thread count.
 constexpr size_t kBlockSize = 1024;
-
-// Direction components smaller than this are treated as parallel to a slab: the ray would
-// have to travel ~1e16 m to cross the bounds' enlargement margin along that axis.
-constexpr float kParallelEpsilon = 1e-20f;
 
 const char* ErrorName(RTCError code) {
     switch (code) {
@@ -61,34 +60,6 @@ const char* ErrorName(RTCError code) {
 
 bool Finite(const glm::vec3& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
-
-// Ray/box slab test (Kay & Kajiya, "Ray tracing complex scenes", SIGGRAPH 1986) restricted
-// to t ∈ [0, tMax_m]. invDirection holds 1/direction per axis (unused for parallel axes).
-bool SlabHit(const glm::vec3& boxMin, const glm::vec3& boxMax, const glm::vec3& origin,
-             const glm::vec3& direction, const glm::vec3& invDirection, float tMax_m) {
-    float t0 = 0.0f;
-    float t1 = tMax_m;
-    for (int axis = 0; axis < 3; ++axis) {
-        if (std::abs(direction[axis]) < kParallelEpsilon) {
-            if (origin[axis] < boxMin[axis] || origin[axis] > boxMax[axis]) return false;
-            continue;
-        }
-        float tA = (boxMin[axis] - origin[axis]) * invDirection[axis];
-        float tB = (boxMax[axis] - origin[axis]) * invDirection[axis];
-        if (tA > tB) std::swap(tA, tB);
-        t0 = std::max(t0, tA);
-        t1 = std::min(t1, tB);
-        if (t0 > t1) return false;
-    }
-    return true;
-}
-
-glm::vec3 InverseDirection(const glm::vec3& direction) {
-    glm::vec3 inv(0.0f);
-    for (int axis = 0; axis < 3; ++axis)
-        if (std::abs(direction[axis]) >= kParallelEpsilon) inv[axis] = 1.0f / direction[axis];
-    return inv;
 }
 
 void OccludedPacket(const int* valid, RTCScene scene, RTCIntersectContext* context, RTCRay4* rays) {
@@ -404,6 +375,20 @@ bool OcclusionScene::MayOcclude(const glm::vec3& origin, const glm::vec3& direct
                    maxDistance_m);
 }
 
+OccluderBoundsTest OcclusionScene::BoundsTest(const glm::vec3& direction,
+                                              float maxDistance_m) const {
+    const Impl& impl = *impl_;
+    CHECK_MSG(impl.committed, "OcclusionScene::BoundsTest before Commit()");
+    CHECK_MSG(Finite(direction) && !std::isnan(maxDistance_m), "BoundsTest: non-finite ray");
+    OccluderBoundsTest test;
+    test.min_ = impl.testMin, test.max_ = impl.testMax;
+    test.direction_ = direction;
+    test.inverse_ = InverseDirection(direction);
+    test.maxDistance_m_ = maxDistance_m;
+    test.empty_ = impl.meshes.empty() || maxDistance_m < 0.0f;
+    return test;
+}
+
 bool OcclusionScene::Occluded(const glm::vec3& a, const glm::vec3& b) const {
     const Impl& impl = *impl_;
     CHECK_MSG(impl.committed, "OcclusionScene::Occluded before Commit()");
@@ -436,7 +421,8 @@ bool OcclusionScene::Occluded(const glm::vec3& a, const glm::vec3& b) const {
 
 void OcclusionScene::DirectionalVisibility(std::span<const glm::vec3> origins,
                                            const glm::vec3& direction, float tNear_m,
-                                           std::span<uint8_t> visible) const {
+                                           std::span<uint8_t> visible,
+                                           bool originsMayOcclude) const {
     const Impl& impl = *impl_;
     CHECK_MSG(impl.committed, "OcclusionScene::DirectionalVisibility before Commit()");
     CHECK_MSG(visible.size() == origins.size(),
@@ -464,7 +450,8 @@ void OcclusionScene::DirectionalVisibility(std::span<const glm::vec3> origins,
         int count = 0;
         for (size_t i = begin; i < end; ++i) {
             CHECK_MSG(Finite(origins[i]), "DirectionalVisibility: origin " << i << " not finite");
-            if (!SlabHit(impl.testMin, impl.testMax, origins[i], direction, invDirection, kInf)) {
+            if (!originsMayOcclude &&
+                !SlabHit(impl.testMin, impl.testMax, origins[i], direction, invDirection, kInf)) {
                 visible[i] = 1;
                 continue;
             }

@@ -1,12 +1,69 @@
 // Embree 3 occlusion queries over the scene's meshes: sun/moon shadow rays and line of sight.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <memory>
 #include <span>
+#include <utility>
 
 namespace seasense::channels {
+
+namespace occlusion_detail {
+
+// Direction components smaller than this are treated as parallel to a slab: the ray would
+// have to travel ~1e16 m to cross the bounds' enlargement margin along that axis.
+inline constexpr float kParallelEpsilon = 1e-20f;
+
+inline glm::vec3 InverseDirection(const glm::vec3& direction) {
+    glm::vec3 inv(0.0f);
+    for (int axis = 0; axis < 3; ++axis)
+        if (std::abs(direction[axis]) >= kParallelEpsilon) inv[axis] = 1.0f / direction[axis];
+    return inv;
+}
+
+// Ray/box slab test (Kay & Kajiya, "Ray tracing complex scenes", SIGGRAPH 1986) restricted
+// to t ∈ [0, tMax_m]. invDirection holds 1/direction per axis (unused for parallel axes).
+inline bool SlabHit(const glm::vec3& boxMin, const glm::vec3& boxMax, const glm::vec3& origin,
+                    const glm::vec3& direction, const glm::vec3& invDirection, float tMax_m) {
+    float t0 = 0.0f;
+    float t1 = tMax_m;
+    for (int axis = 0; axis < 3; ++axis) {
+        if (std::abs(direction[axis]) < kParallelEpsilon) {
+            if (origin[axis] < boxMin[axis] || origin[axis] > boxMax[axis]) return false;
+            continue;
+        }
+        float tA = (boxMin[axis] - origin[axis]) * invDirection[axis];
+        float tB = (boxMax[axis] - origin[axis]) * invDirection[axis];
+        if (tA > tB) std::swap(tA, tB);
+        t0 = std::max(t0, tA);
+        t1 = std::min(t1, tB);
+        if (t0 > t1) return false;
+    }
+    return true;
+}
+
+}  // namespace occlusion_detail
+
+// OcclusionScene::MayOcclude for one direction and distance, set up once (the inverse
+// direction, the bounds) and inline, for the many shadow-ray origins of a frame: MayOcclude(o)
+// equals the scene's MayOcclude(o, direction, maxDistance_m) for every finite o (checked by the
+// scene's call, not here). Valid while the scene is not changed.
+class OccluderBoundsTest {
+  public:
+    bool MayOcclude(const glm::vec3& origin) const {
+        return !empty_ &&
+               occlusion_detail::SlabHit(min_, max_, origin, direction_, inverse_, maxDistance_m_);
+    }
+
+  private:
+    friend class OcclusionScene;
+    glm::vec3 min_{0.0f}, max_{0.0f}, direction_{0.0f, 0.0f, 1.0f}, inverse_{0.0f};
+    float maxDistance_m_ = 0.0f;
+    bool empty_ = true;  // no mesh, or maxDistance_m < 0: nothing is occluded
+};
 
 // Build-then-commit: add meshes, Commit(), then query from any number of threads.
 // Positions are world ENU metres (float precision: scenes within ~10 km of the origin).
@@ -45,6 +102,8 @@ class OcclusionScene {
     // True when the ray from origin along unit direction can meet the casters' bounding
     // box within maxDistance_m: a cheap test that lets shading skip shadow rays.
     bool MayOcclude(const glm::vec3& origin, const glm::vec3& direction, float maxDistance_m) const;
+    // MayOcclude along one direction, prepared for many origins (OccluderBoundsTest).
+    OccluderBoundsTest BoundsTest(const glm::vec3& direction, float maxDistance_m) const;
 
     // True when the open segment from a to b hits any mesh.
     bool Occluded(const glm::vec3& a, const glm::vec3& b) const;
@@ -52,8 +111,11 @@ class OcclusionScene {
     // Shadow rays toward a directional light: for each origin, visible[i] = 0 when the ray
     // origin[i] + t·direction, t ∈ (tNear_m, ∞) hits a mesh, 1 otherwise. Traced in packets
     // of up to 16 (rtcOccluded16/8/4); origins for which MayOcclude is false are not traced.
+    // originsMayOcclude: the caller kept only origins for which MayOcclude(origin, direction,
+    // d) is true (any d ≥ 0), so that test is not repeated here (it is true with d = ∞ too).
     void DirectionalVisibility(std::span<const glm::vec3> origins, const glm::vec3& direction,
-                               float tNear_m, std::span<uint8_t> visible) const;
+                               float tNear_m, std::span<uint8_t> visible,
+                               bool originsMayOcclude = false) const;
 
   private:
     struct Impl;

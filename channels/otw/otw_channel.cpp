@@ -14,6 +14,7 @@
 #include "channels/otw/celestial.h"
 #include "channels/otw/cloud_layer.h"
 #include "channels/otw/lightning_overlay.h"
+#include "channels/otw/sea_glint.h"
 #include "channels/otw/shore_shading.h"
 #include "channels/otw/spray_overlay.h"
 #include "channels/plume/plume_composite.h"
@@ -140,6 +141,7 @@ struct SeaChunk {
     alignas(16) float mvx[kChunk], mvy[kChunk];            // −v: toward the far airlight
     alignas(16) float range[kChunk], cosV[kChunk], cosS[kChunk];
     alignas(16) float cos2[kChunk], tan2[kChunk], sunVis[kChunk];
+    bool glintLanes[kChunk / simd::kLanes];  // whether a lane group may glint (cos2, tan2, Fs)
     alignas(16) float F[kChunk], Fs[kChunk];
     alignas(16) float skyR[kChunk], skyG[kChunk], skyB[kChunk];
     alignas(16) float horR[kChunk], horG[kChunk], horB[kChunk];
@@ -173,6 +175,10 @@ struct SeaShading {
         // computed from padding, then dropped).
         using namespace simd;
         static_assert(kChunk % kLanes == 0);
+        const float tan2Limit = GlintTan2Limit(slopeVar);
+        CHECK(tan2Limit < 1e5f);  // GlintPossible's bound
+        const VF glintLimit = Splat(tan2Limit);
+        const float glintCos2 = GlintCos2Bound(tan2Limit);
         for (size_t i = 0; i < count; i += kLanes) {
             const size_t lanes = std::min(kLanes, count - i);
             VF Nx = Load(nx + i, lanes, 0.0f), Ny = Load(ny + i, lanes, 0.0f),
@@ -200,14 +206,20 @@ struct SeaShading {
             Store(ch.F + i, fresnel(cosV));
             const VF cosS = Dot(Nx, Ny, Nz, Splat(keyDir.x), Splat(keyDir.y), Splat(keyDir.z));
             Store(ch.cosS + i, cosS);
+            // The glint facet's tilt only where a lane of the group may glint (GlintPossible):
+            // a group without one skips a square root, two divisions and a Fresnel look-up, as
+            // the second loop skips its glint (glintLanes).
             const VF wx = vx + keyDir.x, wy = vy + keyDir.y, wz = vz + keyDir.z;
-            const VF inv = 1.0f / Sqrt(Dot(wx, wy, wz, wx, wy, wz));
-            const VF hx = wx * inv, hy = wy * inv, hz = wz * inv;
-            const VF cosB = Max(Dot(hx, hy, hz, Nx, Ny, Nz), Splat(1e-3f));
-            const VF cos2 = cosB * cosB;
-            Store(ch.cos2 + i, cos2);
-            Store(ch.tan2 + i, (1.0f - cos2) / cos2);
-            Store(ch.Fs + i, fresnel(Dot(vx, vy, vz, hx, hy, hz)));
+            const VF ww = Dot(wx, wy, wz, wx, wy, wz);
+            const bool mayGlint = Any(GlintPossible(cosS, Load(ch.sunVis + i),
+                                                    Dot(wx, wy, wz, Nx, Ny, Nz), ww, glintCos2));
+            ch.glintLanes[i / kLanes] = mayGlint;
+            if (mayGlint) {
+                const GlintTilt tilt = GlintFacetTilt(vx, vy, vz, wx, wy, wz, ww, Nx, Ny, Nz);
+                Store(ch.cos2 + i, tilt.cos2);
+                Store(ch.tan2 + i, tilt.tan2);
+                Store(ch.Fs + i, fresnel(tilt.vDotH));
+            }
             // Lambertian irradiance of sand and foam: sky as on a plane tilted to the normal,
             // (1 + n_z)/2 of the level-surface sky irradiance, and the fill lights.
             const VF skyView = 0.5f * (1.0f + Nz);
@@ -227,22 +239,26 @@ struct SeaShading {
         sky.LookUp(count, ch.rx, ch.ry, ch.rz, ch.skyR, ch.skyG, ch.skyB);
         sky.HorizonLookUp(count, ch.mvx, ch.mvy, ch.horR, ch.horG, ch.horB);
 
-        const VF glintLimit = Splat(60.0f * slopeVar);
         // Reciprocals of the frame's constants: multiplications in the loop, not divisions.
         const float minusInvSlopeVar = -1.0f / slopeVar;
         const float invGlintNorm = 1.0f / (float(M_PI) * slopeVar);
         for (size_t i = 0; i < count; i += kLanes) {
             const VF F = Load(ch.F + i), oneMinusF = 1.0f - F;
-            const VF cosV = Load(ch.cosV + i), cos2 = Load(ch.cos2 + i);
-            const VF tan2 = Load(ch.tan2 + i), sunVis = Load(ch.sunVis + i);
+            const VF cosV = Load(ch.cosV + i), sunVis = Load(ch.sunVis + i);
             // Cox–Munk glint: L = E_sun ρ(ω) p(β) / (4 cos θ_v cos⁴ β) (Cox & Munk 1954), β
             // the tilt of the reflecting facet from the local normal. Beyond e^-60 the glint
             // is below float precision next to the sky term.
-            const VI glint = (Load(ch.cosS + i) > 0.0f) & (sunVis > 0.0f) & (tan2 < glintLimit);
+            VI glint{};
+            bool anyGlint = false;
+            if (ch.glintLanes[i / kLanes]) {
+                const VF tan2 = Load(ch.tan2 + i);
+                glint = (Load(ch.cosS + i) > 0.0f) & (sunVis > 0.0f) & (tan2 < glintLimit);
+                anyGlint = Any(glint);
+            }
             // Lanes without glint drop g (Select below): skipped when no lane has it.
-            const bool anyGlint = Any(glint);
             VF g = Splat(0.0f);
             if (anyGlint) {
+                const VF tan2 = Load(ch.tan2 + i), cos2 = Load(ch.cos2 + i);
                 const VF p = ExpNonPositive(tan2 * minusInvSlopeVar) * invGlintNorm;
                 g = (Load(ch.Fs + i) * p) / (((4.0f * cosV) * cos2) * cos2);
             }
@@ -252,8 +268,11 @@ struct SeaShading {
             const size_t lanes = std::min(kLanes, count - i);
             const VF d = Load(depth + i, lanes, kDeepColumn_m);
             const VF w = Load(wet + i, lanes, 0.0f), c = Load(foam + i, lanes, 0.0f);
-            // The water path factor 1 + 1/cos θ_t, from cos θ_v as stored above.
-            const VF path = WaterPathFactor(cosV, float(radiometry::kSeaWaterIndexVisible));
+            // The water path factor 1 + 1/cos θ_t, from cos θ_v as stored above; over deep
+            // water (most of the sea) its lower bound gives the same radiance.
+            const VF path = BottomUnseenInEveryLane(shore, d)
+                                ? Splat(kMinWaterPathFactor)
+                                : WaterPathFactor(cosV, float(radiometry::kSeaWaterIndexVisible));
             const VF keyLit = Load(ch.keyCos + i) * sunVis;
             const auto channel = [&](const ShoreChannel& sh, const float* skyC, const float* horC,
                                      const float* ambC, float dw, float sunEC, float* outC) {
@@ -460,6 +479,9 @@ struct FrameShading {
     const radiometry::AnalyticSky& sky;
     const OcclusionScene& occlusion;
     RayBoxTest casters;
+    // occlusion.MayOcclude along keyDir (to 1e30 m), prepared once: a shadow ray is traced
+    // only where casters.MayHit and this pass.
+    OccluderBoundsTest occluders;
     SeaShading sea;
     const std::vector<glm::dvec3>& reflectance;  // per entity
 
@@ -715,7 +737,7 @@ class BlockClassifier {
         const glm::vec3 nrm = v * (1.0f / std::sqrt((v.x * v.x + v.y * v.y) + v.z * v.z));
         for (int s = 0; s < count; ++s) {
             const glm::vec3 origin = ShadowRayOrigin(Store3(samples[s]), nrm);
-            if (f_.casters.MayHit(origin) && f_.occlusion.MayOcclude(origin, f_.keyDir, 1e30f)) {
+            if (f_.casters.MayHit(origin) && f_.occluders.MayOcclude(origin)) {
                 sc_.origins.push_back(origin);
                 sc_.originOwner.push_back(kSeaOwner | uint32_t(e));
             }
@@ -757,7 +779,7 @@ class BlockClassifier {
         sc_.modelLit.push_back(1);
         if (tri.shadowable) {
             const glm::vec3 o = ShadowRayOrigin(position, nrm);
-            if (f_.casters.MayHit(o) && f_.occlusion.MayOcclude(o, f_.keyDir, 1e30f)) {
+            if (f_.casters.MayHit(o) && f_.occluders.MayOcclude(o)) {
                 sc_.origins.push_back(o);
                 sc_.originOwner.push_back(uint32_t(e));
             }
@@ -777,7 +799,8 @@ class BlockClassifier {
 uint64_t TraceSunVisibility(const FrameShading& f, int n, BlockScratch& sc) {
     if (sc.origins.empty()) return 0;
     sc.vis.resize(sc.origins.size());
-    f.occlusion.DirectionalVisibility(sc.origins, f.keyDir, 0.0f, sc.vis);
+    // Every origin passed f.occluders (BlockClassifier): not tested again.
+    f.occlusion.DirectionalVisibility(sc.origins, f.keyDir, 0.0f, sc.vis, true);
     for (size_t r = 0; r < sc.origins.size(); ++r) {
         const uint32_t owner = sc.originOwner[r];
         if (owner & kSeaOwner)
@@ -1133,6 +1156,7 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
                          sky,
                          occlusion,
                          RayBoxTest(geometry_.CasterMin(), geometry_.CasterMax(), key.dir),
+                         occlusion.BoundsTest(key.dir, 1e30f),
                          SeaShading{eye,
                                     key.dir,
                                     key.E,

@@ -54,6 +54,22 @@ inline simd::VF WaterPathFactor(simd::VF cosV, float n) {
     return 1.0f + 1.0f / cosT;
 }
 
+// A lower bound of WaterPathFactor for any cosV in (0, 1 + 1e-6]: 1 + 1/cos θ_t ≥ 2 but for
+// the rounding of a cosine just above 1.
+inline constexpr float kMinWaterPathFactor = 1.5f;
+
+// Whether ShoreRadiance's bottom term e^{−K d (1 + 1/cos θ_t)} is 0 in every lane of each
+// channel for any path factor p ≥ kMinWaterPathFactor: where −K·(d·kMinWaterPathFactor) < −87,
+// −K·(d·p) has the same sign and a magnitude at least as large (float rounding is monotone), so
+// it is below −87 too. There ShoreRadiance gives the same bits with kMinWaterPathFactor for the
+// path factor, and WaterPathFactor (a square root and a division) need not be computed.
+inline bool BottomUnseenInEveryLane(const ShoreChannel (&c)[3], simd::VF depth) {
+    using namespace simd;
+    const VF d = depth * kMinWaterPathFactor;
+    return All((-c[0].K_perm * d < -87.0f) & (-c[1].K_perm * d < -87.0f) &
+               (-c[2].K_perm * d < -87.0f));
+}
+
 // Radiance (cd/m², one channel) of a surf-zone point before fog:
 //   water:  reflected + (1 − F)·[ρ_wet E/π · T + R_rs E_d · (1 − T)],  T = e^{−K d (1 + 1/cos θ_t)}
 //   sand:   ρ_sand E/π,  ρ_sand from dry to wet by wetness

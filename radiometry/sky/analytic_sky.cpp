@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 #include "radiometry/color/rec709.h"
@@ -23,6 +24,24 @@ using namespace simd4;
 
 constexpr int kTableSize = 128;
 constexpr int kHorizonSize = 512;
+
+// Writes the first count ≤ simd::kLanes of lanes' (r, g, b, ·) registers to r, g and b: four
+// lanes at a time transposed to (r r r r), (g g g g), (b b b b).
+void StoreTransposed(F4 (&lanes)[simd::kLanes], size_t count, float* r, float* g, float* b) {
+    static_assert(simd::kLanes % 4 == 0);
+    alignas(16) float tmp[3][simd::kLanes];
+    const bool full = count == simd::kLanes;
+    float* out[3] = {full ? r : tmp[0], full ? g : tmp[1], full ? b : tmp[2]};
+    for (size_t q = 0; q < simd::kLanes; q += 4) {
+        F4 c0 = lanes[q], c1 = lanes[q + 1], c2 = lanes[q + 2], c3 = lanes[q + 3];
+        _MM_TRANSPOSE4_PS(c0, c1, c2, c3);
+        _mm_storeu_ps(out[0] + q, c0);
+        _mm_storeu_ps(out[1] + q, c1);
+        _mm_storeu_ps(out[2] + q, c2);
+    }
+    if (full) return;
+    for (size_t l = 0; l < count; ++l) r[l] = tmp[0][l], g[l] = tmp[1][l], b[l] = tmp[2][l];
+}
 
 // Position around the horizon in [0, 4) from a horizontal direction without trigonometry:
 // the perimeter parameter of the octahedral diamond |u| + |v| = 1.
@@ -372,19 +391,27 @@ void AnalyticSky::LookUp(size_t n, const float* x, const float* y, const float* 
         VI i0 = __builtin_convertvector(tu, VI), j0 = __builtin_convertvector(tv, VI);
         i0 = i0 < hiIndex ? i0 : hiIndex;
         j0 = j0 < hiIndex ? j0 : hiIndex;
-        const VF fu = tu - __builtin_convertvector(i0, VF);
-        const VF fv = tv - __builtin_convertvector(j0, VF);
+        alignas(32) float fu[kLanes], fv[kLanes];
+        Store(fu, tu - __builtin_convertvector(i0, VF));
+        Store(fv, tv - __builtin_convertvector(j0, VF));
         // Float index of texel (i0, j0)'s red: 4 floats a texel, kTableSize texels a row.
-        const VI t00 = (i0 + (j0 << 7)) << 2;
-        const VI t10 = t00 + 4 * kTableSize;
-        const auto channel = [&](int c, float* out) {
-            const VF a = Lerp(Gather(t + c, t00), Gather(t + 4 + c, t00), fu);
-            const VF b = Lerp(Gather(t + c, t10), Gather(t + 4 + c, t10), fu);
-            Store(out + k, Lerp(a, b, fv), count);
-        };
-        channel(0, r);
-        channel(1, g);
-        channel(2, b);
+        alignas(32) int32_t t00[kLanes];
+        const VI t00v = (i0 + (j0 << 7)) << 2;
+        std::memcpy(t00, &t00v, sizeof t00);
+        // A lane's texels (r, g, b, 0) by 16-byte loads, blended on SSE registers with the
+        // scalar LookUp's operations per component, then transposed to the outputs.
+        F4 rgb[kLanes];
+        for (size_t l = 0; l < kLanes; ++l) {
+            const float* row0 = t + t00[l];
+            const float* row1 = row0 + 4 * kTableSize;
+            const F4 a00 = _mm_loadu_ps(row0), a01 = _mm_loadu_ps(row0 + 4);
+            const F4 a10 = _mm_loadu_ps(row1), a11 = _mm_loadu_ps(row1 + 4);
+            const F4 wu = Set4(fu[l]), wv = Set4(fv[l]);
+            const F4 a = _mm_add_ps(a00, _mm_mul_ps(_mm_sub_ps(a01, a00), wu));
+            const F4 c = _mm_add_ps(a10, _mm_mul_ps(_mm_sub_ps(a11, a10), wu));
+            rgb[l] = _mm_add_ps(a, _mm_mul_ps(_mm_sub_ps(c, a), wv));
+        }
+        StoreTransposed(rgb, count, r + k, g + k, b + k);
     }
 }
 
@@ -415,11 +442,18 @@ void AnalyticSky::HorizonLookUp(size_t n, const float* x, const float* y, float*
         VI i = __builtin_convertvector(tu, VI);
         i = i < hiIndex ? i : hiIndex;
         i = i > 0 ? i : VI{};
-        const VF f = Min(Max(tu - __builtin_convertvector(i, VF), zero), one);
-        const VI t0 = i << 2;  // float index of texel i's red
-        Store(r + k, Lerp(Gather(h, t0), Gather(h + 4, t0), f), count);
-        Store(g + k, Lerp(Gather(h + 1, t0), Gather(h + 5, t0), f), count);
-        Store(b + k, Lerp(Gather(h + 2, t0), Gather(h + 6, t0), f), count);
+        alignas(32) float f[kLanes];
+        Store(f, Min(Max(tu - __builtin_convertvector(i, VF), zero), one));
+        alignas(32) int32_t t0[kLanes];
+        const VI t0v = i << 2;  // float index of texel i's red
+        std::memcpy(t0, &t0v, sizeof t0);
+        // As LookUp: a lane's two texels by 16-byte loads, blended on an SSE register.
+        F4 rgb[kLanes];
+        for (size_t l = 0; l < kLanes; ++l) {
+            const F4 a = _mm_loadu_ps(h + t0[l]), c = _mm_loadu_ps(h + t0[l] + 4);
+            rgb[l] = _mm_add_ps(a, _mm_mul_ps(_mm_sub_ps(c, a), Set4(f[l])));
+        }
+        StoreTransposed(rgb, count, r + k, g + k, b + k);
     }
 }
 

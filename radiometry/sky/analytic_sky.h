@@ -80,9 +80,9 @@ class AnalyticSky {
 
     // Batched LookUp / HorizonLookUp over n directions in structure-of-arrays form (x[i],
     // y[i], z[i]), writing rgb to r[i], g[i], b[i]. simd::kLanes at a time (eight in the AVX2
-    // build, texels by gather instructions); every lane does exactly the scalar arithmetic, so
-    // results equal the one-at-a-time calls bit for bit whatever the batch size or a sample's
-    // position in it.
+    // build; texels by 16-byte loads, blended per lane); every lane does exactly the scalar
+    // arithmetic, so results equal the one-at-a-time calls bit for bit whatever the batch size or a
+    // sample's position in it.
     void LookUp(size_t n, const float* x, const float* y, const float* z, float* r, float* g,
                 float* b) const;
     void HorizonLookUp(size_t n, const float* x, const float* y, float* r, float* g,

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -292,6 +293,51 @@ TEST(OcclusionScene, DirectionalVisibilityAgreesWithOccluded) {
             ASSERT_EQ(again, visible) << threads << " threads";
         }
     }
+}
+
+// The prepared bounds test gives MayOcclude's answer for every origin, direction (also along
+// the axes, where slabs are parallel) and distance; DirectionalVisibility of origins that pass
+// it gives the same visibility whether it tests them again or not.
+TEST(OcclusionScene, BoundsTestEqualsMayOccludeAndPrefilteredOriginsTraceTheSame) {
+    OcclusionScene empty;
+    empty.Commit();
+    EXPECT_FALSE(empty.BoundsTest(glm::vec3(0.0f, 0.0f, 1.0f), 1e30f).MayOcclude(glm::vec3(0.0f)));
+
+    OcclusionScene scene;
+    const TestMesh box = MakeBox({-1.0f, -1.0f, 0.0f}, {1.0f, 1.0f, kBoxHeight_m});
+    Add(scene, box);
+    Add(scene, Translated(box, {6.0f, 2.0f, 0.5f}));
+    scene.Commit();
+    const size_t count = 3000;
+    std::vector<glm::vec3> origins(count);
+    for (size_t i = 0; i < count; ++i) {
+        auto u = [&](uint64_t stream) { return float(scene::Uniform01(77, stream, i)); };
+        origins[i] = glm::vec3(30 * u(0) - 15, 30 * u(1) - 15, 8 * u(2) - 2);
+    }
+    const glm::vec3 directions[] = {SunDirection(250, 4.4), SunDirection(30, 60),
+                                    glm::vec3(0.0f, 0.0f, 1.0f), glm::vec3(1.0f, 0.0f, 0.0f),
+                                    glm::normalize(glm::vec3(-1.0f, 1e-21f, 0.5f))};
+    size_t hits = 0, misses = 0;
+    for (const glm::vec3& direction : directions) {
+        for (float maxDistance_m : {1e30f, 6.0f, 0.0f, -1.0f}) {
+            const OccluderBoundsTest test = scene.BoundsTest(direction, maxDistance_m);
+            for (const glm::vec3& o : origins) {
+                const bool may = scene.MayOcclude(o, direction, maxDistance_m);
+                ASSERT_EQ(test.MayOcclude(o), may) << maxDistance_m;
+                hits += may, misses += !may;
+            }
+        }
+        std::vector<glm::vec3> kept;
+        for (const glm::vec3& o : origins)
+            if (scene.MayOcclude(o, direction, 1e30f)) kept.push_back(o);
+        std::vector<uint8_t> tested(kept.size(), 7), trusted(kept.size(), 7);
+        scene.DirectionalVisibility(kept, direction, kShadowTNear_m, tested);
+        scene.DirectionalVisibility(kept, direction, kShadowTNear_m, trusted, true);
+        EXPECT_EQ(tested, trusted);
+        EXPECT_GT(std::count(tested.begin(), tested.end(), 0), 0);
+    }
+    EXPECT_GT(hits, count / 4);
+    EXPECT_GT(misses, count);
 }
 
 TEST(OcclusionScene, BadMeshesAreInputErrors) {

@@ -113,5 +113,64 @@ TEST(ShoreShading, DeepWaterLanesEqualTheirValuesAmongShallowLanes) {
     EXPECT_NEAR(deep[1], 3.0f + 0.97f * c.rrs * 1800.0f, 1e-4f);
 }
 
+// Where BottomUnseenInEveryLane holds, ShoreRadiance gives the same bits with
+// kMinWaterPathFactor as with the true path factor (so SeaShading skips WaterPathFactor), for
+// view cosines from grazing to just above 1; and it holds over the deep column of the open sea
+// but not over shallow water, where the bottom shows.
+TEST(ShoreShading, PathFactorBoundGivesTheSameRadianceWhereTheBottomIsUnseen) {
+    const ShoreChannel otw[3] = {{0.0003f, 0.28f, 0.28f, 0.45f, 0.50f},
+                                 {0.0015f, 0.10f, 0.24f, 0.39f, 0.53f},
+                                 {0.0050f, 0.13f, 0.17f, 0.30f, 0.55f}};
+    const float cosines[] = {1e-3f,       0.05f, 0.3f, 0.7f, 1.0f, std::nextafter(1.0f, 2.0f),
+                             1.0f + 1e-6f};
+    for (float cosV : cosines)
+        EXPECT_GE(WaterPathFactor(Splat(cosV), 1.341f)[0], kMinWaterPathFactor) << cosV;
+    EXPECT_TRUE(BottomUnseenInEveryLane(otw, Splat(kDeepColumn_m)));
+    EXPECT_FALSE(BottomUnseenInEveryLane(otw, Splat(5.0f)));
+    // The same channels with the middle one's water far clearer (K = 0.01): the test must hold
+    // for each channel, not only for the first.
+    ShoreChannel clear[3] = {otw[0], otw[1], otw[2]};
+    clear[1].K_perm = 0.01f;
+    int unseen = 0, seen = 0;
+    // Depths around the bound of the clearest channel (K = 0.10: −0.1 · 1.5 d < −87 from
+    // d ≈ 580 m), negative and zero columns (sand) and the deep column.
+    const auto check = [&](const ShoreChannel(&channels)[3]) {
+        for (float d0 : {-3.0f, 0.0f, 0.3f, 5.0f, 20.0f, 50.0f, 100.0f, 400.0f, 575.0f, 579.0f,
+                         580.0f, 581.0f, 590.0f, 2000.0f, kDeepColumn_m}) {
+            for (float cosV : cosines) {
+                VF depth, wet, foam, reflected, E, Ed;
+                for (size_t l = 0; l < kLanes; ++l) {
+                    const float f = float(l);
+                    depth[l] = d0 * (1.0f + 0.001f * f);
+                    wet[l] = 0.1f * f;
+                    foam[l] = l == 3 ? 0.25f : 0.0f;
+                    reflected[l] = 3.0f * f;
+                    E[l] = 1000.0f * (f + 1.0f);
+                    Ed[l] = 900.0f * (f + 1.0f);
+                }
+                if (!BottomUnseenInEveryLane(channels, depth)) {
+                    ++seen;
+                    continue;
+                }
+                ++unseen;
+                const VF path = WaterPathFactor(Splat(cosV), 1.341f);
+                for (const ShoreChannel& c : channels) {
+                    const VF exact =
+                        ShoreRadiance(c, reflected, Splat(0.97f), path, depth, wet, foam, E, Ed);
+                    const VF bound =
+                        ShoreRadiance(c, reflected, Splat(0.97f), Splat(kMinWaterPathFactor), depth,
+                                      wet, foam, E, Ed);
+                    for (size_t l = 0; l < kLanes; ++l)
+                        EXPECT_EQ(exact[l], bound[l]) << "depth " << depth[l] << " cos " << cosV;
+                }
+            }
+        }
+    };
+    check(otw);
+    check(clear);
+    EXPECT_GT(unseen, 0);
+    EXPECT_GT(seen, 0);
+}
+
 }  // namespace
 }  // namespace seasense::channels

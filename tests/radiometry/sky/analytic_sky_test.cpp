@@ -233,6 +233,15 @@ TEST(AnalyticSky, BatchedLookupsEqualSingleLookupsBitForBit) {
         y.push_back(float(std::cos(el) * std::cos(az)));
         z.push_back(float(std::sin(el)));
     }
+    // And 4001 directions of low elevation (the sea's reflected rays), spread over azimuth by
+    // the golden ratio, so that neighbouring lanes read texels far apart.
+    for (size_t i = 0; i < 4001; ++i) {
+        const double az = 2.0 * M_PI * std::fmod(double(i) * 0.6180339887498949, 1.0);
+        const double el = 0.3 * double(i) / 4001;
+        x.push_back(float(std::cos(el) * std::sin(az)));
+        y.push_back(float(std::cos(el) * std::cos(az)));
+        z.push_back(float(std::sin(el)));
+    }
     const size_t n = x.size();
     std::vector<float> r(n), g(n), b(n), hr(n), hg(n), hb(n);
     sky.LookUp(n, x.data(), y.data(), z.data(), r.data(), g.data(), b.data());
