@@ -4,8 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
-#include <cstdint>
-#include <cstring>
 
 #include "scene/core/simd_lanes.h"
 
@@ -48,25 +46,9 @@ class FresnelTable {
         VI i = __builtin_convertvector(u, VI);
         i = i < kSize - 1 ? i : VI{} + (kSize - 1);
         i = i > 0 ? i : VI{};
-        // A lane's two table values are adjacent: one 8-byte load each, split into t0 and t1
-        // four lanes at a time (gather instructions are slow on the AMD cores this runs on).
-        alignas(32) int32_t index[kLanes];
-        std::memcpy(index, &i, sizeof index);
-        __m128 lo[kLanes / 4], hi[kLanes / 4];
-        for (size_t q = 0; q < kLanes; q += 4) {
-            const auto pair = [&](size_t l) {
-                return reinterpret_cast<const __m64*>(table_ + index[l]);
-            };
-            const __m128 a = _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), pair(q)), pair(q + 1));
-            const __m128 b = _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), pair(q + 2)), pair(q + 3));
-            lo[q / 4] = _mm_shuffle_ps(a, b, _MM_SHUFFLE(2, 0, 2, 0));
-            hi[q / 4] = _mm_shuffle_ps(a, b, _MM_SHUFFLE(3, 1, 3, 1));
-        }
-#if defined(__AVX__)
-        const VF t0 = _mm256_set_m128(lo[1], lo[0]), t1 = _mm256_set_m128(hi[1], hi[0]);
-#else
-        const VF t0 = lo[0], t1 = hi[0];
-#endif
+        // A lane's two table values are adjacent: one 8-byte load each (simd::GatherPair).
+        VF t0, t1;
+        GatherPair(table_, i, t0, t1);
         return t0 + (t1 - t0) * (u - __builtin_convertvector(i, VF));
     }
 

@@ -42,17 +42,6 @@ inline void Store(float* p, VF v, size_t count = kLanes) {
     for (size_t i = 0; i < count; ++i) p[i] = v[i];
 }
 
-// base[index[l]] in lane l.
-inline VF Gather(const float* base, VI index) {
-#if defined(__AVX2__)
-    return _mm256_i32gather_ps(base, reinterpret_cast<__m256i>(index), 4);
-#else
-    VF v;
-    for (size_t l = 0; l < kLanes; ++l) v[l] = base[index[l]];
-    return v;
-#endif
-}
-
 // base[index[l]] in lane l of lo and base[index[l] + 1] in lane l of hi: each lane's adjacent
 // pair by one 8-byte load, split four lanes at a time. On the AMD cores this project runs on,
 // two eight-lane gather instructions are slower than these loads (BM_UniformTableLanes).
