@@ -173,8 +173,8 @@ UniformTable::UniformTable(std::vector<float> nodes, float xMax)
 
 void UniformTable::operator()(size_t count, const float* x, float* out) const {
     // operator() lane for lane: clamp(x·scale, 0, last) as std::clamp (min(max(u, 0), last)),
-    // the cell's two nodes by simd::GatherPair.
-    // Members in locals: the stores below could alias them as far as the compiler knows.
+    // the cell's two nodes by simd::GatherPair. The members are read into locals once: as far
+    // as the compiler knows, the stores to out could change them.
     using simd::VF, simd::VI;
     const float* nodes = nodes_.data();
     const VF scale = simd::Splat(scale_), last = simd::Splat(last_),
@@ -580,7 +580,8 @@ uint64_t FlirChannel::ShadeRows(const FrameShading& f, int y0, int y1, float* ou
     sc.lit.assign(sc.modelK.size(), f.sunDir.z > 0.0f ? 1 : 0);
     if (!sc.origins.empty()) {
         sc.visible.resize(sc.origins.size());
-        f.occlusion.DirectionalVisibility(sc.origins, f.sunDir, 0.0f, sc.visible);
+        // Every origin passed MayOcclude above: not tested again.
+        f.occlusion.DirectionalVisibility(sc.origins, f.sunDir, 0.0f, sc.visible, true);
         for (size_t r = 0; r < sc.origins.size(); ++r) sc.lit[sc.originOwner[r]] = sc.visible[r];
     }
     for (size_t i = 0; i < sc.modelK.size(); ++i) {

@@ -478,9 +478,12 @@ struct FrameShading {
     bool shadows;
     const radiometry::AnalyticSky& sky;
     const OcclusionScene& occlusion;
+    // The casters' box grown (ViewGeometry::CasterMax), for whole triangles (Gather): a sample
+    // on a triangle that misses it cannot be shadowed.
     RayBoxTest casters;
-    // occlusion.MayOcclude along keyDir (to 1e30 m), prepared once: a shadow ray is traced
-    // only where casters.MayHit and this pass.
+    // occlusion.MayOcclude along keyDir (to 1e30 m), prepared once: a sample's shadow ray is
+    // traced only where this passes. Its box lies inside the casters' (ViewGeometry::
+    // UpdateCasterBounds), so passing it implies casters.MayHit: that is not tested again.
     OccluderBoundsTest occluders;
     SeaShading sea;
     const std::vector<glm::dvec3>& reflectance;  // per entity
@@ -737,7 +740,7 @@ class BlockClassifier {
         const glm::vec3 nrm = v * (1.0f / std::sqrt((v.x * v.x + v.y * v.y) + v.z * v.z));
         for (int s = 0; s < count; ++s) {
             const glm::vec3 origin = ShadowRayOrigin(Store3(samples[s]), nrm);
-            if (f_.casters.MayHit(origin) && f_.occluders.MayOcclude(origin)) {
+            if (f_.occluders.MayOcclude(origin)) {
                 sc_.origins.push_back(origin);
                 sc_.originOwner.push_back(kSeaOwner | uint32_t(e));
             }
@@ -779,7 +782,7 @@ class BlockClassifier {
         sc_.modelLit.push_back(1);
         if (tri.shadowable) {
             const glm::vec3 o = ShadowRayOrigin(position, nrm);
-            if (f_.casters.MayHit(o) && f_.occluders.MayOcclude(o)) {
+            if (f_.occluders.MayOcclude(o)) {
                 sc_.origins.push_back(o);
                 sc_.originOwner.push_back(uint32_t(e));
             }

@@ -34,12 +34,6 @@ constexpr size_t kCachedFrames = 2;
 constexpr uint64_t kSurfDirectionStream = 0x53555246'00000001ULL;
 constexpr uint64_t kSurfPhaseStream = 0x53555246'00000002ULL;
 
-// Bilinear lookup of mip level `level` of a cascade texture at rest position (x0, y0), weighted
-// by `weight`, added to sums. Texel i of level l is centred on the mean of the nodes it averages,
-// (i 2^l + (2^l − 1)/2) Δ, hence the half-texel shifts: the lookup is at texel coordinates
-// (x0 + Δ/2) / (2^l Δ) − ½, taken as ((x0 + Δ/2) / Δ) · 2^−l − ½ from (qx, qy) = (x0 + Δ/2) / Δ,
-// which the levels of one cascade share. The same bits: a correctly rounded quotient scaled by a
-// power of two is the correctly rounded quotient by the scaled divisor (no underflow here).
 // Adds w00 a + w10 b + w01 d + w11 e to sums, the texels a = (i0, j0), b = (i1, j0),
 // d = (i0, j1), e = (i1, j1) of a level of n × n texels (row-major, kGeometryTerms floats each):
 // sums[k] += ((w00 a + w10 b) + w01 d) + w11 e, a vector of terms at a time (all eight with
@@ -63,6 +57,12 @@ void AddTexels(const float* texels, int n, int i0, int j0, float w00, float w10,
     }
 }
 
+// Bilinear lookup of mip level `level` of a cascade texture at rest position (x0, y0), weighted
+// by `weight`, added to sums. Texel i of level l is centred on the mean of the nodes it averages,
+// (i 2^l + (2^l − 1)/2) Δ, hence the half-texel shifts: the lookup is at texel coordinates
+// (x0 + Δ/2) / (2^l Δ) − ½, taken as ((x0 + Δ/2) / Δ) · 2^−l − ½ from (qx, qy) = (x0 + Δ/2) / Δ,
+// which the levels of one cascade share. The same bits: a correctly rounded quotient scaled by a
+// power of two is the correctly rounded quotient by the scaled divisor (no underflow here).
 template <class Texture>
 void AddBilinear(const Texture& c, int level, double qx, double qy, float weight,
                  GeometrySums& sums) {
@@ -278,6 +278,21 @@ OceanSample OceanSurfaceFrame::SampleAt(double x, double y, glm::dvec2* rest) co
 FftFilter OceanSurfaceFrame::Filter(float footprint_m) const {
     FftFilter f;
     CHECK(textures_.size() <= size_t(FftFilter::kMaxCascades));
+    int lastLevel = 0;  // the level of the last lookup added
+    const auto add = [&](size_t c, int level, float factor) {
+        const CascadeTexture& t = textures_[c];
+        const size_t l = size_t(f.lookups++);
+        f.cascade[l] = int(c);
+        f.texel[l] = t.texel_m;
+        f.halfTexel[l] = 0.5 * t.texel_m;
+        f.scale[l] = 1.0 / double(1 << level);
+        f.n[l] = t.n >> level;
+        f.size[l] = double(f.n[l]);
+        f.invSize[l] = 1.0 / f.size[l];
+        f.factor[l] = factor;
+        f.texels[l] = t.levels[size_t(level)].data()->v.data();
+        lastLevel = level;
+    };
     for (size_t c = 0; c < textures_.size(); ++c) {
         const CascadeTexture& t = textures_[c];
         const int top = int(t.levels.size()) - 1;
@@ -286,35 +301,15 @@ FftFilter OceanSurfaceFrame::Filter(float footprint_m) const {
         lod = std::min(lod, float(top));
         f.level[c] = int(lod);
         f.frac[c] = lod - float(f.level[c]);
-        const auto add = [&](int level, float factor) {
-            const int l = f.lookups++;
-            f.cascade[size_t(l)] = int(c);
-            f.texel[size_t(l)] = t.texel_m;
-            f.halfTexel[size_t(l)] = 0.5 * t.texel_m;
-            f.scale[size_t(l)] = 1.0 / double(1 << level);
-            f.n[size_t(l)] = t.n >> level;
-            f.size[size_t(l)] = double(f.n[size_t(l)]);
-            f.invSize[size_t(l)] = 1.0 / f.size[size_t(l)];
-            f.factor[size_t(l)] = factor;
-            f.texels[size_t(l)] = t.levels[size_t(level)].data()->v.data();
-        };
-        add(f.level[c], 1.0f - f.frac[c]);
-        if (f.frac[c] > 0.0f) add(f.level[c] + 1, f.frac[c]);
+        add(c, f.level[c], 1.0f - f.frac[c]);
+        if (f.frac[c] > 0.0f) add(c, f.level[c] + 1, f.frac[c]);
     }
     static_assert(sizeof(Texel) == sizeof(GeometrySums));  // texels read as rows of floats
-    // Pad to whole groups of four with the last lookup (read, never added).
-    for (int l = f.lookups; l % 4 != 0; ++l) {
-        const size_t last = size_t(f.lookups - 1);
-        f.cascade[size_t(l)] = f.cascade[last];
-        f.texel[size_t(l)] = f.texel[last];
-        f.halfTexel[size_t(l)] = f.halfTexel[last];
-        f.scale[size_t(l)] = f.scale[last];
-        f.n[size_t(l)] = f.n[last];
-        f.size[size_t(l)] = f.size[last];
-        f.invSize[size_t(l)] = f.invSize[last];
-        f.factor[size_t(l)] = f.factor[last];
-        f.texels[size_t(l)] = f.texels[last];
-    }
+    // Pad to whole groups of four with copies of the last lookup (read, never added).
+    const int lookups = f.lookups;
+    while (lookups > 0 && f.lookups % 4 != 0)
+        add(size_t(f.cascade[size_t(lookups - 1)]), lastLevel, f.factor[size_t(lookups - 1)]);
+    f.lookups = lookups;
     return f;
 }
 
