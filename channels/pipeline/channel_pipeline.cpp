@@ -173,6 +173,12 @@ FrameRecord ChannelPipeline::RenderAndWrite(int64_t frame) {
     return rec;
 }
 
+void ChannelPipeline::WarmUp(const scene::FrameState& frame) {
+    Render(frame);
+    if (imager_) imager_->Restart();
+    if (intensifier_) intensifier_->Restart();
+}
+
 FrameRecord ChannelPipeline::Render(const scene::FrameState& frame) {
     FrameRecord rec;
     state_ = world_.Compose(frame);

@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cstring>
 #include <filesystem>
+#include <string_view>
 #include <thread>
 
 #include "channels/sync/shm_segment.h"
@@ -26,10 +27,40 @@ std::string Describe(const ProcessExit& e) {
            (abbrev ? std::string(" (SIG") + abbrev + ")" : std::string());
 }
 
-pid_t SpawnProcess(const std::vector<std::string>& argv) {
+std::vector<std::string> RendererEnvironment(const char* const* env) {
+    constexpr std::string_view kName = "GLIBC_TUNABLES=", kHugePages = "glibc.malloc.hugetlb";
+    std::vector<std::string> out;
+    bool tunables = false;
+    for (; env && *env; ++env) {
+        std::string entry = *env;
+        if (entry.starts_with(kName)) {
+            tunables = true;
+            // Tunables are colon-separated name=value pairs; the user's own choice stands.
+            bool chosen = false;
+            for (size_t at = kName.size(); at <= entry.size();) {
+                const size_t end = std::min(entry.find(':', at), entry.size());
+                const std::string_view item = std::string_view(entry).substr(at, end - at);
+                chosen |= item.starts_with(kHugePages) && item.size() > kHugePages.size() &&
+                          item[kHugePages.size()] == '=';
+                at = end + 1;
+            }
+            if (!chosen)
+                entry += (entry.size() > kName.size() ? ":" : "") + std::string(kHugePages) + "=1";
+        }
+        out.push_back(std::move(entry));
+    }
+    if (!tunables) out.push_back(std::string(kName) + std::string(kHugePages) + "=1");
+    return out;
+}
+
+pid_t SpawnProcess(const std::vector<std::string>& argv,
+                   const std::vector<std::string>& environment) {
     std::vector<char*> args;
     for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
     args.push_back(nullptr);
+    std::vector<char*> envp;
+    for (const std::string& e : environment) envp.push_back(const_cast<char*>(e.c_str()));
+    envp.push_back(nullptr);
     posix_spawnattr_t attr;
     ::posix_spawnattr_init(&attr);
     ::posix_spawnattr_setflags(
@@ -44,7 +75,8 @@ pid_t SpawnProcess(const std::vector<std::string>& argv) {
     ::posix_spawnattr_setsigmask(&attr, &none);
     ::posix_spawnattr_setsigdefault(&attr, &defaults);
     pid_t pid = 0;
-    const int err = ::posix_spawn(&pid, args[0], nullptr, &attr, args.data(), environ);
+    const int err = ::posix_spawn(&pid, args[0], nullptr, &attr, args.data(),
+                                  environment.empty() ? environ : envp.data());
     ::posix_spawnattr_destroy(&attr);
     if (err != 0)
         throw RuntimeError("cannot start renderer " + argv[0] + ": " + std::strerror(err));

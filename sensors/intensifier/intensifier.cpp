@@ -178,6 +178,12 @@ Intensifier::Intensifier(const IntensifierSettings& settings, int supersampling)
     display_.assign(size_t(w) * size_t(h) * 3, 0);
 }
 
+void Intensifier::Restart() {
+    started_ = false;
+    lastTime_s_ = 0.0;
+    gain_ = 0.0, duty_ = 1.0, meanPe_ = 0.0;
+}
+
 void Intensifier::Process(const Image& samples, double time_s, int64_t frame) {
     const int w = s_.width_px, h = s_.height_px, n = n_;
     CHECK(samples.width == w * n && samples.height == h * n);

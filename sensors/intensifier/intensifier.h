@@ -23,6 +23,9 @@ class Intensifier {
     // previous call (settled on the first call, or when time does not advance); noise is a pure
     // function of (seed, frame, pixel), so any thread count gives the same frame.
     void Process(const Image& samples, double time_s, int64_t frame);
+    // Forgets the frames processed (the ABC's gain history): the next Process starts settled,
+    // bit for bit what a newly made intensifier gives, with the working memory kept.
+    void Restart();
 
     // Mean photoelectrons per pixel per frame for photon radiance 1 photon s⁻¹ m⁻² sr⁻¹ at the
     // optical axis: QE_peak · τ_optics · A_pixel · π/(4F²) · t_frame (étendue of a pixel behind

@@ -336,6 +336,13 @@ void ThermalImager::Process(const Image& samples, double time_s, int64_t noiseFr
     ++frame_;
 }
 
+void ThermalImager::Restart() {
+    frame_ = 0;
+    lastNoiseFrame_ = 0;
+    lastTime_s_ = 0.0;
+    display_.Reset();
+}
+
 Image ThermalImager::MeasuredRadiance() const {
     Image L(signal_.width, signal_.height, 1);
     const double perIrradiance = 1.0 / irradiancePerRadiance_;

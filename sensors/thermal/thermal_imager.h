@@ -47,6 +47,10 @@ class ThermalImager {
     void Process(const Image& samples, double time_s, int64_t noiseFrame);
     // Process with noiseFrame = FramesProcessed().
     void Process(const Image& samples, double time_s) { Process(samples, time_s, frame_); }
+    // Forgets the frames processed (bolometer lag, AGC memory, frame count): the next Process
+    // is a first frame again, bit for bit what a newly made imager gives, with the working
+    // memory kept.
+    void Restart();
 
     const ThermalImagerSettings& Settings() const { return settings_; }
     const radiometry::Band& GetBand() const { return table_.GetBand(); }

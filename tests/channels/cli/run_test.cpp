@@ -176,6 +176,7 @@ TEST(Run, WritesImagesSyncLogMosaicAndSummaryUnderTheFrameLock) {
     EXPECT_EQ(summary["frames"], 6);
     EXPECT_EQ(summary["status"], "complete");
     EXPECT_GT(summary["fps"].get<double>(), 0.0);
+    EXPECT_GT(summary["startup_s"].get<double>(), 0.0);
     // The frame rate after the first frame, from the sync log: 5 frame intervals between the
     // latest presentations of frames 0 and 5.
     int64_t firstLatest = INT64_MIN, lastLatest = INT64_MIN;
@@ -236,10 +237,13 @@ TEST(Run, EveryFrameOfEveryChannelEqualsCapture) {
     ExpectRunEqualsCapture(kScenario, kChannels, "eq");
 }
 
-// An NVG channel (stateful ABC, scintillation noise keyed by frame and pixel) beside an OTW one.
-TEST(Run, NvgChannelFramesEqualCapture) {
+// The stateful sensors beside an OTW channel: an NVG (ABC, scintillation noise keyed by frame
+// and pixel) and a FLIR (bolometer lag, AGC memory). Their renderers warm up on the first frame
+// before attaching (ChannelPipeline::WarmUp) and restart the sensors' histories: the run's
+// frames are still those of a capture that starts at the first frame.
+TEST(Run, NvgAndFlirChannelFramesEqualCapture) {
     ExpectRunEqualsCapture(std::string(SEASENSE_SOURCE_DIR) + "/tests/data/scenarios/run-nvg.yaml",
-                           {"otw", "nvg"}, "nvg");
+                           {"otw", "nvg", "flir"}, "nvg");
 }
 
 // Over a spectral sea the renderers adopt the fields the host synthesized instead of making

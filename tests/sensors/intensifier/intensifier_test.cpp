@@ -145,6 +145,30 @@ TEST(Intensifier, AbcStepResponseHasTheConfiguredTimeConstant) {
     }
 }
 
+// After Restart the next frame starts settled, as a new intensifier's first frame does: its gain
+// is the fixed point level / mean photoelectrons at once, not the lagged step from the frames
+// before, and the whole frame equals a new intensifier's bit for bit.
+TEST(Intensifier, RestartForgetsTheAbcHistory) {
+    IntensifierSettings s = Small();
+    s.abcTimeConstant_s = 0.2;
+    s.haloFraction = 0.0;
+    Intensifier used(s, 1), fresh(s, 1);
+    const double perPe = 1.0 / used.PhotoelectronsPerRadiance();
+    const double pe0 = 4.0 * s.PixelFramePe(s.abcThreshold_pe_s_mm2);
+    const double dt = 1.0 / 30.0;
+    used.Process(Uniform(s, 1, pe0 * perPe), 0.0, 0);
+    used.Process(Uniform(s, 1, pe0 * perPe), dt, 1);
+    used.Restart();
+    const Image brighter = Uniform(s, 1, 1.25 * pe0 * perPe);
+    used.Process(brighter, 2 * dt, 2);
+    fresh.Process(brighter, 2 * dt, 2);
+    EXPECT_NEAR(used.Gain() / (s.abcLevel / (1.25 * pe0)), 1.0, 1e-6);
+    EXPECT_EQ(used.Gain(), fresh.Gain());
+    EXPECT_TRUE(used.Brightness().pixels == fresh.Brightness().pixels);
+    EXPECT_TRUE(std::equal(used.Display().begin(), used.Display().end(), fresh.Display().begin(),
+                           fresh.Display().end()));
+}
+
 // A tenfold flash: the gain set for the dim scene saturates the screen (washout); the ABC,
 // sensing the saturated screen current, brings the image back to its level.
 TEST(Intensifier, AbcLagWashesOutAFlashThenRecovers) {

@@ -205,6 +205,32 @@ TEST(ThermalImager, BolometerLagFollowsTheExponentialStepResponse) {
     }
 }
 
+// After Restart the next frame starts settled (the bolometer at the scene's radiance, the AGC
+// taking its mapping directly), as a new imager's first frame does, bit for bit; time may start
+// over.
+TEST(ThermalImager, RestartForgetsTheLagAndTheAgc) {
+    const int w = 16, h = 12;
+    ThermalImagerSettings s = SmallSettings(w, h);
+    s.timeConstant_s = 0.010;
+    ThermalImager used(s, radiometry::Band::Lwir(), 2), fresh(s, radiometry::Band::Lwir(), 2);
+    used.Process(Uniform(w, h, 2, LwirRadiance(280.0)), 0.0, 0);
+    used.Process(Uniform(w, h, 2, LwirRadiance(290.0)), 1.0 / 30, 1);
+    used.Restart();
+    EXPECT_EQ(used.FramesProcessed(), 0);
+    const Image hot = Uniform(w, h, 2, LwirRadiance(320.0));
+    used.Process(hot, 0.0, 1);
+    fresh.Process(hot, 0.0, 1);
+    for (int y = 0; y < h; y += 5)
+        for (int x = 0; x < w; x += 5)
+            EXPECT_NEAR(used.Radiance().At(x, y)[0] / (s.opticsTransmission * LwirRadiance(320.0)),
+                        1.0, 1e-6);
+    EXPECT_TRUE(used.Radiance().pixels == fresh.Radiance().pixels);
+    EXPECT_TRUE(std::equal(used.Counts().begin(), used.Counts().end(), fresh.Counts().begin(),
+                           fresh.Counts().end()));
+    EXPECT_TRUE(std::equal(used.Display().begin(), used.Display().end(), fresh.Display().begin(),
+                           fresh.Display().end()));
+}
+
 TEST(ThermalImager, AdcRoundsAndClampsToFourteenBits) {
     const int w = 4, h = 4;
     ThermalImagerSettings s = SmallSettings(w, h);
