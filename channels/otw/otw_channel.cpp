@@ -124,6 +124,13 @@ glm::vec3 ShadowRayOrigin(const glm::vec3& p, const glm::vec3& n) {
 // (computed in tests/radiometry/sky: analytic_sky_test, QuantizedSun…), a tenth of an 8-bit
 // display step; at the five-channel run's time scale (10) the table is rebuilt every ~7 frames.
 constexpr double kSkySunStep_rad = 0.01 * M_PI / 180.0;
+// The moonlit sky's phase-angle and distance steps: within half a step of either its luminance
+// changes by under 0.07 % (the moon's illuminance of Krisciunas & Schaefer 1991 eq. 20, as
+// radiometry's MoonlitSky has it, changes by d ln I / dα ≤ 6.3 per rad, at new moon; 1/d² by
+// 0.03 % for 50 km of the perigee's 356 000 km). The phase angle moves ~2.5e-6 rad per second
+// of scene time, so the table is rebuilt for it every ~80 s of scene time.
+constexpr double kSkyMoonPhaseStep_rad = 2e-4;
+constexpr double kSkyMoonDistanceStep_m = 1.0e5;
 
 // A distant light: unit direction toward it (ENU) and its illuminance on a surface normal to
 // that direction (lx, Rec.709 RGB).
@@ -955,14 +962,8 @@ PlumeLighting BasisPlumeLighting(const DirectionalLight& key, const glm::vec3& d
     light.kind = PlumeLighting::Kind::Visible;
     light.sunDirection = key.dir;
     light.sunIlluminance = key.dir.z > 0.0f ? key.E : glm::vec3(0.0f);
-    // VisibleAmbientRadiance = ½ (sky mean + ρ E_sky-model / π): its sea half is lit by the sky
-    // model's own sun (Rec.709) and dome, replaced here by the channel's downwelling light.
-    const glm::dvec3 skyModelDown =
-        sky.SunIlluminance() * std::max(sky.SunDirection().z, 0.0) + sky.HorizontalSkyIlluminance();
-    const glm::dvec3 skyMean =
-        2.0 * glm::dvec3(VisibleAmbientRadiance(sky)) - double(kSeaAlbedo) * skyModelDown / M_PI;
-    light.ambientRgb =
-        glm::vec3(0.5 * (skyMean + double(kSeaAlbedo) * glm::dvec3(downwelling) / M_PI));
+    light.ambientRgb = glm::vec3(
+        0.5 * (SkyMeanRadiance(sky) + double(kSeaAlbedo) * glm::dvec3(downwelling) / M_PI));
     light.glow = glow;
     return light;
 }
@@ -1045,7 +1046,17 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
         radiometry::QuantizeSunDirection(state.sun.direction, kSkySunStep_rad);
     const glm::dvec3 skyMoon =
         radiometry::QuantizeSunDirection(state.moon.direction, kSkySunStep_rad);
-    if (!sky_ || skySun_ != skySun || skyMoon_ != skyMoon) {
+    // The moonlit sky's phase angle and distance rounded too (steps below), so that the table
+    // is a function of the rounded values alone: a frame's sky does not depend on which earlier
+    // frame built the table (a capture from any first frame gives the run's frames). The sun's
+    // illuminance it keeps (SunIlluminance) is the building frame's: per-frame light takes the
+    // frame's own sun (ChannelPlumes::CompositeOtw).
+    const double moonPhase_rad =
+        kSkyMoonPhaseStep_rad * std::round(state.moon.phaseAngle_rad / kSkyMoonPhaseStep_rad);
+    const double moonDistance_m =
+        kSkyMoonDistanceStep_m * std::round(state.moon.distance_m / kSkyMoonDistanceStep_m);
+    if (!sky_ || skySun_ != skySun || skyMoon_ != skyMoon || skyMoonPhase_rad_ != moonPhase_rad ||
+        skyMoonDistance_m_ != moonDistance_m) {
         radiometry::SkyConditions c;
         c.sunDirection = skySun;
         c.sunIlluminance_lux = state.sun.illuminance_lux;
@@ -1053,12 +1064,14 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
         c.extinctionV_magPerAirmass = scene::ZenithExtinctionV_mag(sc.eyepoint.position_m.z);
         c.moon = true;
         c.moonDirection = skyMoon;
-        c.moonPhaseAngle_rad = state.moon.phaseAngle_rad;
-        c.moonDistance_m = state.moon.distance_m;
+        c.moonPhaseAngle_rad = moonPhase_rad;
+        c.moonDistance_m = moonDistance_m;
         if (basis_) c.basis = basis_->sky;
         sky_ = std::make_unique<radiometry::AnalyticSky>(c);
         skySun_ = skySun;
         skyMoon_ = skyMoon;
+        skyMoonPhase_rad_ = moonPhase_rad;
+        skyMoonDistance_m_ = moonDistance_m;
     }
     const radiometry::AnalyticSky& sky = *sky_;
     const glm::vec3 sunDir(state.sun.direction);

@@ -85,6 +85,7 @@ class OtwChannel {
     std::unique_ptr<radiometry::AnalyticSky> sky_;
     glm::dvec3 skySun_{0.0};
     glm::dvec3 skyMoon_{0.0};
+    double skyMoonPhase_rad_ = 0.0, skyMoonDistance_m_ = 0.0;  // rounded, as the table has them
     std::unique_ptr<StarsNearView> stars_;  // the bright-star list (configs/stars)
     std::unique_ptr<ShadeScratch> scratch_;
     std::unique_ptr<ChannelPlumes> plumes_;  // scenario plumes (channels/plume)

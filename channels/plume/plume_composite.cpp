@@ -1160,7 +1160,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     return stats;
 }
 
-glm::vec3 VisibleAmbientRadiance(const radiometry::AnalyticSky& sky) {
+glm::dvec3 SkyMeanRadiance(const radiometry::AnalyticSky& sky) {
     constexpr int kMu = 16, kPhi = 32;
     std::vector<float> x, y, z;
     for (int m = 0; m < kMu; ++m) {
@@ -1176,12 +1176,15 @@ glm::vec3 VisibleAmbientRadiance(const radiometry::AnalyticSky& sky) {
     sky.LookUp(x.size(), x.data(), y.data(), z.data(), r.data(), g.data(), b.data());
     glm::dvec3 upper(0.0);
     for (size_t i = 0; i < x.size(); ++i) upper += glm::dvec3(r[i], g[i], b[i]);
-    upper /= double(x.size());
-    const glm::dvec3 sunDir = sky.SunDirection();
+    return upper / double(x.size());
+}
+
+glm::vec3 VisibleAmbientRadiance(const radiometry::AnalyticSky& sky, const glm::dvec3& sunDirection,
+                                 const glm::dvec3& sunIlluminanceRgb) {
     const glm::dvec3 down =
-        sky.SunIlluminance() * std::max(sunDir.z, 0.0) + sky.HorizontalSkyIlluminance();
+        sunIlluminanceRgb * std::max(sunDirection.z, 0.0) + sky.HorizontalSkyIlluminance();
     const glm::dvec3 lower = double(kSeaAlbedo) * down / std::numbers::pi;
-    return glm::vec3(0.5 * (upper + lower));
+    return glm::vec3(0.5 * (SkyMeanRadiance(sky) + lower));
 }
 
 ChannelPlumes::ChannelPlumes(const scene::World& world) {
@@ -1219,9 +1222,11 @@ void ChannelPlumes::CompositeOtw(const scene::SceneState& state, const ChannelCa
     PlumeLighting light;
     light.kind = PlumeLighting::Kind::Visible;
     light.sunDirection = glm::vec3(state.sun.direction);
-    light.sunIlluminance =
-        state.sun.direction.z > 0.0 ? glm::vec3(sky.SunIlluminance()) : glm::vec3(0.0f);
-    light.ambientRgb = VisibleAmbientRadiance(sky);
+    // The frame's own sun (the sky table may have been built at an earlier frame).
+    const glm::dvec3 sunRgb =
+        radiometry::SunIlluminanceRgb(state.sun.direction, state.sun.illuminance_lux);
+    light.sunIlluminance = state.sun.direction.z > 0.0 ? glm::vec3(sunRgb) : glm::vec3(0.0f);
+    light.ambientRgb = VisibleAmbientRadiance(sky, state.sun.direction, sunRgb);
     light.glow = glow_.get();
     const scene::PlumeField& field = FieldAt(state.time_s);
     stats_ = CompositePlumes(field, camera, vis, light, radiance);

@@ -172,10 +172,18 @@ class ChannelPlumes {
     PlumeCompositeStats stats_;
 };
 
+// Solid-angle mean radiance (cd/m², RGB) of the sky model's upper hemisphere (midpoint
+// quadrature in cos zenith and azimuth, 16 × 32 directions).
+glm::dvec3 SkyMeanRadiance(const radiometry::AnalyticSky& sky);
+
 // Solid-angle mean radiance (cd/m², RGB) of sky and sea around a plume: the upper hemisphere
-// from the sky model (midpoint quadrature, 16 × 32 directions), the lower from the sea's
-// diffuse reflection of the downwelling light (albedo 0.06, Payne, J. Atmos. Sci. 29 (1972)
-// 959, as a Lambertian reflector).
-glm::vec3 VisibleAmbientRadiance(const radiometry::AnalyticSky& sky);
+// SkyMeanRadiance, the lower the sea's diffuse reflection of the downwelling light (albedo 0.06,
+// Payne, J. Atmos. Sci. 29 (1972) 959, as a Lambertian reflector): the sky model's dome and the
+// frame's own sun, sunIlluminanceRgb (lx on a surface normal to it, per Rec.709 component) from
+// sunDirection (unit ENU). The sun is the frame's, not the sky model's: a sky table is reused
+// over a quantized step of the sun's path, and the frame's light must not depend on which
+// earlier frame built it.
+glm::vec3 VisibleAmbientRadiance(const radiometry::AnalyticSky& sky, const glm::dvec3& sunDirection,
+                                 const glm::dvec3& sunIlluminanceRgb);
 
 }  // namespace seasense::channels

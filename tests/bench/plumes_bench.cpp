@@ -243,7 +243,8 @@ void BM_SkyClockPlumesUpdate(benchmark::State& state) {
             skySun = sun, skyMoon = moon;
             ++rebuilds;
         }
-        benchmark::DoNotOptimize(channels::VisibleAmbientRadiance(*sky));
+        benchmark::DoNotOptimize(
+            channels::VisibleAmbientRadiance(*sky, sky->SunDirection(), sky->SunIlluminance()));
         system.Commit(300.0 + s.time_s, field);
         benchmark::DoNotOptimize(field.PuffCount());
     }

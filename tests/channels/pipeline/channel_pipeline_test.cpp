@@ -1,9 +1,11 @@
 // Channel pipeline: a pipeline that warmed up on one frame renders what a new one renders, for
-// the stateful sensors (FLIR bolometer lag and AGC, NVG automatic brightness control) too.
+// the stateful sensors (FLIR bolometer lag and AGC, NVG automatic brightness control) too; the
+// rendered scene of a frame does not depend on the frame a pipeline started at.
 #include "channels/pipeline/channel_pipeline.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <string>
@@ -60,6 +62,54 @@ TEST(ChannelPipeline, WarmedUpPipelineRendersWhatANewOneRenders) {
             warm.Render(world.Advance(f));
             EXPECT_TRUE(FrameBytes(fresh, name) == FrameBytes(warm, name)) << "frame " << f;
         }
+    }
+}
+
+// The at-aperture image of frame f, whatever frame the pipeline started at: the OTW display (its
+// sensor keeps no history) and the NVG's photon radiance before the intensifier's ABC. Caches
+// kept between frames (the sky table, rebuilt at quantized steps of the sun's and moon's
+// paths; plume fields; the occlusion BVH, refitted) must give every frame the same bits. Over
+// the first frames of run-nvg.yaml the moon's sky crosses a step, and of five-channel.yaml the
+// setting sun's (every ~7 frames) with the burning hulk's plume lit by it.
+TEST(ChannelPipeline, FramesDoNotDependOnTheFirstFrameRendered) {
+    const std::filesystem::path root(SEASENSE_SOURCE_DIR);
+    struct Case {
+        std::filesystem::path scenario;
+        std::string channel;
+        int64_t starts[3], last;
+    };
+    for (const Case& c : {Case{root / "tests/data/scenarios/run-nvg.yaml", "otw", {0, 2, 3}, 8},
+                          Case{root / "tests/data/scenarios/run-nvg.yaml", "nvg", {0, 2, 3}, 8},
+                          Case{root / "configs/five-channel.yaml", "otw-center", {0, 4, 9}, 16}}) {
+        SCOPED_TRACE(c.scenario.filename().string() + " " + c.channel);
+        const scene::Scenario sc = scene::LoadScenario(c.scenario);
+        scene::ChannelSettings ch = *sc.FindChannel(c.channel);
+        ch.width = std::min(ch.width, 160);
+        ch.height = std::min(ch.height, 120);
+        const scene::World world(sc);
+        // Frame f's image per start, for f from the latest start on.
+        std::vector<std::vector<std::vector<uint8_t>>> images;
+        for (const int64_t start : c.starts) {
+            ChannelPipeline p(world, ch, std::filesystem::temp_directory_path(), {"png"},
+                              DefaultOcioConfig());
+            images.emplace_back();
+            for (int64_t f = start; f <= c.last; ++f) {
+                p.Render(world.Advance(f));
+                if (f < c.starts[2]) continue;
+                if (ch.kind == scene::ChannelKind::Nvg) {
+                    const Image& L = p.GetIntensifier().PhotonRadiance();
+                    std::vector<uint8_t> bytes(L.pixels.size() * sizeof(float));
+                    std::memcpy(bytes.data(), L.pixels.data(), bytes.size());
+                    images.back().push_back(std::move(bytes));
+                } else {
+                    images.back().push_back(p.DisplayRgb8());
+                }
+            }
+        }
+        for (size_t k = 0; k < images[0].size(); ++k)
+            for (size_t s = 1; s < images.size(); ++s)
+                EXPECT_TRUE(images[s][k] == images[0][k])
+                    << "frame " << c.starts[2] + int64_t(k) << " from start " << c.starts[s];
     }
 }
 
