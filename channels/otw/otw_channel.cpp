@@ -274,8 +274,11 @@ struct SeaShading {
                                 ? Splat(kMinWaterPathFactor)
                                 : WaterPathFactor(cosV, float(radiometry::kSeaWaterIndexVisible));
             const VF keyLit = Load(ch.keyCos + i) * sunVis;
+            // Inlined, so the three channels share their common terms (the swash film, the
+            // path through the column, the lane tests).
             const auto channel = [&](const ShoreChannel& sh, const float* skyC, const float* horC,
-                                     const float* ambC, float dw, float sunEC, float* outC) {
+                                     const float* ambC, float dw, float sunEC, float* outC)
+                __attribute__((always_inline)) {
                 VF R = F * Load(skyC + i);
                 if (anyGlint) R = Select(glint, R + (sunEC * g) * sunVis, R);
                 const VF E = Load(ambC + i) + sunEC * keyLit;
