@@ -618,7 +618,7 @@ class BlockClassifier {
     // shaded at pixel rate (at the mean barycentrics) unless c = n·v varies too much across it
     // (then its samples are added one by one, as Sample adds them) or depth does (then returns
     // false, nothing added). On one triangle c is linear in the barycentrics.
-    bool SeaTrianglePixel(int x0, uint32_t k, uint32_t prim) {
+    __attribute__((always_inline)) bool SeaTrianglePixel(int x0, uint32_t k, uint32_t prim) {
         const int n = N(), count = n * n;
         if (!DepthsClose(x0)) return false;
         const CachedTriangle& tri = Triangle(prim);
