@@ -170,6 +170,18 @@ struct SeaShading {
     void Shade(size_t count, const float* px, const float* py, const float* pz, const float* nx,
                const float* ny, const float* nz, const float* depth, const float* wet,
                const float* foam, SeaChunk& ch) const {
+        // On a local copy of the constants, which the loops' stores to the chunk's float arrays
+        // cannot change: their lane broadcasts are then made once, not per lane group.
+        const SeaShading local = *this;
+        local.ShadeChunk(count, px, py, pz, nx, ny, nz, depth, wet, foam, ch);
+    }
+
+  private:
+    __attribute__((always_inline)) void ShadeChunk(size_t count, const float* px, const float* py,
+                                                   const float* pz, const float* nx,
+                                                   const float* ny, const float* nz,
+                                                   const float* depth, const float* wet,
+                                                   const float* foam, SeaChunk& ch) const {
         // Geometry: view vector v, reflected ray r, glint half vector h; simd::kLanes entries at
         // a time (the chunk's arrays hold kChunk, a multiple of kLanes: lanes past count are
         // computed from padding, then dropped).
