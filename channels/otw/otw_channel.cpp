@@ -177,6 +177,18 @@ struct SeaShading {
     void Shade(size_t count, const float* px, const float* py, const float* pz, const float* nx,
                const float* ny, const float* nz, const float* depth, const float* wet,
                const float* foam, SeaChunk& ch) const {
+        // On a local copy of the constants, which the loops' stores to the chunk's float arrays
+        // cannot change: their lane broadcasts are then made once, not per lane group.
+        const SeaShading local = *this;
+        local.ShadeChunk(count, px, py, pz, nx, ny, nz, depth, wet, foam, ch);
+    }
+
+  private:
+    __attribute__((always_inline)) void ShadeChunk(size_t count, const float* px, const float* py,
+                                                   const float* pz, const float* nx,
+                                                   const float* ny, const float* nz,
+                                                   const float* depth, const float* wet,
+                                                   const float* foam, SeaChunk& ch) const {
         // Geometry: view vector v, reflected ray r, glint half vector h; simd::kLanes entries at
         // a time (the chunk's arrays hold kChunk, a multiple of kLanes: lanes past count are
         // computed from padding, then dropped).
@@ -281,8 +293,11 @@ struct SeaShading {
                                 ? Splat(kMinWaterPathFactor)
                                 : WaterPathFactor(cosV, float(radiometry::kSeaWaterIndexVisible));
             const VF keyLit = Load(ch.keyCos + i) * sunVis;
+            // Inlined, so the three channels share their common terms (the swash film, the
+            // path through the column, the lane tests).
             const auto channel = [&](const ShoreChannel& sh, const float* skyC, const float* horC,
-                                     const float* ambC, float dw, float sunEC, float* outC) {
+                                     const float* ambC, float dw, float sunEC, float* outC)
+                __attribute__((always_inline)) {
                 VF R = F * Load(skyC + i);
                 if (anyGlint) R = Select(glint, R + (sunEC * g) * sunVis, R);
                 const VF E = Load(ambC + i) + sunEC * keyLit;
@@ -355,8 +370,10 @@ struct BlockScratch {
     std::vector<float> skyX, skyY, skyZ;                          // view directions of sky entries
     std::vector<float> seaPx, seaPy, seaPz, seaNx, seaNy, seaNz;  // normals (unit once shaded)
     std::vector<float> seaDepth, seaWet, seaFoam;                 // OceanAttributes interpolated
-    std::vector<float> seaLit;      // lit fraction of a sea entry's samples (where seaUnlit > 0)
-    std::vector<uint8_t> seaUnlit;  // samples of a sea entry found in shadow
+    std::vector<float> seaLit;  // lit fraction of a sea entry's samples (where seaUnlit > 0)
+    // Samples of a sea entry found in shadow (not a character type, whose stores may alias any
+    // object: the classifier would reload the lists' pointers after each).
+    std::vector<uint16_t> seaUnlit;
     std::vector<glm::vec3> modelPosition, modelNormal;
     std::vector<int> modelMesh;
     std::vector<uint8_t> modelLit;  // sun visibility of model samples
@@ -511,7 +528,15 @@ template <int kN>
 class BlockClassifier {
   public:
     BlockClassifier(const FrameGeometry& g, const FrameShading& f, int py0, BlockScratch& sc)
-        : g_(g), f_(f), sc_(sc), y0_(py0 * g.n) {
+        : g_(g),
+          f_(f),
+          sc_(sc),
+          y0_(py0 * g.n),
+          primitive_(g.vis.primitive.data()),
+          depth_(g.vis.depth.data()),
+          b1_(g.vis.b1.data()),
+          b2_(g.vis.b2.data()),
+          frame_(g.frame) {
         CHECK(kN == 0 || kN == g.n);
     }
 
@@ -525,7 +550,7 @@ class BlockClassifier {
         }
         const glm::vec3 pixelRow = g_.RowBase(1.0 - 2.0 * (py * n + 0.5 * n) / g_.sampleHeight);
         const uint32_t kRow = uint32_t(size_t(py * n - y0_) * size_t(sw));
-        const uint32_t* prim = g_.vis.primitive.data();
+        const uint32_t* prim = primitive_;
         for (int px = pxBegin; px < pxEnd; ++px) {
             const int x0 = px * n;
             const uint32_t prim0 = prim[rowIndex_[0] + size_t(x0)];
@@ -569,13 +594,13 @@ class BlockClassifier {
     // The cached triangle prim. The hit, most calls, is inlined; the gathering is not.
     __attribute__((always_inline)) const CachedTriangle& Triangle(uint32_t prim) {
         CachedTriangle& tri = sc_.triangles[prim % BlockScratch::kTriangleCacheSize];
-        if (tri.prim == prim && tri.frame == g_.frame) [[likely]]
+        if (tri.prim == prim && tri.frame == frame_) [[likely]]
             return tri;
         return Gather(prim, tri);
     }
     __attribute__((noinline)) const CachedTriangle& Gather(uint32_t prim, CachedTriangle& tri) {
         g_.Fetch(prim, tri);
-        tri.frame = g_.frame;
+        tri.frame = frame_;
         tri.shadowable = false;
         if (f_.shadows) {
             // Every shadow-ray origin on the triangle lies in its bounding box grown by the
@@ -597,7 +622,7 @@ class BlockClassifier {
     bool DepthsClose(int x0) const {
         float dMin = std::numeric_limits<float>::infinity(), dMax = 0.0f;
         for (int j = 0; j < N(); ++j) {
-            const float* depth = g_.vis.depth.data() + rowIndex_[j] + size_t(x0);
+            const float* depth = depth_ + rowIndex_[j] + size_t(x0);
             for (int i = 0; i < N(); ++i)
                 dMin = std::min(dMin, depth[i]), dMax = std::max(dMax, depth[i]);
         }
@@ -622,7 +647,7 @@ class BlockClassifier {
     // shaded at pixel rate (at the mean barycentrics) unless c = n·v varies too much across it
     // (then its samples are added one by one, as Sample adds them) or depth does (then returns
     // false, nothing added). On one triangle c is linear in the barycentrics.
-    bool SeaTrianglePixel(int x0, uint32_t k, uint32_t prim) {
+    __attribute__((always_inline)) bool SeaTrianglePixel(int x0, uint32_t k, uint32_t prim) {
         const int n = N(), count = n * n;
         if (!DepthsClose(x0)) return false;
         const CachedTriangle& tri = Triangle(prim);
@@ -632,8 +657,8 @@ class BlockClassifier {
         float b1Sum = 0.0f, b2Sum = 0.0f;
         for (int j = 0; j < n; ++j) {
             const size_t index = rowIndex_[j] + size_t(x0);
-            b1[j] = g_.vis.b1.data() + index;
-            b2[j] = g_.vis.b2.data() + index;
+            b1[j] = b1_ + index;
+            b2[j] = b2_ + index;
             for (int i = 0; i < n; ++i) {
                 b1Sum += b1[j][i];
                 b2Sum += b2[j][i];
@@ -685,8 +710,8 @@ class BlockClassifier {
             for (int i = 0; i < n; ++i) {
                 const size_t index = rowIndex_[j] + size_t(x0 + i);
                 const int s = j * n + i;
-                const CachedTriangle& tri = Triangle(g_.vis.primitive[index]);
-                const float b1 = g_.vis.b1[index], b2 = g_.vis.b2[index];
+                const CachedTriangle& tri = Triangle(primitive_[index]);
+                const float b1 = b1_[index], b2 = b2_[index];
                 Interpolate(tri, b1, b2, p[s], nrm[s]);
                 a[s] = InterpolateAttributes(tri, b1, b2);
                 aSum = _mm_add_ps(aSum, a[s]);
@@ -765,7 +790,7 @@ class BlockClassifier {
     // One sample (x, row j of the pixel row) shaded on its own.
     void Sample(int x, int j, uint32_t k) {
         const size_t index = rowIndex_[j] + size_t(x);
-        const uint32_t prim = g_.vis.primitive[index];
+        const uint32_t prim = primitive_[index];
         if (prim == kNoPrimitive) {
             // View direction, normalized in the sky pass.
             AddSky(k, sampleRow_[j] + (float(x) + 0.5f) * g_.colStep);
@@ -773,11 +798,11 @@ class BlockClassifier {
         }
         const CachedTriangle& tri = Triangle(prim);
         if (tri.mesh == 0) {
-            SeaSample(tri, g_.vis.b1[index], g_.vis.b2[index], k);
+            SeaSample(tri, b1_[index], b2_[index], k);
             return;
         }
         F4 p, nSum;
-        Interpolate(tri, g_.vis.b1[index], g_.vis.b2[index], p, nSum);
+        Interpolate(tri, b1_[index], b2_[index], p, nSum);
         const glm::vec3 position = Store3(p);
         glm::vec3 nrm = glm::normalize(Store3(nSum));
         if (glm::dot(nrm, f_.eye - position) < 0.0f) nrm = -nrm;
@@ -799,7 +824,12 @@ class BlockClassifier {
     const FrameGeometry& g_;
     const FrameShading& f_;
     BlockScratch& sc_;
-    const int y0_;                            // first sample row of the block
+    const int y0_;  // first sample row of the block
+    // The visibility buffer's arrays and the frame count, read per sample: one load away here,
+    // not three through g_.
+    const uint32_t* const primitive_;
+    const float *const depth_, *const b1_, *const b2_;
+    const uint64_t frame_;
     glm::vec3 sampleRow_[kMaxSupersampling];  // RowBase of the pixel row's sample rows
     size_t rowIndex_[kMaxSupersampling];      // visibility index of their first sample
 };

@@ -27,7 +27,8 @@ constexpr int kHorizonSize = 512;
 
 // Writes the first count ≤ simd::kLanes of lanes' (r, g, b, ·) registers to r, g and b: four
 // lanes at a time transposed to (r r r r), (g g g g), (b b b b).
-void StoreTransposed(F4 (&lanes)[simd::kLanes], size_t count, float* r, float* g, float* b) {
+__attribute__((always_inline)) inline void StoreTransposed(F4 (&lanes)[simd::kLanes], size_t count,
+                                                           float* r, float* g, float* b) {
     static_assert(simd::kLanes % 4 == 0);
     alignas(16) float tmp[3][simd::kLanes];
     const bool full = count == simd::kLanes;
