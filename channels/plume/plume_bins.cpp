@@ -6,12 +6,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <iterator>
 #include <limits>
 #include <numbers>
 
 #include "scene/core/check.h"
 #include "scene/core/simd4.h"
+#include "scene/core/simd_lanes.h"
 
 namespace seasense::channels {
 
@@ -351,6 +353,9 @@ float HalfDiagonal(int w, int h) {
     return float(0.5 * std::sqrt(double(w) * double(w) + double(h) * double(h)) + 1e-3);
 }
 
+// ⌊a / b⌋ for b > 0.
+int FloorDiv(int a, int b) { return a >= 0 ? a / b : -((b - 1 - a) / b); }
+
 }  // namespace
 
 inline bool PlumeScreenBins::Reaches(uint32_t k, int x0, int y0, int x1, int y1, float rho) const {
@@ -364,22 +369,13 @@ inline bool PlumeScreenBins::Reaches(uint32_t k, int x0, int y0, int x1, int y1,
     return cx >= lo && cx <= hi;
 }
 
-inline void PlumeScreenBins::AddRange(uint32_t k, float smallPixels, std::span<List> out) const {
-    // The puff's small-puff tests made once for all the lists.
-    const Footprint& fp = footprint_[k];
-    const bool small = fp.sigmaPixels < smallPixels,
-               halfSmall = fp.sigmaPixels < 0.5f * smallPixels;
-    for (List& o : out) {
-        o.index.push_back(k);
-        o.near_m = std::min(o.near_m, fp.near_m);
-        o.far_m = std::max(o.far_m, fp.far_m);
-        if (small) o.smallOpticalDepth += fp.tauMax;
-        if (halfSmall) o.halfSmallOpticalDepth += fp.tauMax;
-    }
-}
-
 inline void PlumeScreenBins::Add(uint32_t k, float smallPixels, List& out) const {
-    AddRange(k, smallPixels, std::span<List>(&out, 1));
+    const Footprint& fp = footprint_[k];
+    out.index.push_back(k);
+    out.near_m = std::min(out.near_m, fp.near_m);
+    out.far_m = std::max(out.far_m, fp.far_m);
+    if (fp.sigmaPixels < smallPixels) out.smallOpticalDepth += fp.tauMax;
+    if (fp.sigmaPixels < 0.5f * smallPixels) out.halfSmallOpticalDepth += fp.tauMax;
 }
 
 inline void PlumeScreenBins::Take(uint32_t k, int x0, int y0, int x1, int y1, float rho,
@@ -455,13 +451,46 @@ void PlumeScreenBins::Gather(const List& from, int x0, int y0, int x1, int y1, f
     Finish(copy, out);
 }
 
+void PlumeScreenBins::ListRow::Clear() {
+    index.clear();
+    start.assign(1, 0);
+    count.clear();
+    near_m.clear(), far_m.clear();
+    smallOpticalDepth.clear(), halfSmallOpticalDepth.clear();
+}
+
+void PlumeScreenBins::ListRow::Take(size_t c, List& out) const {
+    CHECK(c < count.size());
+    out.count = count[c];
+    out.index.assign(index.begin() + start[c], index.begin() + start[c + 1]);
+    out.near_m = near_m[c];
+    out.far_m = far_m[c];
+    out.smallOpticalDepth = smallOpticalDepth[c];
+    out.halfSmallOpticalDepth = halfSmallOpticalDepth[c];
+    out.copied = false;
+}
+
 void PlumeScreenBins::GatherRow(const List& from, int x0, int y0, int y1, int step, int width,
-                                int cells, float smallPixels, std::span<List> out) const {
-    CHECK(step > 0 && width > 0 && cells >= 0 && out.size() >= size_t(cells));
-    for (int c = 0; c < cells; ++c) {
-        CHECK(&from != &out[size_t(c)]);
-        Begin(out[size_t(c)]);
+                                int cells, float smallPixels, ListRow& out) const {
+    CHECK(step > 0 && width > 0 && cells >= 0 && cells <= kMaxRowCells);
+    using simd::kLanes;
+    using simd::VF;
+    using simd::VI;
+    // The rectangles' ranges, sums and counts, kLanes rectangles a vector, as Begin starts them.
+    constexpr size_t kVectors = (kMaxRowCells + kLanes - 1) / kLanes;
+    VF nearV[kVectors], farV[kVectors], smallV[kVectors], halfSmallV[kVectors];
+    VI countV[kVectors];
+    for (size_t v = 0; v < kVectors; ++v) {
+        nearV[v] = simd::Splat(std::numeric_limits<float>::infinity());
+        farV[v] = smallV[v] = halfSmallV[v] = simd::Splat(0.0f);
+        countV[v] = VI{};
     }
+    // Lane l of vector v is rectangle v·kLanes + l: its bit in a puff's mask, shifted down by
+    // v·kLanes.
+    VI laneBit;
+    for (size_t l = 0; l < kLanes; ++l) laneBit[l] = int32_t(1u << l);
+    std::vector<std::pair<uint32_t, uint32_t>>& reached = out.reached;
+    reached.clear();
     y1 = std::min(y1, height_);
     // Rectangle c clipped to the bin area as Gather clips it; empty ones get no puffs.
     const auto Right = [&](int c) { return std::min(x0 + c * step + width, width_); };
@@ -481,50 +510,104 @@ void PlumeScreenBins::GatherRow(const List& from, int x0, int y0, int y1, int st
             double spanHi = std::numeric_limits<double>::infinity();
             if (fp.sqrtLambdaMax != 0.0f && !EllipseSpan(fp, centreY, rho, spanLo, spanHi))
                 continue;
-            // The rectangles c with x0 + c·step < r.x1 and x0 + c·step + width > r.x0, widened
-            // by one on each side (the tests below decide exactly).
-            const int lo = std::max((r.x0 - x0 - width) / step - 1, 0);
-            const int hi = std::min((r.x1 - x0) / step + 1, cells - 1);
-            // The full-width rectangles among them (those before lastFull) that the puff
-            // reaches: rectangle overlap and ellipse span are each an interval of c (the centres
-            // increase with c), so they are too. Its ends are found from an estimate by the
-            // exact tests, and the rectangles between them take the puff without tests.
-            const auto Reached = [&](int c) {
-                const int cx0 = x0 + c * step, cx1 = cx0 + width;
-                if (r.x1 <= cx0 || r.x0 >= cx1) return false;
-                const double cx = 0.5 * double(cx0 + cx1);
-                return cx >= spanLo && cx <= spanHi;
+            // The rectangles c that the puff's rectangle overlaps, x0 + c·step < r.x1 and
+            // x0 + c·step + width > r.x0: an interval of c, in integers.
+            const int overlapLo = FloorDiv(r.x0 - x0 - width, step) + 1;
+            const int overlapHi = FloorDiv(r.x1 - x0 - 1, step);
+            // Those whose centres lie in the ellipse's span, as Reaches tests them: an interval
+            // of c too (the centres increase with c), its ends estimated in double precision
+            // (within far less than one step of the exact quotients, clamped to the row) and
+            // then moved by one where the exact test of the centre says so.
+            const auto Centre = [&](int c) {
+                const int cx0 = x0 + c * step;
+                return 0.5 * double(cx0 + (cx0 + width));
             };
-            const int fullHi = std::min(hi, lastFull);
-            if (lo <= fullHi) {
-                // Estimates of the interval's ends from the four bounds (centre x0 + c·step +
-                // width / 2), clamped to the candidates; the walks then find them exactly.
-                const double centre0 = double(x0) + 0.5 * width;
-                const double firstEstimate =
-                    std::max(std::floor(double(r.x0 - x0 - width) / step) + 1.0,
-                             std::ceil((spanLo - centre0) / step));
-                const double lastEstimate = std::min(std::ceil(double(r.x1 - x0) / step) - 1.0,
-                                                     std::floor((spanHi - centre0) / step));
-                int first = int(std::clamp(firstEstimate, double(lo), double(fullHi)));
-                while (first > lo && Reached(first - 1)) --first;
-                while (first <= fullHi && !Reached(first)) ++first;
-                if (first <= fullHi) {
-                    int last = int(std::clamp(lastEstimate, double(first), double(fullHi)));
-                    while (last > first && !Reached(last)) --last;
-                    while (last < fullHi && Reached(last + 1)) ++last;
-                    AddRange(k, smallPixels, out.subspan(size_t(first), size_t(last - first + 1)));
-                }
+            const double centre0 = Centre(0);
+            int spanFirst = std::numeric_limits<int>::min() / 2;
+            int spanLast = std::numeric_limits<int>::max() / 2;
+            if (fp.sqrtLambdaMax != 0.0f) {
+                spanFirst =
+                    int(std::clamp(std::ceil((spanLo - centre0) / step), -2.0, double(cells)));
+                if (Centre(spanFirst - 1) >= spanLo)
+                    --spanFirst;
+                else if (Centre(spanFirst) < spanLo)
+                    ++spanFirst;
+                spanLast =
+                    int(std::clamp(std::floor((spanHi - centre0) / step), -2.0, double(cells)));
+                if (Centre(spanLast + 1) <= spanHi)
+                    ++spanLast;
+                else if (Centre(spanLast) > spanHi)
+                    --spanLast;
             }
+            // The full-width rectangles (up to lastFull) that the puff reaches take it
+            // without further tests.
+            uint32_t mask = 0;
+            const int first = std::max({overlapLo, spanFirst, 0});
+            const int last = std::min({overlapHi, spanLast, lastFull});
+            // Bits first … last (last ≤ 31: the shift is of a 64-bit one).
+            if (first <= last) mask = uint32_t((uint64_t(2) << last) - (uint64_t(1) << first));
             // Rectangles clipped at the bin area's edge: each with its own ρ.
-            for (int c = std::max(lo, lastFull + 1); c <= hi; ++c) {
+            for (int c = std::max({overlapLo, lastFull + 1, 0});
+                 c <= std::min(overlapHi, cells - 1); ++c) {
                 const int cx0 = x0 + c * step, cx1 = Right(c);
-                if (cx0 >= cx1 || r.x1 <= cx0 || r.x0 >= cx1) continue;
-                Take(k, cx0, y0, cx1, y1, HalfDiagonal(cx1 - cx0, y1 - y0), smallPixels,
-                     out[size_t(c)]);
+                if (cx0 >= cx1) continue;
+                if (Reaches(k, cx0, y0, cx1, y1, HalfDiagonal(cx1 - cx0, y1 - y0))) mask |= 1u << c;
+            }
+            if (mask == 0) continue;
+            reached.emplace_back(k, mask);
+            // The puff's ranges and sums into the rectangles it reaches, in from's order as Add
+            // puts them in one list: std::min and std::max are simd::Min and Max lane for lane,
+            // and a rectangle the puff does not reach keeps its values.
+            const VF nearK = simd::Splat(fp.near_m), farK = simd::Splat(fp.far_m);
+            const bool small = fp.sigmaPixels < smallPixels;
+            const bool halfSmall = fp.sigmaPixels < 0.5f * smallPixels;
+            const VF tau = simd::Splat(fp.tauMax);
+            const int hiBit = 31 - __builtin_clz(mask);
+            for (size_t v = size_t(__builtin_ctz(mask)) / kLanes; v <= size_t(hiBit) / kLanes;
+                 ++v) {
+                const VI in = ((VI{} + int32_t(mask >> (v * kLanes))) & laneBit) != 0;
+                nearV[v] = simd::Select(in, simd::Min(nearV[v], nearK), nearV[v]);
+                farV[v] = simd::Select(in, simd::Max(farV[v], farK), farV[v]);
+                countV[v] -= in;
+                if (small) smallV[v] = simd::Select(in, smallV[v] + tau, smallV[v]);
+                if (halfSmall) halfSmallV[v] = simd::Select(in, halfSmallV[v] + tau, halfSmallV[v]);
             }
         }
     }
-    for (int c = 0; c < cells; ++c) Finish(false, out[size_t(c)]);
+    // The lists, one after the other, each padded to a multiple of 4 with the inert puff.
+    alignas(32) float nearA[kVectors * kLanes], farA[kVectors * kLanes];
+    alignas(32) float smallA[kVectors * kLanes], halfSmallA[kVectors * kLanes];
+    alignas(32) int32_t countA[kVectors * kLanes];
+    for (size_t v = 0; v < kVectors; ++v) {
+        simd::Store(nearA + v * kLanes, nearV[v]);
+        simd::Store(farA + v * kLanes, farV[v]);
+        simd::Store(smallA + v * kLanes, smallV[v]);
+        simd::Store(halfSmallA + v * kLanes, halfSmallV[v]);
+        std::memcpy(countA + v * kLanes, &countV[v], sizeof(VI));
+    }
+    size_t end = out.index.size();
+    for (int c = 0; c < cells; ++c) end += (size_t(countA[c]) + 3) & ~size_t(3);
+    // One slot more: the loop below writes each puff before it knows whether it keeps it.
+    out.index.resize(end + 1);
+    uint32_t* dst = out.index.data() + out.start.back();
+    for (int c = 0; c < cells; ++c) {
+        size_t n = 0;
+        for (const auto& [k, mask] : reached) {
+            dst[n] = k;
+            n += (mask >> c) & 1u;
+        }
+        CHECK(n == size_t(countA[c]));
+        const size_t padded = (n + 3) & ~size_t(3);
+        std::fill(dst + n, dst + padded, inert_);
+        dst += padded;
+        out.start.push_back(uint32_t(dst - out.index.data()));
+        out.count.push_back(uint32_t(n));
+        out.near_m.push_back(nearA[c]);
+        out.far_m.push_back(farA[c]);
+        out.smallOpticalDepth.push_back(smallA[c]);
+        out.halfSmallOpticalDepth.push_back(halfSmallA[c]);
+    }
+    out.index.resize(end);
 }
 
 void PlumeScreenBins::Copy(List& list) const {

@@ -228,11 +228,9 @@ using plume_detail::Bilinear;
 using plume_detail::Bilinear4;
 using plume_detail::VisibleSource;
 
-// One row of cells' lists: cell cx has index[start[cx], start[cx + 1]) (padded to 4).
+// One row of cells' lists (cell cx's is lists' list cx).
 struct CellRow {
-    std::vector<uint32_t> index, start, count;
-    std::vector<float> near_m, far_m;
-    std::vector<float> smallOpticalDepth, halfSmallOpticalDepth;
+    PlumeScreenBins::ListRow lists;
     // Whether every surface of the cell lies in front of its puffs (the cell is skipped).
     std::vector<uint8_t> inFront;
 };
@@ -279,7 +277,6 @@ class FrameBuffersLease {
 // parallelism), so no two users share it.
 struct Scratch {
     PlumeScreenBins::List list;
-    std::vector<PlumeScreenBins::List> cellLists{PlumeScreenBins::kTile / kCell};
     std::vector<float> range, depthRows;
     std::vector<std::pair<int, int>> depthRuns;
 };
@@ -373,6 +370,15 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             }
             return;
         }
+        if (!visible && N == 2) {
+            // The infrared's usual case, each sample row's two values at once (SSE2).
+            const __m128 Tv = _mm_set1_ps(T), s = _mm_set1_ps((1.0f - T) * S[0]);
+            for (int j = 0; j < 2; ++j) {
+                __m64* o = reinterpret_cast<__m64*>(radiance.At(px * 2, py * 2 + j));
+                _mm_storel_pi(o, _mm_add_ps(_mm_mul_ps(_mm_loadl_pi(Tv, o), Tv), s));
+            }
+            return;
+        }
         const int channels = visible ? 3 : 1;
         for (int j = 0; j < N; ++j) {
             float* o = radiance.At(px * N, py * N + j);
@@ -459,14 +465,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     if (cellRows.size() < size_t(cellsY)) cellRows.resize(size_t(cellsY));
     // Cell cx's list of row (not copied).
     const auto TakeList = [](const CellRow& row, int cx, PlumeScreenBins::List& list) {
-        list.count = row.count[size_t(cx)];
-        list.index.assign(row.index.begin() + row.start[size_t(cx)],
-                          row.index.begin() + row.start[size_t(cx) + 1]);
-        list.near_m = row.near_m[size_t(cx)];
-        list.far_m = row.far_m[size_t(cx)];
-        list.smallOpticalDepth = row.smallOpticalDepth[size_t(cx)];
-        list.halfSmallOpticalDepth = row.halfSmallOpticalDepth[size_t(cx)];
-        list.copied = false;
+        row.lists.Take(size_t(cx), list);
     };
     // The depths of cell row cy's samples in its cells with puffs, read once in the visibility
     // buffer's order (its rows streamed rather than 2 × 2 samples at a time) into kCell·N rows
@@ -479,7 +478,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
         const int rowSamples = kCell * N, sy0 = cy * rowSamples;
         runs.clear();
         for (int cx = 0; cx < cellsX; ++cx) {
-            if (row.count[size_t(cx)] == 0 || row.inFront[size_t(cx)]) continue;
+            if (row.lists.count[size_t(cx)] == 0 || row.inFront[size_t(cx)]) continue;
             const int sx0 = cx * rowSamples, sx1 = std::min(sx0 + rowSamples, vis.width);
             if (sx0 >= sx1) continue;
             if (!runs.empty() && runs.back().second == sx0)
@@ -616,18 +615,10 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     tbb::parallel_for(
         tbb::blocked_range<int>(0, cellsY, 1),
         [&](const tbb::blocked_range<int>& r) {
-            Scratch& local = LocalScratch();
-            std::span<PlumeScreenBins::List> cellLists(local.cellLists);
             for (int cy = r.begin(); cy != r.end(); ++cy) {
                 CellRow& row = cellRows[size_t(cy)];
-                row.index.clear();
-                row.start.assign(size_t(cellsX) + 1, 0);
-                row.count.assign(size_t(cellsX), 0);
-                row.near_m.assign(size_t(cellsX), 0.0f);
-                row.far_m.assign(size_t(cellsX), 0.0f);
-                row.smallOpticalDepth.assign(size_t(cellsX), 0.0f);
-                row.halfSmallOpticalDepth.assign(size_t(cellsX), 0.0f);
-                for (int cx = 0; cx < cellsX; ++cx) {
+                row.lists.Clear();
+                for (int cx = 0; cx < cellsX; cx += kTile / kCell) {
                     // The cells of one tile column take their puffs from the list of the tile's
                     // block (a cell reaches one pixel beyond itself), in one GatherRow: a puff
                     // outside the row's pixel rows is passed over at the first test. (Gathering
@@ -635,24 +626,13 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                     // its test with the strip's half diagonal could drop a puff that Gather per
                     // cell keeps: PlumeScreenBins.GatherRowEqualsGatherPerRectangle.)
                     constexpr int kCellsPerTile = kTile / kCell;
-                    static_assert(kTile % kCell == 0);
-                    if (cx % kCellsPerTile == 0)
-                        bins.GatherRow(blocks[size_t(cy / kCellsPerTile) * size_t(blocksX) +
-                                              size_t(cx / kCellsPerTile)],
-                                       cx * kCell, cy * kCell, cy * kCell + kCell + 1, kCell,
-                                       kCell + 1, std::min(kCellsPerTile, cellsX - cx),
-                                       float(kCell), cellLists);
-                    const PlumeScreenBins::List& list = cellLists[size_t(cx % kCellsPerTile)];
-                    row.start[size_t(cx)] = uint32_t(row.index.size());
-                    if (list.size() == 0) continue;
-                    row.index.insert(row.index.end(), list.index.begin(), list.index.end());
-                    row.count[size_t(cx)] = uint32_t(list.count);
-                    row.near_m[size_t(cx)] = list.near_m;
-                    row.far_m[size_t(cx)] = list.far_m;
-                    row.smallOpticalDepth[size_t(cx)] = list.smallOpticalDepth;
-                    row.halfSmallOpticalDepth[size_t(cx)] = list.halfSmallOpticalDepth;
+                    static_assert(kTile % kCell == 0 &&
+                                  kCellsPerTile <= PlumeScreenBins::kMaxRowCells);
+                    bins.GatherRow(blocks[size_t(cy / kCellsPerTile) * size_t(blocksX) +
+                                          size_t(cx / kCellsPerTile)],
+                                   cx * kCell, cy * kCell, cy * kCell + kCell + 1, kCell, kCell + 1,
+                                   std::min(kCellsPerTile, cellsX - cx), float(kCell), row.lists);
                 }
-                row.start[size_t(cellsX)] = uint32_t(row.index.size());
                 // The cells whose every surface lies in front of their puffs: their pixels
                 // are all skipped in pass 2 (minDepth ≥ depthInFront), so their corners are
                 // traced only if another cell uses them.
@@ -660,10 +640,11 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                 // lists stay: a node they are the near corner of is traced from theirs).
                 row.inFront.assign(size_t(cellsX), 0);
                 for (int cx = 0; cx < cellsX; ++cx)
-                    if (row.count[size_t(cx)] != 0)
+                    if (row.lists.count[size_t(cx)] != 0)
                         row.inFront[size_t(cx)] =
                             !CellInSpans(cx, cy) ||
-                            AllDepthsAtLeast(cx, cy, DepthInFront(cx, cy, row.near_m[size_t(cx)]));
+                            AllDepthsAtLeast(cx, cy,
+                                             DepthInFront(cx, cy, row.lists.near_m[size_t(cx)]));
             }
         },
         tbb::simple_partitioner());
@@ -675,7 +656,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     const auto Used = [&](int cx, int cy) {
         if (cx < 0 || cy < 0 || cx >= cellsX || cy >= cellsY) return false;
         const CellRow& row = cellRows[size_t(cy)];
-        return row.count[size_t(cx)] != 0 && !row.inFront[size_t(cx)];
+        return row.lists.count[size_t(cx)] != 0 && !row.inFront[size_t(cx)];
     };
     tbb::parallel_for(
         tbb::blocked_range<int>(0, nodesY, 1),
@@ -691,7 +672,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                     const size_t n = size_t(ny) * size_t(nodesX) + size_t(nx);
                     // No puff reaches the node's cell, so none reaches the node: a clear sky
                     // (the buffers are reused from frame to frame, so this is written).
-                    if (row.count[size_t(cx)] == 0) {
+                    if (row.lists.count[size_t(cx)] == 0) {
                         nodes[n] = BandTrace{};
                         nodeT[n] = 1.0f;
                         continue;
@@ -760,9 +741,9 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
         uint64_t cost = 0;
         bool puffs = false;
         for (int cx = 0; cx < cellsX; ++cx) {
-            puffs |= row.count[size_t(cx)] != 0;
-            if (row.count[size_t(cx)] != 0 && !row.inFront[size_t(cx)])
-                cost += row.count[size_t(cx)] + kCell * kCell;
+            puffs |= row.lists.count[size_t(cx)] != 0;
+            if (row.lists.count[size_t(cx)] != 0 && !row.inFront[size_t(cx)])
+                cost += row.lists.count[size_t(cx)] + kCell * kCell;
         }
         if (puffs) rowOrder.emplace_back(cost, cy);
     }
@@ -806,7 +787,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                     return rest && _mm_movemask_ps(sky) == 0xf;
                 };
                 for (int cx = 0; cx < cellsX; ++cx) {
-                    if (row.count[size_t(cx)] == 0) continue;
+                    if (row.lists.count[size_t(cx)] == 0) continue;
                     // Every pixel of the cell is skipped by the test minDepth ≥ depthInFront.
                     if (row.inFront[size_t(cx)]) {
                         covered += uint64_t(std::min(W, (cx + 1) * kCell) - cx * kCell) *

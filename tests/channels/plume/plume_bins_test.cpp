@@ -196,17 +196,23 @@ TEST(PlumeScreenBins, GatherRowEqualsGatherPerRectangle) {
             for (uint32_t k = 0; k < bands[b].KeptPuffs(); ++k) all[b].index.push_back(k);
             all[b].count = all[b].index.size();
         }
-        std::vector<PlumeScreenBins::List> row(12);
+        PlumeScreenBins::ListRow row;
+        PlumeScreenBins::List l;
         size_t nonEmpty = 0, compared = 0;
-        // GatherRow of bins for the strip at x0 against Gather per rectangle.
+        // GatherRow of bins for the strip at x0 against Gather per rectangle; the row's lists
+        // appended to those of the strip before it (as CompositePlumes makes a row of cells
+        // from its tiles' strips).
         const auto check = [&](int b, int x0, int y0, int step, int width, int cells) {
             const PlumeScreenBins& bins = bands[b];
+            if (x0 == 0) row.Clear();
+            const size_t before = row.size();
             bins.Gather(x0, y0, x0 + (cells - 1) * step + width, y0 + 5, 4.0f, false, strip);
             bins.GatherRow(wide ? strip : all[b], x0, y0, y0 + 5, step, width, cells, 4.0f, row);
+            ASSERT_EQ(row.size(), before + size_t(cells));
             for (int c = 0; c < cells; ++c) {
                 const int x = x0 + c * step;
                 bins.Gather(x, y0, x + width, y0 + 5, 4.0f, false, single);
-                const PlumeScreenBins::List& l = row[size_t(c)];
+                row.Take(before + size_t(c), l);
                 ASSERT_EQ(l.count, single.count) << x << ", " << y0 << " band " << b;
                 EXPECT_EQ(l.index, single.index);
                 EXPECT_EQ(std::memcmp(&l.near_m, &single.near_m, 4), 0);
@@ -218,11 +224,13 @@ TEST(PlumeScreenBins, GatherRowEqualsGatherPerRectangle) {
                 ++compared;
             }
         };
-        for (const auto [step, width, cells] : {std::array{4, 5, 8}, {3, 7, 11}, {5, 2, 7}}) {
+        for (const auto [step, width, cells] :
+             {std::array{4, 5, 8}, {3, 7, 11}, {5, 2, 7}, {1, 2, PlumeScreenBins::kMaxRowCells}}) {
             const int stripWidth = (cells - 1) * step + width;
             for (int y0 = 0; y0 < cam.height + PlumeScreenBins::kMargin; y0 += 4)
-                for (int x0 = 0; x0 < cam.width + PlumeScreenBins::kMargin; x0 += stripWidth)
-                    for (int b = 0; b < 2; ++b) check(b, x0, y0, step, width, cells);
+                for (int b = 0; b < 2; ++b)
+                    for (int x0 = 0; x0 < cam.width + PlumeScreenBins::kMargin; x0 += stripWidth)
+                        check(b, x0, y0, step, width, cells);
         }
         EXPECT_GT(nonEmpty, 300u);
         EXPECT_GT(nonEmpty * 10, compared);  // the plumes fill a good part of the view
