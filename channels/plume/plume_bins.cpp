@@ -470,37 +470,43 @@ void PlumeScreenBins::ListRow::Take(size_t c, List& out) const {
     out.copied = false;
 }
 
-void PlumeScreenBins::GatherRow(const List& from, int x0, int y0, int y1, int step, int width,
-                                int cells, float smallPixels, ListRow& out) const {
-    CHECK(step > 0 && width > 0 && cells >= 0 && cells <= kMaxRowCells);
-    using simd::kLanes;
-    using simd::VF;
-    using simd::VI;
-    // The rectangles' ranges, sums and counts, kLanes rectangles a vector, as Begin starts them.
-    constexpr size_t kVectors = (kMaxRowCells + kLanes - 1) / kLanes;
-    VF nearV[kVectors], farV[kVectors], smallV[kVectors], halfSmallV[kVectors];
-    VI countV[kVectors];
-    for (size_t v = 0; v < kVectors; ++v) {
-        nearV[v] = simd::Splat(std::numeric_limits<float>::infinity());
-        farV[v] = smallV[v] = halfSmallV[v] = simd::Splat(0.0f);
-        countV[v] = VI{};
-    }
-    // Lane l of vector v is rectangle v·kLanes + l: its bit in a puff's mask, shifted down by
-    // v·kLanes.
-    VI laneBit;
-    for (size_t l = 0; l < kLanes; ++l) laneBit[l] = int32_t(1u << l);
-    std::vector<std::pair<uint32_t, uint32_t>>& reached = out.reached;
+void PlumeScreenBins::MergeBlocks(std::span<const List> blocks, RowSource& out) const {
+    CHECK(blocks.size() <= 64);
+    out.mark.assign(kept_.size(), 0);
+    for (size_t b = 0; b < blocks.size(); ++b)
+        for (size_t j = 0; j < blocks[b].count; ++j)
+            out.mark[blocks[b].index[j]] |= uint64_t(1) << b;
+    out.index.clear(), out.blocks.clear();
+    for (size_t k = 0; k < out.mark.size(); ++k)
+        if (out.mark[k] != 0) out.index.push_back(uint32_t(k)), out.blocks.push_back(out.mark[k]);
+}
+
+void PlumeScreenBins::OneBlock(const List& list, RowSource& out) {
+    out.index.assign(list.index.begin(), list.index.begin() + ptrdiff_t(list.count));
+    out.blocks.assign(list.count, 1);
+}
+
+void PlumeScreenBins::GatherRow(const RowSource& from, int x0, int y0, int y1, int step, int width,
+                                int cellsPerBlock, int cells, float smallPixels,
+                                ListRow& out) const {
+    CHECK(step > 0 && width > 0 && cells >= 0);
+    CHECK(cellsPerBlock > 0 && cellsPerBlock <= kMaxRowCells);
+    const int blockCount = (cells + cellsPerBlock - 1) / cellsPerBlock;
+    CHECK(blockCount <= 64);
+    std::vector<ListRow::Reach>& reached = out.reached;
     reached.clear();
     y1 = std::min(y1, height_);
-    // Rectangle c clipped to the bin area as Gather clips it; empty ones get no puffs.
+    // The last rectangle of full width (width_ − width − x0 may be negative: none), and the
+    // first of those clipped at the bin area's edge (each tested on its own, with its own ρ;
+    // rectangles wholly beyond the edge are empty).
+    const int lastFull =
+        width_ - width - x0 >= 0 ? std::min((width_ - width - x0) / step, cells - 1) : -1;
+    const int edge0 = lastFull + 1;
     const auto Right = [&](int c) { return std::min(x0 + c * step + width, width_); };
     if (y0 < y1 && cells > 0) {
         const float rho = HalfDiagonal(width, y1 - y0);
         const float centreY = 0.5f * float(y0 + y1);
-        // The last rectangle of full width (width_ − width − x0 may be negative: none).
-        const int lastFull =
-            width_ - width - x0 >= 0 ? std::min((width_ - width - x0) / step, cells - 1) : -1;
-        for (size_t j = 0; j < from.count; ++j) {
+        for (size_t j = 0; j < from.index.size(); ++j) {
             const uint32_t k = from.index[j];
             const Footprint& fp = footprint_[k];
             const Rect& r = fp.rect;
@@ -541,23 +547,63 @@ void PlumeScreenBins::GatherRow(const List& from, int x0, int y0, int y1, int st
             }
             // The full-width rectangles (up to lastFull) that the puff reaches take it
             // without further tests.
-            uint32_t mask = 0;
-            const int first = std::max({overlapLo, spanFirst, 0});
-            const int last = std::min({overlapHi, spanLast, lastFull});
-            // Bits first … last (last ≤ 31: the shift is of a 64-bit one).
-            if (first <= last) mask = uint32_t((uint64_t(2) << last) - (uint64_t(1) << first));
+            ListRow::Reach reach{k, std::max({overlapLo, spanFirst, 0}),
+                                 std::min({overlapHi, spanLast, lastFull}), 0, from.blocks[j]};
             // Rectangles clipped at the bin area's edge: each with its own ρ.
-            for (int c = std::max({overlapLo, lastFull + 1, 0});
-                 c <= std::min(overlapHi, cells - 1); ++c) {
+            for (int c = std::max(overlapLo, edge0); c <= std::min(overlapHi, cells - 1); ++c) {
                 const int cx0 = x0 + c * step, cx1 = Right(c);
-                if (cx0 >= cx1) continue;
-                if (Reaches(k, cx0, y0, cx1, y1, HalfDiagonal(cx1 - cx0, y1 - y0))) mask |= 1u << c;
+                if (cx0 >= cx1) break;
+                CHECK(c - edge0 < 64);
+                if (Reaches(k, cx0, y0, cx1, y1, HalfDiagonal(cx1 - cx0, y1 - y0)))
+                    reach.edge |= uint64_t(1) << (c - edge0);
+            }
+            if (reach.first <= reach.last || reach.edge != 0) reached.push_back(reach);
+        }
+    }
+    using simd::kLanes;
+    using simd::VF;
+    using simd::VI;
+    // Lane l of vector v is rectangle v·kLanes + l of a block: its bit in a puff's mask,
+    // shifted down by v·kLanes.
+    VI laneBit;
+    for (size_t l = 0; l < kLanes; ++l) laneBit[l] = int32_t(1u << l);
+    constexpr size_t kVectors = (kMaxRowCells + kLanes - 1) / kLanes;
+    std::vector<std::pair<uint32_t, uint32_t>>& block = out.block;
+    for (int b = 0; b < blockCount; ++b) {
+        const int cb0 = b * cellsPerBlock, n = std::min(cellsPerBlock, cells - cb0);
+        // The block's rectangles' ranges, sums and counts, kLanes rectangles a vector, as Begin
+        // starts them.
+        VF nearV[kVectors], farV[kVectors], smallV[kVectors], halfSmallV[kVectors];
+        VI countV[kVectors];
+        for (size_t v = 0; v < kVectors; ++v) {
+            nearV[v] = simd::Splat(std::numeric_limits<float>::infinity());
+            farV[v] = smallV[v] = halfSmallV[v] = simd::Splat(0.0f);
+            countV[v] = VI{};
+        }
+        block.clear();
+        const uint32_t all = uint32_t((uint64_t(1) << n) - 1);
+        for (const ListRow::Reach& reach : reached) {
+            if (!((reach.blocks >> b) & 1u)) continue;
+            // The block's rectangles among the puff's: bits first − cb0 … last − cb0, and its
+            // edge rectangles.
+            const int first = std::max(reach.first, cb0), last = std::min(reach.last, cb0 + n - 1);
+            uint32_t mask =
+                first <= last
+                    ? uint32_t((uint64_t(2) << (last - cb0)) - (uint64_t(1) << (first - cb0)))
+                    : 0u;
+            if (reach.edge != 0) {
+                const int shift = edge0 - cb0;
+                const uint64_t edge = shift >= 0    ? (shift < 64 ? reach.edge << shift : 0)
+                                      : shift > -64 ? reach.edge >> -shift
+                                                    : 0;
+                mask |= uint32_t(edge) & all;
             }
             if (mask == 0) continue;
-            reached.emplace_back(k, mask);
+            block.emplace_back(reach.k, mask);
             // The puff's ranges and sums into the rectangles it reaches, in from's order as Add
             // puts them in one list: std::min and std::max are simd::Min and Max lane for lane,
             // and a rectangle the puff does not reach keeps its values.
+            const Footprint& fp = footprint_[reach.k];
             const VF nearK = simd::Splat(fp.near_m), farK = simd::Splat(fp.far_m);
             const bool small = fp.sigmaPixels < smallPixels;
             const bool halfSmall = fp.sigmaPixels < 0.5f * smallPixels;
@@ -573,41 +619,41 @@ void PlumeScreenBins::GatherRow(const List& from, int x0, int y0, int y1, int st
                 if (halfSmall) halfSmallV[v] = simd::Select(in, halfSmallV[v] + tau, halfSmallV[v]);
             }
         }
-    }
-    // The lists, one after the other, each padded to a multiple of 4 with the inert puff.
-    alignas(32) float nearA[kVectors * kLanes], farA[kVectors * kLanes];
-    alignas(32) float smallA[kVectors * kLanes], halfSmallA[kVectors * kLanes];
-    alignas(32) int32_t countA[kVectors * kLanes];
-    for (size_t v = 0; v < kVectors; ++v) {
-        simd::Store(nearA + v * kLanes, nearV[v]);
-        simd::Store(farA + v * kLanes, farV[v]);
-        simd::Store(smallA + v * kLanes, smallV[v]);
-        simd::Store(halfSmallA + v * kLanes, halfSmallV[v]);
-        std::memcpy(countA + v * kLanes, &countV[v], sizeof(VI));
-    }
-    size_t end = out.index.size();
-    for (int c = 0; c < cells; ++c) end += (size_t(countA[c]) + 3) & ~size_t(3);
-    // One slot more: the loop below writes each puff before it knows whether it keeps it.
-    out.index.resize(end + 1);
-    uint32_t* dst = out.index.data() + out.start.back();
-    for (int c = 0; c < cells; ++c) {
-        size_t n = 0;
-        for (const auto& [k, mask] : reached) {
-            dst[n] = k;
-            n += (mask >> c) & 1u;
+        // The block's lists, one after the other, each padded to a multiple of 4 with the
+        // inert puff.
+        alignas(32) float nearA[kVectors * kLanes], farA[kVectors * kLanes];
+        alignas(32) float smallA[kVectors * kLanes], halfSmallA[kVectors * kLanes];
+        alignas(32) int32_t countA[kVectors * kLanes];
+        for (size_t v = 0; v < kVectors; ++v) {
+            simd::Store(nearA + v * kLanes, nearV[v]);
+            simd::Store(farA + v * kLanes, farV[v]);
+            simd::Store(smallA + v * kLanes, smallV[v]);
+            simd::Store(halfSmallA + v * kLanes, halfSmallV[v]);
+            std::memcpy(countA + v * kLanes, &countV[v], sizeof(VI));
         }
-        CHECK(n == size_t(countA[c]));
-        const size_t padded = (n + 3) & ~size_t(3);
-        std::fill(dst + n, dst + padded, inert_);
-        dst += padded;
-        out.start.push_back(uint32_t(dst - out.index.data()));
-        out.count.push_back(uint32_t(n));
-        out.near_m.push_back(nearA[c]);
-        out.far_m.push_back(farA[c]);
-        out.smallOpticalDepth.push_back(smallA[c]);
-        out.halfSmallOpticalDepth.push_back(halfSmallA[c]);
+        size_t end = out.index.size();
+        for (int c = 0; c < n; ++c) end += (size_t(countA[c]) + 3) & ~size_t(3);
+        // One slot more: the loop below writes each puff before it knows whether it keeps it.
+        out.index.resize(end + 1);
+        uint32_t* dst = out.index.data() + out.start.back();
+        for (int c = 0; c < n; ++c) {
+            size_t m = 0;
+            for (const auto& [k, mask] : block) {
+                dst[m] = k;
+                m += (mask >> c) & 1u;
+            }
+            const size_t padded = (m + 3) & ~size_t(3);
+            std::fill(dst + m, dst + padded, inert_);
+            dst += padded;
+            out.start.push_back(uint32_t(dst - out.index.data()));
+            out.count.push_back(uint32_t(m));
+            out.near_m.push_back(nearA[c]);
+            out.far_m.push_back(farA[c]);
+            out.smallOpticalDepth.push_back(smallA[c]);
+            out.halfSmallOpticalDepth.push_back(halfSmallA[c]);
+        }
+        out.index.resize(end);
     }
-    out.index.resize(end);
 }
 
 void PlumeScreenBins::Copy(List& list) const {

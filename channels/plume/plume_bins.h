@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -96,23 +97,44 @@ class PlumeScreenBins {
     struct ListRow {
         std::vector<uint32_t> index, start{0}, count;
         std::vector<float> near_m, far_m, smallOpticalDepth, halfSmallOpticalDepth;
-        // GatherRow's scratch: per puff reaching the row, its kept position and the mask of the
-        // rectangles it reaches.
-        std::vector<std::pair<uint32_t, uint32_t>> reached;
         size_t size() const { return count.size(); }
         void Clear();
         // List c as Gather makes it (not copied).
         void Take(size_t c, List& out) const;
+
+      private:
+        friend class PlumeScreenBins;
+        // GatherRow's scratch: the puffs reaching the row (their rectangles: an interval of
+        // full-width ones and a mask of those clipped at the bin area's edge), and those of
+        // one block with the mask of its rectangles they reach.
+        struct Reach {
+            uint32_t k;
+            int first, last;
+            uint64_t edge, blocks;
+        };
+        std::vector<Reach> reached;
+        std::vector<std::pair<uint32_t, uint32_t>> block;
     };
-    static constexpr int kMaxRowCells = 32;
-    // Gather(from, …) for a row of cells ≤ kMaxRowCells rectangles [x0 + c·step, x0 + c·step +
-    // width) × [y0, y1), c = 0 … cells − 1, appended to out as its next `cells` lists: the same
-    // lists bit for bit, with one pass over from's puffs (each puff visits only the rectangles
-    // its own rectangle can reach) instead of one pass per rectangle, each puff's ranges and
-    // sums added to the rectangles it reaches on SIMD lanes (one rectangle a lane), and the
-    // lists written once, without growing them puff by puff.
-    void GatherRow(const List& from, int x0, int y0, int y1, int step, int width, int cells,
-                   float smallPixels, ListRow& out) const;
+    // The puffs of a row of up to 64 blocks' lists (each in kept order): each puff once, in
+    // kept order, with the blocks whose lists hold it (bit b for block b).
+    struct RowSource {
+        std::vector<uint32_t> index;
+        std::vector<uint64_t> blocks;
+        std::vector<uint64_t> mark;  // MergeBlocks' scratch, per kept puff
+    };
+    void MergeBlocks(std::span<const List> blocks, RowSource& out) const;
+    // All the puffs of a list in one block.
+    static void OneBlock(const List& list, RowSource& out);
+    static constexpr int kMaxRowCells = 32;  // cells of one block
+    // For a row of `cells` rectangles [x0 + c·step, x0 + c·step + width) × [y0, y1),
+    // c = 0 … cells − 1, in blocks of cellsPerBlock ≤ kMaxRowCells: Gather(list of block
+    // c / cellsPerBlock, rectangle c, …) appended to out as its next `cells` lists (the same
+    // lists bit for bit). One pass over from's puffs finds the rectangles each reaches (its
+    // ellipse's span once for the row, not once per block), then per block its ranges and
+    // sums are added to the rectangles it reaches on SIMD lanes, one rectangle a lane, and
+    // the lists are written once, without growing them puff by puff.
+    void GatherRow(const RowSource& from, int x0, int y0, int y1, int step, int width,
+                   int cellsPerBlock, int cells, float smallPixels, ListRow& out) const;
     // Copies a gathered list's data (no-op when copied already).
     void Copy(List& list) const;
     // Tile of pixel (px, py).

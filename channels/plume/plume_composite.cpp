@@ -244,6 +244,7 @@ struct FrameBuffers {
     std::vector<BandTrace> nodes;
     std::vector<float> nodeT;
     std::vector<PlumeScreenBins::List> blocks;
+    std::vector<PlumeScreenBins::RowSource> bandSources;
     bool busy = false;
 };
 
@@ -578,21 +579,37 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     // bottom edges that its last cells reach, gathered from the tiles once. Every row of cells
     // of pass 1 lies inside its tiles' blocks, so it takes its puffs from the blocks' lists (the
     // same lists bit for bit as from the tiles) instead of merging two to four tiles' lists
-    // again for each of the tile's kTile / kCell rows of cells.
+    // again for each of the tile's kTile / kCell rows of cells. The lists of each row of blocks
+    // (in segments of 64 blocks) are merged into one, each puff with the blocks that hold it,
+    // so that pass 1 finds a puff's span in a row of cells once, not once per block.
     constexpr int kTile = PlumeScreenBins::kTile;
+    constexpr int kCellsPerTile = kTile / kCell;
+    static_assert(kTile % kCell == 0 && kCellsPerTile <= PlumeScreenBins::kMaxRowCells);
+    constexpr int kSegmentBlocks = 64;
     const int blocksX = (cellsX * kCell + kTile - 1) / kTile;
     const int blocksY = (cellsY * kCell + kTile - 1) / kTile;
+    const int segments = (blocksX + kSegmentBlocks - 1) / kSegmentBlocks;
     std::vector<PlumeScreenBins::List>& blocks = lease.buffers->blocks;
     if (blocks.size() < size_t(blocksX) * size_t(blocksY))
         blocks.resize(size_t(blocksX) * size_t(blocksY));
+    std::vector<PlumeScreenBins::RowSource>& bandSources = lease.buffers->bandSources;
+    if (bandSources.size() < size_t(segments) * size_t(blocksY))
+        bandSources.resize(size_t(segments) * size_t(blocksY));
     tbb::parallel_for(
         tbb::blocked_range<int>(0, blocksY, 1),
         [&](const tbb::blocked_range<int>& r) {
-            for (int by = r.begin(); by != r.end(); ++by)
+            for (int by = r.begin(); by != r.end(); ++by) {
+                const size_t row = size_t(by) * size_t(blocksX);
                 for (int bx = 0; bx < blocksX; ++bx)
                     bins.Gather(bx * kTile, by * kTile, (bx + 1) * kTile + 1, (by + 1) * kTile + 1,
-                                float(kCell), false,
-                                blocks[size_t(by) * size_t(blocksX) + size_t(bx)]);
+                                float(kCell), false, blocks[row + size_t(bx)]);
+                for (int s = 0; s < segments; ++s) {
+                    const int b0 = s * kSegmentBlocks, b1 = std::min(b0 + kSegmentBlocks, blocksX);
+                    bins.MergeBlocks(std::span<const PlumeScreenBins::List>(
+                                         blocks.data() + row + size_t(b0), size_t(b1 - b0)),
+                                     bandSources[size_t(by) * size_t(segments) + size_t(s)]);
+                }
+            }
         },
         tbb::simple_partitioner());
 
@@ -618,20 +635,20 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             for (int cy = r.begin(); cy != r.end(); ++cy) {
                 CellRow& row = cellRows[size_t(cy)];
                 row.lists.Clear();
-                for (int cx = 0; cx < cellsX; cx += kTile / kCell) {
+                for (int s = 0; s < segments; ++s) {
                     // The cells of one tile column take their puffs from the list of the tile's
-                    // block (a cell reaches one pixel beyond itself), in one GatherRow: a puff
-                    // outside the row's pixel rows is passed over at the first test. (Gathering
-                    // the row's strip of the block first tested every puff's ellipse twice, and
-                    // its test with the strip's half diagonal could drop a puff that Gather per
-                    // cell keeps: PlumeScreenBins.GatherRowEqualsGatherPerRectangle.)
-                    constexpr int kCellsPerTile = kTile / kCell;
-                    static_assert(kTile % kCell == 0 &&
-                                  kCellsPerTile <= PlumeScreenBins::kMaxRowCells);
-                    bins.GatherRow(blocks[size_t(cy / kCellsPerTile) * size_t(blocksX) +
-                                          size_t(cx / kCellsPerTile)],
-                                   cx * kCell, cy * kCell, cy * kCell + kCell + 1, kCell, kCell + 1,
-                                   std::min(kCellsPerTile, cellsX - cx), float(kCell), row.lists);
+                    // block (a cell reaches one pixel beyond itself), all the row's in one
+                    // GatherRow: a puff outside the row's pixel rows is passed over at the first
+                    // test. (Gathering the row's strip of the block first tested every puff's
+                    // ellipse twice, and its test with the strip's half diagonal could drop a
+                    // puff that Gather per cell keeps:
+                    // PlumeScreenBins.GatherRowEqualsGatherPerRectangle.)
+                    const int cx0 = s * kSegmentBlocks * kCellsPerTile;
+                    bins.GatherRow(
+                        bandSources[size_t(cy / kCellsPerTile) * size_t(segments) + size_t(s)],
+                        cx0 * kCell, cy * kCell, cy * kCell + kCell + 1, kCell, kCell + 1,
+                        kCellsPerTile, std::min(kSegmentBlocks * kCellsPerTile, cellsX - cx0),
+                        float(kCell), row.lists);
                 }
                 // The cells whose every surface lies in front of their puffs: their pixels
                 // are all skipped in pass 2 (minDepth ≥ depthInFront), so their corners are
