@@ -957,19 +957,19 @@ __attribute__((target("avx2"))) void PlumeScreenBins::TraceWide(const List& l, c
     size_t k = 0;
     for (; k + 8 <= l.index.size(); k += 8) {
         if constexpr (Copied) {
-            eight([&](int f) __attribute__((target("avx2"))) {
+            eight([&](int f) __attribute__((target("avx2"), always_inline)) {
                 return Load8<true>(l.data[f], puffData_.data() + f, l.index.data(), k);
             });
         } else {
             F8 fields[kPuffRecord];
             TransposeRecords8(puffData_.data(), l.index.data() + k, fields);
-            eight([&](int f) __attribute__((target("avx2"))) { return fields[f]; });
+            eight([&](int f) __attribute__((target("avx2"), always_inline)) { return fields[f]; });
         }
     }
     // A last group of four (lists hold a multiple of four): in the low lanes, the inert puff
     // in the high ones (unused, so they add zeros to the odd groups' sums).
     if (k < l.index.size())
-        eight([&](int f) __attribute__((target("avx2"))) {
+        eight([&](int f) __attribute__((target("avx2"), always_inline)) {
             return _mm256_insertf128_ps(_mm256_castps128_ps256(Load4<Copied>(
                                             l.data[f], puffData_.data() + f, l.index.data(), k)),
                                         _mm_set1_ps(puffData_[inert_ * kStride + size_t(f)]), 1);
