@@ -3,8 +3,9 @@
 // thick flame puff and for a view of part of the plumes (whose puffs out of view no longer
 // share the tolerance), lists holding every puff whose cutoff ellipsoid their rays meet (and
 // little more), lists taken from larger lists (one rectangle or a row of them) equal to
-// lists from the tiles, eight-lane traces equal to four-lane ones, and the dropping of puffs
-// too thin to matter.
+// lists from the tiles, a row's lists taken from its blocks' merged lists equal to those
+// taken from each cell's block, eight-lane traces equal to four-lane ones, and the dropping
+// of puffs too thin to matter.
 #include "channels/plume/plume_bins.h"
 
 #include <gtest/gtest.h>
