@@ -6,12 +6,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <iterator>
 #include <limits>
 #include <numbers>
 
 #include "scene/core/check.h"
 #include "scene/core/simd4.h"
+#include "scene/core/simd_lanes.h"
 
 namespace seasense::channels {
 
@@ -351,6 +353,9 @@ float HalfDiagonal(int w, int h) {
     return float(0.5 * std::sqrt(double(w) * double(w) + double(h) * double(h)) + 1e-3);
 }
 
+// ⌊a / b⌋ for b > 0.
+int FloorDiv(int a, int b) { return a >= 0 ? a / b : -((b - 1 - a) / b); }
+
 }  // namespace
 
 inline bool PlumeScreenBins::Reaches(uint32_t k, int x0, int y0, int x1, int y1, float rho) const {
@@ -364,22 +369,13 @@ inline bool PlumeScreenBins::Reaches(uint32_t k, int x0, int y0, int x1, int y1,
     return cx >= lo && cx <= hi;
 }
 
-inline void PlumeScreenBins::AddRange(uint32_t k, float smallPixels, std::span<List> out) const {
-    // The puff's small-puff tests made once for all the lists.
-    const Footprint& fp = footprint_[k];
-    const bool small = fp.sigmaPixels < smallPixels,
-               halfSmall = fp.sigmaPixels < 0.5f * smallPixels;
-    for (List& o : out) {
-        o.index.push_back(k);
-        o.near_m = std::min(o.near_m, fp.near_m);
-        o.far_m = std::max(o.far_m, fp.far_m);
-        if (small) o.smallOpticalDepth += fp.tauMax;
-        if (halfSmall) o.halfSmallOpticalDepth += fp.tauMax;
-    }
-}
-
 inline void PlumeScreenBins::Add(uint32_t k, float smallPixels, List& out) const {
-    AddRange(k, smallPixels, std::span<List>(&out, 1));
+    const Footprint& fp = footprint_[k];
+    out.index.push_back(k);
+    out.near_m = std::min(out.near_m, fp.near_m);
+    out.far_m = std::max(out.far_m, fp.far_m);
+    if (fp.sigmaPixels < smallPixels) out.smallOpticalDepth += fp.tauMax;
+    if (fp.sigmaPixels < 0.5f * smallPixels) out.halfSmallOpticalDepth += fp.tauMax;
 }
 
 inline void PlumeScreenBins::Take(uint32_t k, int x0, int y0, int x1, int y1, float rho,
@@ -455,23 +451,62 @@ void PlumeScreenBins::Gather(const List& from, int x0, int y0, int x1, int y1, f
     Finish(copy, out);
 }
 
-void PlumeScreenBins::GatherRow(const List& from, int x0, int y0, int y1, int step, int width,
-                                int cells, float smallPixels, std::span<List> out) const {
-    CHECK(step > 0 && width > 0 && cells >= 0 && out.size() >= size_t(cells));
-    for (int c = 0; c < cells; ++c) {
-        CHECK(&from != &out[size_t(c)]);
-        Begin(out[size_t(c)]);
-    }
+void PlumeScreenBins::ListRow::Clear() {
+    index.clear();
+    start.assign(1, 0);
+    count.clear();
+    near_m.clear(), far_m.clear();
+    smallOpticalDepth.clear(), halfSmallOpticalDepth.clear();
+}
+
+void PlumeScreenBins::ListRow::Take(size_t c, List& out) const {
+    CHECK(c < count.size());
+    out.count = count[c];
+    out.index.assign(index.begin() + start[c], index.begin() + start[c + 1]);
+    out.near_m = near_m[c];
+    out.far_m = far_m[c];
+    out.smallOpticalDepth = smallOpticalDepth[c];
+    out.halfSmallOpticalDepth = halfSmallOpticalDepth[c];
+    out.copied = false;
+}
+
+void PlumeScreenBins::MergeBlocks(std::span<const List> blocks, RowSource& out) const {
+    CHECK(blocks.size() <= 64);
+    out.mark.assign(kept_.size(), 0);
+    for (size_t b = 0; b < blocks.size(); ++b)
+        for (size_t j = 0; j < blocks[b].count; ++j)
+            out.mark[blocks[b].index[j]] |= uint64_t(1) << b;
+    out.index.clear(), out.blocks.clear();
+    for (size_t k = 0; k < out.mark.size(); ++k)
+        if (out.mark[k] != 0) out.index.push_back(uint32_t(k)), out.blocks.push_back(out.mark[k]);
+}
+
+void PlumeScreenBins::OneBlock(const List& list, RowSource& out) {
+    out.index.assign(list.index.begin(), list.index.begin() + ptrdiff_t(list.count));
+    out.blocks.assign(list.count, 1);
+}
+
+void PlumeScreenBins::GatherRow(const RowSource& from, int x0, int y0, int y1, int step, int width,
+                                int cellsPerBlock, int cells, float smallPixels,
+                                ListRow& out) const {
+    CHECK(step > 0 && width > 0 && cells >= 0);
+    CHECK(cellsPerBlock > 0 && cellsPerBlock <= kMaxRowCells);
+    const int blockCount = (cells + cellsPerBlock - 1) / cellsPerBlock;
+    CHECK(blockCount <= 64);
+    std::vector<ListRow::Reach>& reached = out.reached;
+    reached.clear();
     y1 = std::min(y1, height_);
-    // Rectangle c clipped to the bin area as Gather clips it; empty ones get no puffs.
+    // The last rectangle of full width (width_ − width − x0 may be negative: none), and the
+    // first of those clipped at the bin area's edge (each tested on its own, with its own ρ;
+    // rectangles wholly beyond the edge are empty).
+    const int lastFull =
+        width_ - width - x0 >= 0 ? std::min((width_ - width - x0) / step, cells - 1) : -1;
+    const int edge0 = lastFull + 1;
     const auto Right = [&](int c) { return std::min(x0 + c * step + width, width_); };
     if (y0 < y1 && cells > 0) {
         const float rho = HalfDiagonal(width, y1 - y0);
         const float centreY = 0.5f * float(y0 + y1);
-        // The last rectangle of full width (width_ − width − x0 may be negative: none).
-        const int lastFull =
-            width_ - width - x0 >= 0 ? std::min((width_ - width - x0) / step, cells - 1) : -1;
-        for (size_t j = 0; j < from.count; ++j) {
+        for (size_t j = 0; j < from.index.size(); ++j) {
             const uint32_t k = from.index[j];
             const Footprint& fp = footprint_[k];
             const Rect& r = fp.rect;
@@ -481,50 +516,144 @@ void PlumeScreenBins::GatherRow(const List& from, int x0, int y0, int y1, int st
             double spanHi = std::numeric_limits<double>::infinity();
             if (fp.sqrtLambdaMax != 0.0f && !EllipseSpan(fp, centreY, rho, spanLo, spanHi))
                 continue;
-            // The rectangles c with x0 + c·step < r.x1 and x0 + c·step + width > r.x0, widened
-            // by one on each side (the tests below decide exactly).
-            const int lo = std::max((r.x0 - x0 - width) / step - 1, 0);
-            const int hi = std::min((r.x1 - x0) / step + 1, cells - 1);
-            // The full-width rectangles among them (those before lastFull) that the puff
-            // reaches: rectangle overlap and ellipse span are each an interval of c (the centres
-            // increase with c), so they are too. Its ends are found from an estimate by the
-            // exact tests, and the rectangles between them take the puff without tests.
-            const auto Reached = [&](int c) {
-                const int cx0 = x0 + c * step, cx1 = cx0 + width;
-                if (r.x1 <= cx0 || r.x0 >= cx1) return false;
-                const double cx = 0.5 * double(cx0 + cx1);
-                return cx >= spanLo && cx <= spanHi;
+            // The rectangles c that the puff's rectangle overlaps, x0 + c·step < r.x1 and
+            // x0 + c·step + width > r.x0: an interval of c, in integers.
+            const int overlapLo = FloorDiv(r.x0 - x0 - width, step) + 1;
+            const int overlapHi = FloorDiv(r.x1 - x0 - 1, step);
+            // Those whose centres lie in the ellipse's span, as Reaches tests them: an interval
+            // of c too (the centres increase with c), its ends estimated in double precision
+            // (within far less than one step of the exact quotients, clamped to the row) and
+            // then moved by one where the exact test of the centre says so.
+            const auto Centre = [&](int c) {
+                const int cx0 = x0 + c * step;
+                return 0.5 * double(cx0 + (cx0 + width));
             };
-            const int fullHi = std::min(hi, lastFull);
-            if (lo <= fullHi) {
-                // Estimates of the interval's ends from the four bounds (centre x0 + c·step +
-                // width / 2), clamped to the candidates; the walks then find them exactly.
-                const double centre0 = double(x0) + 0.5 * width;
-                const double firstEstimate =
-                    std::max(std::floor(double(r.x0 - x0 - width) / step) + 1.0,
-                             std::ceil((spanLo - centre0) / step));
-                const double lastEstimate = std::min(std::ceil(double(r.x1 - x0) / step) - 1.0,
-                                                     std::floor((spanHi - centre0) / step));
-                int first = int(std::clamp(firstEstimate, double(lo), double(fullHi)));
-                while (first > lo && Reached(first - 1)) --first;
-                while (first <= fullHi && !Reached(first)) ++first;
-                if (first <= fullHi) {
-                    int last = int(std::clamp(lastEstimate, double(first), double(fullHi)));
-                    while (last > first && !Reached(last)) --last;
-                    while (last < fullHi && Reached(last + 1)) ++last;
-                    AddRange(k, smallPixels, out.subspan(size_t(first), size_t(last - first + 1)));
-                }
+            const double centre0 = Centre(0);
+            int spanFirst = std::numeric_limits<int>::min() / 2;
+            int spanLast = std::numeric_limits<int>::max() / 2;
+            if (fp.sqrtLambdaMax != 0.0f) {
+                spanFirst =
+                    int(std::clamp(std::ceil((spanLo - centre0) / step), -2.0, double(cells)));
+                if (Centre(spanFirst - 1) >= spanLo)
+                    --spanFirst;
+                else if (Centre(spanFirst) < spanLo)
+                    ++spanFirst;
+                spanLast =
+                    int(std::clamp(std::floor((spanHi - centre0) / step), -2.0, double(cells)));
+                if (Centre(spanLast + 1) <= spanHi)
+                    ++spanLast;
+                else if (Centre(spanLast) > spanHi)
+                    --spanLast;
             }
+            // The full-width rectangles (up to lastFull) that the puff reaches take it
+            // without further tests.
+            ListRow::Reach reach{k, std::max({overlapLo, spanFirst, 0}),
+                                 std::min({overlapHi, spanLast, lastFull}), 0, from.blocks[j]};
             // Rectangles clipped at the bin area's edge: each with its own ρ.
-            for (int c = std::max(lo, lastFull + 1); c <= hi; ++c) {
+            for (int c = std::max(overlapLo, edge0); c <= std::min(overlapHi, cells - 1); ++c) {
                 const int cx0 = x0 + c * step, cx1 = Right(c);
-                if (cx0 >= cx1 || r.x1 <= cx0 || r.x0 >= cx1) continue;
-                Take(k, cx0, y0, cx1, y1, HalfDiagonal(cx1 - cx0, y1 - y0), smallPixels,
-                     out[size_t(c)]);
+                if (cx0 >= cx1) break;
+                CHECK(c - edge0 < 64);
+                if (Reaches(k, cx0, y0, cx1, y1, HalfDiagonal(cx1 - cx0, y1 - y0)))
+                    reach.edge |= uint64_t(1) << (c - edge0);
             }
+            if (reach.first <= reach.last || reach.edge != 0) reached.push_back(reach);
         }
     }
-    for (int c = 0; c < cells; ++c) Finish(false, out[size_t(c)]);
+    using simd::kLanes;
+    using simd::VF;
+    using simd::VI;
+    // Lane l of vector v is rectangle v·kLanes + l of a block: its bit in a puff's mask,
+    // shifted down by v·kLanes.
+    VI laneBit;
+    for (size_t l = 0; l < kLanes; ++l) laneBit[l] = int32_t(1u << l);
+    constexpr size_t kVectors = (kMaxRowCells + kLanes - 1) / kLanes;
+    std::vector<std::pair<uint32_t, uint32_t>>& block = out.block;
+    for (int b = 0; b < blockCount; ++b) {
+        const int cb0 = b * cellsPerBlock, n = std::min(cellsPerBlock, cells - cb0);
+        // The block's rectangles' ranges, sums and counts, kLanes rectangles a vector, as Begin
+        // starts them.
+        VF nearV[kVectors], farV[kVectors], smallV[kVectors], halfSmallV[kVectors];
+        VI countV[kVectors];
+        for (size_t v = 0; v < kVectors; ++v) {
+            nearV[v] = simd::Splat(std::numeric_limits<float>::infinity());
+            farV[v] = smallV[v] = halfSmallV[v] = simd::Splat(0.0f);
+            countV[v] = VI{};
+        }
+        block.clear();
+        const uint32_t all = uint32_t((uint64_t(1) << n) - 1);
+        for (const ListRow::Reach& reach : reached) {
+            if (!((reach.blocks >> b) & 1u)) continue;
+            // The block's rectangles among the puff's: bits first − cb0 … last − cb0, and its
+            // edge rectangles.
+            const int first = std::max(reach.first, cb0), last = std::min(reach.last, cb0 + n - 1);
+            uint32_t mask =
+                first <= last
+                    ? uint32_t((uint64_t(2) << (last - cb0)) - (uint64_t(1) << (first - cb0)))
+                    : 0u;
+            if (reach.edge != 0) {
+                const int shift = edge0 - cb0;
+                const uint64_t edge = shift >= 0    ? (shift < 64 ? reach.edge << shift : 0)
+                                      : shift > -64 ? reach.edge >> -shift
+                                                    : 0;
+                mask |= uint32_t(edge) & all;
+            }
+            if (mask == 0) continue;
+            block.emplace_back(reach.k, mask);
+            // The puff's ranges and sums into the rectangles it reaches, in from's order as Add
+            // puts them in one list: std::min and std::max are simd::Min and Max lane for lane,
+            // and a rectangle the puff does not reach keeps its values.
+            const Footprint& fp = footprint_[reach.k];
+            const VF nearK = simd::Splat(fp.near_m), farK = simd::Splat(fp.far_m);
+            const bool small = fp.sigmaPixels < smallPixels;
+            const bool halfSmall = fp.sigmaPixels < 0.5f * smallPixels;
+            const VF tau = simd::Splat(fp.tauMax);
+            const int hiBit = 31 - __builtin_clz(mask);
+            for (size_t v = size_t(__builtin_ctz(mask)) / kLanes; v <= size_t(hiBit) / kLanes;
+                 ++v) {
+                const VI in = ((VI{} + int32_t(mask >> (v * kLanes))) & laneBit) != 0;
+                nearV[v] = simd::Select(in, simd::Min(nearV[v], nearK), nearV[v]);
+                farV[v] = simd::Select(in, simd::Max(farV[v], farK), farV[v]);
+                countV[v] -= in;
+                if (small) smallV[v] = simd::Select(in, smallV[v] + tau, smallV[v]);
+                if (halfSmall) halfSmallV[v] = simd::Select(in, halfSmallV[v] + tau, halfSmallV[v]);
+            }
+        }
+        // The block's lists, one after the other, each padded to a multiple of 4 with the
+        // inert puff.
+        alignas(32) float nearA[kVectors * kLanes], farA[kVectors * kLanes];
+        alignas(32) float smallA[kVectors * kLanes], halfSmallA[kVectors * kLanes];
+        alignas(32) int32_t countA[kVectors * kLanes];
+        for (size_t v = 0; v < kVectors; ++v) {
+            simd::Store(nearA + v * kLanes, nearV[v]);
+            simd::Store(farA + v * kLanes, farV[v]);
+            simd::Store(smallA + v * kLanes, smallV[v]);
+            simd::Store(halfSmallA + v * kLanes, halfSmallV[v]);
+            std::memcpy(countA + v * kLanes, &countV[v], sizeof(VI));
+        }
+        size_t end = out.index.size();
+        for (int c = 0; c < n; ++c) end += (size_t(countA[c]) + 3) & ~size_t(3);
+        // One slot more: the loop below writes each puff before it knows whether it keeps it.
+        out.index.resize(end + 1);
+        uint32_t* dst = out.index.data() + out.start.back();
+        for (int c = 0; c < n; ++c) {
+            size_t m = 0;
+            for (const auto& [k, mask] : block) {
+                dst[m] = k;
+                m += (mask >> c) & 1u;
+            }
+            const size_t padded = (m + 3) & ~size_t(3);
+            std::fill(dst + m, dst + padded, inert_);
+            dst += padded;
+            out.start.push_back(uint32_t(dst - out.index.data()));
+            out.count.push_back(uint32_t(m));
+            out.near_m.push_back(nearA[c]);
+            out.far_m.push_back(farA[c]);
+            out.smallOpticalDepth.push_back(smallA[c]);
+            out.halfSmallOpticalDepth.push_back(halfSmallA[c]);
+        }
+        out.index.resize(end);
+    }
 }
 
 void PlumeScreenBins::Copy(List& list) const {
@@ -828,19 +957,19 @@ __attribute__((target("avx2"))) void PlumeScreenBins::TraceWide(const List& l, c
     size_t k = 0;
     for (; k + 8 <= l.index.size(); k += 8) {
         if constexpr (Copied) {
-            eight([&](int f) __attribute__((target("avx2"))) {
+            eight([&](int f) __attribute__((target("avx2"), always_inline)) {
                 return Load8<true>(l.data[f], puffData_.data() + f, l.index.data(), k);
             });
         } else {
             F8 fields[kPuffRecord];
             TransposeRecords8(puffData_.data(), l.index.data() + k, fields);
-            eight([&](int f) __attribute__((target("avx2"))) { return fields[f]; });
+            eight([&](int f) __attribute__((target("avx2"), always_inline)) { return fields[f]; });
         }
     }
     // A last group of four (lists hold a multiple of four): in the low lanes, the inert puff
     // in the high ones (unused, so they add zeros to the odd groups' sums).
     if (k < l.index.size())
-        eight([&](int f) __attribute__((target("avx2"))) {
+        eight([&](int f) __attribute__((target("avx2"), always_inline)) {
             return _mm256_insertf128_ps(_mm256_castps128_ps256(Load4<Copied>(
                                             l.data[f], puffData_.data() + f, l.index.data(), k)),
                                         _mm_set1_ps(puffData_[inert_ * kStride + size_t(f)]), 1);

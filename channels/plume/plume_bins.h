@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "channels/camera/channel_camera.h"
@@ -90,12 +91,50 @@ class PlumeScreenBins {
     // small rectangles share one larger one.
     void Gather(const List& from, int x0, int y0, int x1, int y1, float smallPixels, bool copy,
                 List& out) const;
-    // Gather(from, …) for a row of `cells` rectangles [x0 + c·step, x0 + c·step + width) ×
-    // [y0, y1), c = 0 … cells − 1, into out[c]: the same lists bit for bit, with one pass over
-    // from's puffs (each puff visits only the rectangles its own rectangle can reach) instead
-    // of one pass per rectangle.
-    void GatherRow(const List& from, int x0, int y0, int y1, int step, int width, int cells,
-                   float smallPixels, std::span<List> out) const;
+    // Lists of a row of rectangles, back to back: list c holds the puffs index[start[c],
+    // start[c + 1]) (count[c] of them, padded to a multiple of 4 with the inert puff), with the
+    // ranges and small-puff sums of a List.
+    struct ListRow {
+        std::vector<uint32_t> index, start{0}, count;
+        std::vector<float> near_m, far_m, smallOpticalDepth, halfSmallOpticalDepth;
+        size_t size() const { return count.size(); }
+        void Clear();
+        // List c as Gather makes it (not copied).
+        void Take(size_t c, List& out) const;
+
+      private:
+        friend class PlumeScreenBins;
+        // GatherRow's scratch: the puffs reaching the row (their rectangles: an interval of
+        // full-width ones and a mask of those clipped at the bin area's edge), and those of
+        // one block with the mask of its rectangles they reach.
+        struct Reach {
+            uint32_t k;
+            int first, last;
+            uint64_t edge, blocks;
+        };
+        std::vector<Reach> reached;
+        std::vector<std::pair<uint32_t, uint32_t>> block;
+    };
+    // The puffs of a row of up to 64 blocks' lists (each in kept order): each puff once, in
+    // kept order, with the blocks whose lists hold it (bit b for block b).
+    struct RowSource {
+        std::vector<uint32_t> index;
+        std::vector<uint64_t> blocks;
+        std::vector<uint64_t> mark;  // MergeBlocks' scratch, per kept puff
+    };
+    void MergeBlocks(std::span<const List> blocks, RowSource& out) const;
+    // All the puffs of a list in one block.
+    static void OneBlock(const List& list, RowSource& out);
+    static constexpr int kMaxRowCells = 32;  // cells of one block
+    // For a row of `cells` rectangles [x0 + c·step, x0 + c·step + width) × [y0, y1),
+    // c = 0 … cells − 1, in blocks of cellsPerBlock ≤ kMaxRowCells: Gather(list of block
+    // c / cellsPerBlock, rectangle c, …) appended to out as its next `cells` lists (the same
+    // lists bit for bit). One pass over from's puffs finds the rectangles each reaches (its
+    // ellipse's span once for the row, not once per block), then per block its ranges and
+    // sums are added to the rectangles it reaches on SIMD lanes, one rectangle a lane, and
+    // the lists are written once, without growing them puff by puff.
+    void GatherRow(const RowSource& from, int x0, int y0, int y1, int step, int width,
+                   int cellsPerBlock, int cells, float smallPixels, ListRow& out) const;
     // Copies a gathered list's data (no-op when copied already).
     void Copy(List& list) const;
     // Tile of pixel (px, py).
@@ -168,9 +207,6 @@ class PlumeScreenBins {
     // list.
     bool Reaches(uint32_t k, int x0, int y0, int x1, int y1, float rho) const;
     void Add(uint32_t k, float smallPixels, List& out) const;
-    // Puts puff k in every list of out (its index, ranges and small-puff sums); Add is this for
-    // one list.
-    void AddRange(uint32_t k, float smallPixels, std::span<List> out) const;
     uint32_t inert_ = 0;
     // Starts out's list for the rectangle and adds puff k to it if it Reaches the rectangle.
     static void Begin(List& out);

@@ -228,11 +228,9 @@ using plume_detail::Bilinear;
 using plume_detail::Bilinear4;
 using plume_detail::VisibleSource;
 
-// One row of cells' lists: cell cx has index[start[cx], start[cx + 1]) (padded to 4).
+// One row of cells' lists (cell cx's is lists' list cx).
 struct CellRow {
-    std::vector<uint32_t> index, start, count;
-    std::vector<float> near_m, far_m;
-    std::vector<float> smallOpticalDepth, halfSmallOpticalDepth;
+    PlumeScreenBins::ListRow lists;
     // Whether every surface of the cell lies in front of its puffs (the cell is skipped).
     std::vector<uint8_t> inFront;
 };
@@ -246,6 +244,7 @@ struct FrameBuffers {
     std::vector<BandTrace> nodes;
     std::vector<float> nodeT;
     std::vector<PlumeScreenBins::List> blocks;
+    std::vector<PlumeScreenBins::RowSource> bandSources;
     bool busy = false;
 };
 
@@ -279,7 +278,6 @@ class FrameBuffersLease {
 // parallelism), so no two users share it.
 struct Scratch {
     PlumeScreenBins::List list;
-    std::vector<PlumeScreenBins::List> cellLists{PlumeScreenBins::kTile / kCell};
     std::vector<float> range, depthRows;
     std::vector<std::pair<int, int>> depthRuns;
 };
@@ -373,6 +371,15 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             }
             return;
         }
+        if (!visible && N == 2) {
+            // The infrared's usual case, each sample row's two values at once (SSE2).
+            const __m128 Tv = _mm_set1_ps(T), s = _mm_set1_ps((1.0f - T) * S[0]);
+            for (int j = 0; j < 2; ++j) {
+                __m64* o = reinterpret_cast<__m64*>(radiance.At(px * 2, py * 2 + j));
+                _mm_storel_pi(o, _mm_add_ps(_mm_mul_ps(_mm_loadl_pi(Tv, o), Tv), s));
+            }
+            return;
+        }
         const int channels = visible ? 3 : 1;
         for (int j = 0; j < N; ++j) {
             float* o = radiance.At(px * N, py * N + j);
@@ -459,14 +466,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     if (cellRows.size() < size_t(cellsY)) cellRows.resize(size_t(cellsY));
     // Cell cx's list of row (not copied).
     const auto TakeList = [](const CellRow& row, int cx, PlumeScreenBins::List& list) {
-        list.count = row.count[size_t(cx)];
-        list.index.assign(row.index.begin() + row.start[size_t(cx)],
-                          row.index.begin() + row.start[size_t(cx) + 1]);
-        list.near_m = row.near_m[size_t(cx)];
-        list.far_m = row.far_m[size_t(cx)];
-        list.smallOpticalDepth = row.smallOpticalDepth[size_t(cx)];
-        list.halfSmallOpticalDepth = row.halfSmallOpticalDepth[size_t(cx)];
-        list.copied = false;
+        row.lists.Take(size_t(cx), list);
     };
     // The depths of cell row cy's samples in its cells with puffs, read once in the visibility
     // buffer's order (its rows streamed rather than 2 × 2 samples at a time) into kCell·N rows
@@ -479,7 +479,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
         const int rowSamples = kCell * N, sy0 = cy * rowSamples;
         runs.clear();
         for (int cx = 0; cx < cellsX; ++cx) {
-            if (row.count[size_t(cx)] == 0 || row.inFront[size_t(cx)]) continue;
+            if (row.lists.count[size_t(cx)] == 0 || row.inFront[size_t(cx)]) continue;
             const int sx0 = cx * rowSamples, sx1 = std::min(sx0 + rowSamples, vis.width);
             if (sx0 >= sx1) continue;
             if (!runs.empty() && runs.back().second == sx0)
@@ -579,21 +579,37 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     // bottom edges that its last cells reach, gathered from the tiles once. Every row of cells
     // of pass 1 lies inside its tiles' blocks, so it takes its puffs from the blocks' lists (the
     // same lists bit for bit as from the tiles) instead of merging two to four tiles' lists
-    // again for each of the tile's kTile / kCell rows of cells.
+    // again for each of the tile's kTile / kCell rows of cells. The lists of each row of blocks
+    // (in segments of 64 blocks) are merged into one, each puff with the blocks that hold it,
+    // so that pass 1 finds a puff's span in a row of cells once, not once per block.
     constexpr int kTile = PlumeScreenBins::kTile;
+    constexpr int kCellsPerTile = kTile / kCell;
+    static_assert(kTile % kCell == 0 && kCellsPerTile <= PlumeScreenBins::kMaxRowCells);
+    constexpr int kSegmentBlocks = 64;
     const int blocksX = (cellsX * kCell + kTile - 1) / kTile;
     const int blocksY = (cellsY * kCell + kTile - 1) / kTile;
+    const int segments = (blocksX + kSegmentBlocks - 1) / kSegmentBlocks;
     std::vector<PlumeScreenBins::List>& blocks = lease.buffers->blocks;
     if (blocks.size() < size_t(blocksX) * size_t(blocksY))
         blocks.resize(size_t(blocksX) * size_t(blocksY));
+    std::vector<PlumeScreenBins::RowSource>& bandSources = lease.buffers->bandSources;
+    if (bandSources.size() < size_t(segments) * size_t(blocksY))
+        bandSources.resize(size_t(segments) * size_t(blocksY));
     tbb::parallel_for(
         tbb::blocked_range<int>(0, blocksY, 1),
         [&](const tbb::blocked_range<int>& r) {
-            for (int by = r.begin(); by != r.end(); ++by)
+            for (int by = r.begin(); by != r.end(); ++by) {
+                const size_t row = size_t(by) * size_t(blocksX);
                 for (int bx = 0; bx < blocksX; ++bx)
                     bins.Gather(bx * kTile, by * kTile, (bx + 1) * kTile + 1, (by + 1) * kTile + 1,
-                                float(kCell), false,
-                                blocks[size_t(by) * size_t(blocksX) + size_t(bx)]);
+                                float(kCell), false, blocks[row + size_t(bx)]);
+                for (int s = 0; s < segments; ++s) {
+                    const int b0 = s * kSegmentBlocks, b1 = std::min(b0 + kSegmentBlocks, blocksX);
+                    bins.MergeBlocks(std::span<const PlumeScreenBins::List>(
+                                         blocks.data() + row + size_t(b0), size_t(b1 - b0)),
+                                     bandSources[size_t(by) * size_t(segments) + size_t(s)]);
+                }
+            }
         },
         tbb::simple_partitioner());
 
@@ -616,43 +632,24 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     tbb::parallel_for(
         tbb::blocked_range<int>(0, cellsY, 1),
         [&](const tbb::blocked_range<int>& r) {
-            Scratch& local = LocalScratch();
-            std::span<PlumeScreenBins::List> cellLists(local.cellLists);
             for (int cy = r.begin(); cy != r.end(); ++cy) {
                 CellRow& row = cellRows[size_t(cy)];
-                row.index.clear();
-                row.start.assign(size_t(cellsX) + 1, 0);
-                row.count.assign(size_t(cellsX), 0);
-                row.near_m.assign(size_t(cellsX), 0.0f);
-                row.far_m.assign(size_t(cellsX), 0.0f);
-                row.smallOpticalDepth.assign(size_t(cellsX), 0.0f);
-                row.halfSmallOpticalDepth.assign(size_t(cellsX), 0.0f);
-                for (int cx = 0; cx < cellsX; ++cx) {
+                row.lists.Clear();
+                for (int s = 0; s < segments; ++s) {
                     // The cells of one tile column take their puffs from the list of the tile's
-                    // block (a cell reaches one pixel beyond itself), in one GatherRow: a puff
-                    // outside the row's pixel rows is passed over at the first test. (Gathering
-                    // the row's strip of the block first tested every puff's ellipse twice, and
-                    // its test with the strip's half diagonal could drop a puff that Gather per
-                    // cell keeps: PlumeScreenBins.GatherRowEqualsGatherPerRectangle.)
-                    constexpr int kCellsPerTile = kTile / kCell;
-                    static_assert(kTile % kCell == 0);
-                    if (cx % kCellsPerTile == 0)
-                        bins.GatherRow(blocks[size_t(cy / kCellsPerTile) * size_t(blocksX) +
-                                              size_t(cx / kCellsPerTile)],
-                                       cx * kCell, cy * kCell, cy * kCell + kCell + 1, kCell,
-                                       kCell + 1, std::min(kCellsPerTile, cellsX - cx),
-                                       float(kCell), cellLists);
-                    const PlumeScreenBins::List& list = cellLists[size_t(cx % kCellsPerTile)];
-                    row.start[size_t(cx)] = uint32_t(row.index.size());
-                    if (list.size() == 0) continue;
-                    row.index.insert(row.index.end(), list.index.begin(), list.index.end());
-                    row.count[size_t(cx)] = uint32_t(list.count);
-                    row.near_m[size_t(cx)] = list.near_m;
-                    row.far_m[size_t(cx)] = list.far_m;
-                    row.smallOpticalDepth[size_t(cx)] = list.smallOpticalDepth;
-                    row.halfSmallOpticalDepth[size_t(cx)] = list.halfSmallOpticalDepth;
+                    // block (a cell reaches one pixel beyond itself), all the row's in one
+                    // GatherRow: a puff outside the row's pixel rows is passed over at the first
+                    // test. (Gathering the row's strip of the block first tested every puff's
+                    // ellipse twice, and its test with the strip's half diagonal could drop a
+                    // puff that Gather per cell keeps:
+                    // PlumeScreenBins.GatherRowEqualsGatherPerRectangle.)
+                    const int cx0 = s * kSegmentBlocks * kCellsPerTile;
+                    bins.GatherRow(
+                        bandSources[size_t(cy / kCellsPerTile) * size_t(segments) + size_t(s)],
+                        cx0 * kCell, cy * kCell, cy * kCell + kCell + 1, kCell, kCell + 1,
+                        kCellsPerTile, std::min(kSegmentBlocks * kCellsPerTile, cellsX - cx0),
+                        float(kCell), row.lists);
                 }
-                row.start[size_t(cellsX)] = uint32_t(row.index.size());
                 // The cells whose every surface lies in front of their puffs: their pixels
                 // are all skipped in pass 2 (minDepth ≥ depthInFront), so their corners are
                 // traced only if another cell uses them.
@@ -660,10 +657,11 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                 // lists stay: a node they are the near corner of is traced from theirs).
                 row.inFront.assign(size_t(cellsX), 0);
                 for (int cx = 0; cx < cellsX; ++cx)
-                    if (row.count[size_t(cx)] != 0)
+                    if (row.lists.count[size_t(cx)] != 0)
                         row.inFront[size_t(cx)] =
                             !CellInSpans(cx, cy) ||
-                            AllDepthsAtLeast(cx, cy, DepthInFront(cx, cy, row.near_m[size_t(cx)]));
+                            AllDepthsAtLeast(cx, cy,
+                                             DepthInFront(cx, cy, row.lists.near_m[size_t(cx)]));
             }
         },
         tbb::simple_partitioner());
@@ -675,7 +673,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     const auto Used = [&](int cx, int cy) {
         if (cx < 0 || cy < 0 || cx >= cellsX || cy >= cellsY) return false;
         const CellRow& row = cellRows[size_t(cy)];
-        return row.count[size_t(cx)] != 0 && !row.inFront[size_t(cx)];
+        return row.lists.count[size_t(cx)] != 0 && !row.inFront[size_t(cx)];
     };
     tbb::parallel_for(
         tbb::blocked_range<int>(0, nodesY, 1),
@@ -691,7 +689,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                     const size_t n = size_t(ny) * size_t(nodesX) + size_t(nx);
                     // No puff reaches the node's cell, so none reaches the node: a clear sky
                     // (the buffers are reused from frame to frame, so this is written).
-                    if (row.count[size_t(cx)] == 0) {
+                    if (row.lists.count[size_t(cx)] == 0) {
                         nodes[n] = BandTrace{};
                         nodeT[n] = 1.0f;
                         continue;
@@ -760,9 +758,9 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
         uint64_t cost = 0;
         bool puffs = false;
         for (int cx = 0; cx < cellsX; ++cx) {
-            puffs |= row.count[size_t(cx)] != 0;
-            if (row.count[size_t(cx)] != 0 && !row.inFront[size_t(cx)])
-                cost += row.count[size_t(cx)] + kCell * kCell;
+            puffs |= row.lists.count[size_t(cx)] != 0;
+            if (row.lists.count[size_t(cx)] != 0 && !row.inFront[size_t(cx)])
+                cost += row.lists.count[size_t(cx)] + kCell * kCell;
         }
         if (puffs) rowOrder.emplace_back(cost, cy);
     }
@@ -806,7 +804,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                     return rest && _mm_movemask_ps(sky) == 0xf;
                 };
                 for (int cx = 0; cx < cellsX; ++cx) {
-                    if (row.count[size_t(cx)] == 0) continue;
+                    if (row.lists.count[size_t(cx)] == 0) continue;
                     // Every pixel of the cell is skipped by the test minDepth ≥ depthInFront.
                     if (row.inFront[size_t(cx)]) {
                         covered += uint64_t(std::min(W, (cx + 1) * kCell) - cx * kCell) *

@@ -3,8 +3,9 @@
 // thick flame puff and for a view of part of the plumes (whose puffs out of view no longer
 // share the tolerance), lists holding every puff whose cutoff ellipsoid their rays meet (and
 // little more), lists taken from larger lists (one rectangle or a row of them) equal to
-// lists from the tiles, eight-lane traces equal to four-lane ones, and the dropping of puffs
-// too thin to matter.
+// lists from the tiles, a row's lists taken from its blocks' merged lists equal to those
+// taken from each cell's block, eight-lane traces equal to four-lane ones, and the dropping
+// of puffs too thin to matter.
 #include "channels/plume/plume_bins.h"
 
 #include <gtest/gtest.h>
@@ -196,17 +197,25 @@ TEST(PlumeScreenBins, GatherRowEqualsGatherPerRectangle) {
             for (uint32_t k = 0; k < bands[b].KeptPuffs(); ++k) all[b].index.push_back(k);
             all[b].count = all[b].index.size();
         }
-        std::vector<PlumeScreenBins::List> row(12);
+        PlumeScreenBins::ListRow row;
+        PlumeScreenBins::RowSource source;
+        PlumeScreenBins::List l;
         size_t nonEmpty = 0, compared = 0;
-        // GatherRow of bins for the strip at x0 against Gather per rectangle.
+        // GatherRow of bins for the strip at x0 against Gather per rectangle; the row's lists
+        // appended to those of the strip before it (as CompositePlumes makes a row of cells
+        // from its tiles' strips).
         const auto check = [&](int b, int x0, int y0, int step, int width, int cells) {
             const PlumeScreenBins& bins = bands[b];
+            if (x0 == 0) row.Clear();
+            const size_t before = row.size();
             bins.Gather(x0, y0, x0 + (cells - 1) * step + width, y0 + 5, 4.0f, false, strip);
-            bins.GatherRow(wide ? strip : all[b], x0, y0, y0 + 5, step, width, cells, 4.0f, row);
+            PlumeScreenBins::OneBlock(wide ? strip : all[b], source);
+            bins.GatherRow(source, x0, y0, y0 + 5, step, width, cells, cells, 4.0f, row);
+            ASSERT_EQ(row.size(), before + size_t(cells));
             for (int c = 0; c < cells; ++c) {
                 const int x = x0 + c * step;
                 bins.Gather(x, y0, x + width, y0 + 5, 4.0f, false, single);
-                const PlumeScreenBins::List& l = row[size_t(c)];
+                row.Take(before + size_t(c), l);
                 ASSERT_EQ(l.count, single.count) << x << ", " << y0 << " band " << b;
                 EXPECT_EQ(l.index, single.index);
                 EXPECT_EQ(std::memcmp(&l.near_m, &single.near_m, 4), 0);
@@ -218,15 +227,79 @@ TEST(PlumeScreenBins, GatherRowEqualsGatherPerRectangle) {
                 ++compared;
             }
         };
-        for (const auto [step, width, cells] : {std::array{4, 5, 8}, {3, 7, 11}, {5, 2, 7}}) {
+        for (const auto [step, width, cells] :
+             {std::array{4, 5, 8}, {3, 7, 11}, {5, 2, 7}, {1, 2, PlumeScreenBins::kMaxRowCells}}) {
             const int stripWidth = (cells - 1) * step + width;
             for (int y0 = 0; y0 < cam.height + PlumeScreenBins::kMargin; y0 += 4)
-                for (int x0 = 0; x0 < cam.width + PlumeScreenBins::kMargin; x0 += stripWidth)
-                    for (int b = 0; b < 2; ++b) check(b, x0, y0, step, width, cells);
+                for (int b = 0; b < 2; ++b)
+                    for (int x0 = 0; x0 < cam.width + PlumeScreenBins::kMargin; x0 += stripWidth)
+                        check(b, x0, y0, step, width, cells);
         }
         EXPECT_GT(nonEmpty, 300u);
         EXPECT_GT(nonEmpty * 10, compared);  // the plumes fill a good part of the view
     }
+}
+
+// A row of cells gathered from the merged lists of its blocks (as CompositePlumes gathers its
+// rows: blocks of a tile and the pixel beyond, 8 cells of 4 × 4 pixels each, and blocks of
+// 3 cells) gets for each cell what Gather takes from the cell's own block's list: the same
+// puffs in the same order, ranges and small-puff sums bit for bit, the rows' last cells
+// running past the bin area's edge.
+TEST(PlumeScreenBins, GatherRowOfBlocksEqualsGatherFromEachBlock) {
+    const scene::PlumeField field = CommittedPlumes();
+    ChannelCamera narrow = NorthCamera({0.0, 0.0, 20.0}, 203, 150, 6.0, 1.5);
+    scene::Attitude attitude;
+    attitude.heading_rad = std::atan2(-300.0, 2000.0);
+    attitude.pitch_rad = 1.5 * std::numbers::pi / 180.0;
+    narrow.worldFromCamera.worldFromBody = scene::WorldFromBodyRotation(attitude);
+    const ChannelCamera cameras[] = {NorthCamera({0.0, 0.0, 20.0}, 203, 150, 40.0, 3.0), narrow};
+    size_t nonEmpty = 0, compared = 0;
+    for (const ChannelCamera& cam : cameras) {
+        for (const ObscurantBand band : {ObscurantBand::Visible, ObscurantBand::Lwir}) {
+            const PlumeScreenBins bins(field, cam, band);
+            const int areaW = cam.width + PlumeScreenBins::kMargin;
+            const int areaH = cam.height + PlumeScreenBins::kMargin;
+            for (const int blockPixels : {PlumeScreenBins::kTile, 12}) {
+                const int cellsPerBlock = blockPixels / 4;
+                const int cells = (areaW + 3) / 4;
+                const int blocksX = (cells + cellsPerBlock - 1) / cellsPerBlock;
+                std::vector<PlumeScreenBins::List> blocks(static_cast<size_t>(blocksX));
+                PlumeScreenBins::RowSource source;
+                PlumeScreenBins::ListRow row;
+                PlumeScreenBins::List single, l;
+                for (int y0 = 0; y0 < areaH; y0 += blockPixels) {
+                    for (int bx = 0; bx < blocksX; ++bx)
+                        bins.Gather(bx * blockPixels, y0, (bx + 1) * blockPixels + 1,
+                                    y0 + blockPixels + 1, 4.0f, false, blocks[size_t(bx)]);
+                    bins.MergeBlocks(blocks, source);
+                    for (int cy = y0; cy < std::min(y0 + blockPixels, areaH); cy += 4) {
+                        row.Clear();
+                        bins.GatherRow(source, 0, cy, cy + 5, 4, 5, cellsPerBlock, cells, 4.0f,
+                                       row);
+                        ASSERT_EQ(row.size(), size_t(cells));
+                        for (int c = 0; c < cells; ++c) {
+                            bins.Gather(blocks[size_t(c / cellsPerBlock)], c * 4, cy, c * 4 + 5,
+                                        cy + 5, 4.0f, false, single);
+                            row.Take(size_t(c), l);
+                            ASSERT_EQ(l.count, single.count) << c << ", " << cy;
+                            EXPECT_EQ(l.index, single.index);
+                            EXPECT_EQ(std::memcmp(&l.near_m, &single.near_m, 4), 0);
+                            EXPECT_EQ(std::memcmp(&l.far_m, &single.far_m, 4), 0);
+                            EXPECT_EQ(
+                                std::memcmp(&l.smallOpticalDepth, &single.smallOpticalDepth, 4), 0);
+                            EXPECT_EQ(std::memcmp(&l.halfSmallOpticalDepth,
+                                                  &single.halfSmallOpticalDepth, 4),
+                                      0);
+                            nonEmpty += single.count > 0;
+                            ++compared;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    EXPECT_GT(nonEmpty, 1000u);
+    EXPECT_GT(nonEmpty * 10, compared);
 }
 
 // A cell's list holds every puff whose cutoff ellipsoid (τ_max e^(−r²/2) = ε) a ray through
