@@ -15,12 +15,25 @@
 #include <cmath>
 #include <cstring>
 #include <numbers>
+#include <string>
 
 #include "channels/plume/plume_composite.h"
 #include "scene/plumes/plume_system.h"
 
 namespace seasense::channels {
 namespace {
+
+// Two lists hold the same puffs in the same order with the same ranges and small-puff sums, bit
+// for bit (ASSERTs inside: call through ASSERT_NO_FATAL_FAILURE where it matters).
+void ExpectSameList(const PlumeScreenBins::List& a, const PlumeScreenBins::List& b,
+                    const std::string& where) {
+    ASSERT_EQ(a.count, b.count) << where;
+    EXPECT_EQ(a.index, b.index) << where;
+    EXPECT_EQ(std::memcmp(&a.near_m, &b.near_m, 4), 0) << where;
+    EXPECT_EQ(std::memcmp(&a.far_m, &b.far_m, 4), 0) << where;
+    EXPECT_EQ(std::memcmp(&a.smallOpticalDepth, &b.smallOpticalDepth, 4), 0) << where;
+    EXPECT_EQ(std::memcmp(&a.halfSmallOpticalDepth, &b.halfSmallOpticalDepth, 4), 0) << where;
+}
 
 using scene::ObscurantBand;
 
@@ -153,15 +166,8 @@ TEST(PlumeScreenBins, GatherFromALargerListEqualsGatherFromTheTiles) {
             for (int x = x0; x < x0 + PlumeScreenBins::kTile; x += 4) {
                 bins.Gather(strip, x, y0, x + 5, y0 + 5, 4.0f, false, fromStrip);
                 bins.Gather(x, y0, x + 5, y0 + 5, 4.0f, false, fromTiles);
-                ASSERT_EQ(fromStrip.count, fromTiles.count) << x << ", " << y0;
-                EXPECT_EQ(fromStrip.index, fromTiles.index);
-                EXPECT_EQ(std::memcmp(&fromStrip.near_m, &fromTiles.near_m, 4), 0);
-                EXPECT_EQ(std::memcmp(&fromStrip.far_m, &fromTiles.far_m, 4), 0);
-                EXPECT_EQ(
-                    std::memcmp(&fromStrip.smallOpticalDepth, &fromTiles.smallOpticalDepth, 4), 0);
-                EXPECT_EQ(std::memcmp(&fromStrip.halfSmallOpticalDepth,
-                                      &fromTiles.halfSmallOpticalDepth, 4),
-                          0);
+                ASSERT_NO_FATAL_FAILURE(ExpectSameList(
+                    fromStrip, fromTiles, std::to_string(x) + ", " + std::to_string(y0)));
                 nonEmpty += fromTiles.count > 0;
             }
         }
@@ -216,13 +222,9 @@ TEST(PlumeScreenBins, GatherRowEqualsGatherPerRectangle) {
                 const int x = x0 + c * step;
                 bins.Gather(x, y0, x + width, y0 + 5, 4.0f, false, single);
                 row.Take(before + size_t(c), l);
-                ASSERT_EQ(l.count, single.count) << x << ", " << y0 << " band " << b;
-                EXPECT_EQ(l.index, single.index);
-                EXPECT_EQ(std::memcmp(&l.near_m, &single.near_m, 4), 0);
-                EXPECT_EQ(std::memcmp(&l.far_m, &single.far_m, 4), 0);
-                EXPECT_EQ(std::memcmp(&l.smallOpticalDepth, &single.smallOpticalDepth, 4), 0);
-                EXPECT_EQ(std::memcmp(&l.halfSmallOpticalDepth, &single.halfSmallOpticalDepth, 4),
-                          0);
+                ASSERT_NO_FATAL_FAILURE(ExpectSameList(
+                    l, single,
+                    std::to_string(x) + ", " + std::to_string(y0) + " band " + std::to_string(b)));
                 nonEmpty += single.count > 0;
                 ++compared;
             }
@@ -281,15 +283,8 @@ TEST(PlumeScreenBins, GatherRowOfBlocksEqualsGatherFromEachBlock) {
                             bins.Gather(blocks[size_t(c / cellsPerBlock)], c * 4, cy, c * 4 + 5,
                                         cy + 5, 4.0f, false, single);
                             row.Take(size_t(c), l);
-                            ASSERT_EQ(l.count, single.count) << c << ", " << cy;
-                            EXPECT_EQ(l.index, single.index);
-                            EXPECT_EQ(std::memcmp(&l.near_m, &single.near_m, 4), 0);
-                            EXPECT_EQ(std::memcmp(&l.far_m, &single.far_m, 4), 0);
-                            EXPECT_EQ(
-                                std::memcmp(&l.smallOpticalDepth, &single.smallOpticalDepth, 4), 0);
-                            EXPECT_EQ(std::memcmp(&l.halfSmallOpticalDepth,
-                                                  &single.halfSmallOpticalDepth, 4),
-                                      0);
+                            ASSERT_NO_FATAL_FAILURE(ExpectSameList(
+                                l, single, std::to_string(c) + ", " + std::to_string(cy)));
                             nonEmpty += single.count > 0;
                             ++compared;
                         }
