@@ -67,6 +67,42 @@ scene::PlumeField CommittedFourPlumes() {
     return field;
 }
 
+// A screen wider than 64 blocks of 32 pixels: pass 0 merges each row of blocks' lists in
+// segments of 64 blocks, and a puff straddling the segments' border (pixel 2048) must reach the
+// cells on both sides. Every pixel near the border has the transmittance of its ray through the
+// puff (the exact line integral; sky cells may be blended from their corners, within 0.02).
+TEST(PlumeComposite, PuffAcrossTheBorderOfTwoSegmentsOfBlocksOnAWideScreen) {
+    const glm::dvec3 eye{0.0, 0.0, 10.0};
+    const ChannelCamera cam = NorthCamera(eye, 2112, 16, 1);
+    // The ray through the centre of pixel (2048, 8), and a puff 500 m along it.
+    const double a = (2.0 * (2048 + 0.5) / cam.width - 1.0) * cam.TanHalfH();
+    const glm::dvec3 towardBorder = glm::normalize(glm::dvec3(a, 1.0, 0.0));
+    scene::Puff puff;
+    puff.centre_m = eye + 500.0 * towardBorder;
+    puff.sigmaH_m = 20.0;
+    puff.sigmaZ_m = 10.0;
+    puff.mass_kg = 0.3;
+    const scene::PlumeField field = OnePlume(scene::PlumeKind::Smoke, 0.3, {puff});
+    const double alpha = scene::KindOptics(scene::PlumeKind::Smoke, 0.3).massExtinction_m2pkg[0];
+    const VisibilityBuffer vis = SkyOnly(cam);
+    Image radiance(cam.SampleWidth(), cam.SampleHeight(), 3);
+    std::fill(radiance.pixels.begin(), radiance.pixels.end(), 1.0f);
+    CompositePlumes(field, cam, vis, Dark(), radiance);
+    const glm::dmat3 worldFromCamera = cam.worldFromCamera.worldFromBody;
+    double thickest = 1.0;
+    for (int x = 1900; x < 2112; x += 3) {
+        const double ax = (2.0 * (x + 0.5) / cam.width - 1.0) * cam.TanHalfH();
+        const glm::dvec3 d = glm::normalize(worldFromCamera * glm::dvec3(ax, 1.0, 0.0));
+        const double T = std::exp(-alpha * scene::GaussianPuffLineIntegral_kgpm2(
+                                               puff.centre_m, puff.sigmaH_m, puff.sigmaZ_m,
+                                               puff.mass_kg, eye, d, kPlumeSkyRange_m));
+        thickest = std::min(thickest, T);
+        // Row 8 is the horizon row (b = 0 between rows 7 and 8: within half a pixel).
+        EXPECT_NEAR(radiance.At(x, 8)[0], T, 0.02) << "pixel " << x;
+    }
+    ASSERT_LT(thickest, 0.5);  // thick enough for a missing puff to show
+}
+
 // Sky above the horizon and below it a level sea at eye.z below the eye of cam (looking north).
 VisibilityBuffer SkyAndLevelSea(const ChannelCamera& cam, const glm::dvec3& eye) {
     VisibilityBuffer vis = SkyOnly(cam);
