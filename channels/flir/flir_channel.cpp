@@ -345,6 +345,8 @@ struct FlirChannel::FrameShading {
     int sampleWidth = 0, sampleHeight = 0;
     glm::vec3 eye{0.0f}, sunDir{0.0f};
     bool shadows = false;
+    // occlusion.MayOcclude along sunDir (to 1e30 m), prepared once for the frame's model samples.
+    OccluderBoundsTest occluders;
     float seaB = 0.0f, airB = 0.0f;
     SurfInfrared surf;
     // View rays: direction ∝ forward + up·ndcY − right + (x + ½)·colStep (the camera axes
@@ -566,7 +568,7 @@ uint64_t FlirChannel::ShadeRows(const FrameShading& f, int y0, int y1, float* ou
             sc.modelMesh.push_back(mesh);
             if (f.shadows) {
                 const glm::vec3 o = ShadowRayOrigin(position, normal);
-                if (f.occlusion.MayOcclude(o, f.sunDir, 1e30f)) {
+                if (f.occluders.MayOcclude(o)) {
                     sc.origins.push_back(o);
                     sc.originOwner.push_back(uint32_t(sc.modelK.size() - 1));
                 }
@@ -580,7 +582,7 @@ uint64_t FlirChannel::ShadeRows(const FrameShading& f, int y0, int y1, float* ou
     sc.lit.assign(sc.modelK.size(), f.sunDir.z > 0.0f ? 1 : 0);
     if (!sc.origins.empty()) {
         sc.visible.resize(sc.origins.size());
-        // Every origin passed MayOcclude above: not tested again.
+        // Every origin passed f.occluders above: not tested again.
         f.occlusion.DirectionalVisibility(sc.origins, f.sunDir, 0.0f, sc.visible, true);
         for (size_t r = 0; r < sc.origins.size(); ++r) sc.lit[sc.originOwner[r]] = sc.visible[r];
     }
@@ -646,6 +648,7 @@ void FlirChannel::Render(const scene::SceneState& state, Image& radiance) {
     frame.eye = glm::vec3(cam.worldFromCamera.position_m);
     frame.sunDir = glm::vec3(state.sun.direction);
     frame.shadows = setup_.channel.shadows && !occlusion.Empty() && frame.sunDir.z > 0.0f;
+    frame.occluders = occlusion.BoundsTest(frame.sunDir, 1e30f);
     frame.seaB = float(table_.Radiance(sea_.temperature_K));
     frame.airB = float(atmosphere_.AirRadiance());
     frame.surf = surf_;

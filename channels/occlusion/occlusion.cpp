@@ -370,9 +370,7 @@ bool OcclusionScene::MayOcclude(const glm::vec3& origin, const glm::vec3& direct
     CHECK_MSG(impl.committed, "OcclusionScene::MayOcclude before Commit()");
     CHECK_MSG(Finite(origin) && Finite(direction) && !std::isnan(maxDistance_m),
               "MayOcclude: non-finite ray");
-    if (impl.meshes.empty() || maxDistance_m < 0.0f) return false;
-    return SlabHit(impl.testMin, impl.testMax, origin, direction, InverseDirection(direction),
-                   maxDistance_m);
+    return BoundsTest(direction, maxDistance_m).MayOcclude(origin);
 }
 
 OccluderBoundsTest OcclusionScene::BoundsTest(const glm::vec3& direction,

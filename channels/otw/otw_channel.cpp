@@ -11,6 +11,7 @@
 #include <cstring>
 #include <limits>
 
+#include "channels/occlusion/occlusion.h"
 #include "channels/otw/celestial.h"
 #include "channels/otw/cloud_layer.h"
 #include "channels/otw/lightning_overlay.h"
@@ -48,32 +49,19 @@ constexpr float kSeaAlbedo = 0.06f;
 // Koschmieder: extinction coefficient for a 2 % contrast threshold, β = 3.912 / V.
 double ExtinctionFromVisibility(double visibility_m) { return 3.912 / visibility_m; }
 
-// Whether the ray origin + t·direction, t ≥ 0, meets the box [lo, hi] (slab test; Kay & Kajiya,
-// SIGGRAPH 1986). Inline for the per-sample shadow-caster prefilter.
+// Whether the ray origin + t·direction, t ≥ 0, meets the box [lo, hi]: OcclusionScene's slab
+// test (occlusion_detail::SlabHit) for a box of the caller's. Inline for the per-triangle
+// shadow-caster prefilter.
 struct RayBoxTest {
     glm::vec3 lo, hi, direction, inverse;
     RayBoxTest(const glm::vec3& boxMin, const glm::vec3& boxMax, const glm::vec3& d)
-        : lo(boxMin), hi(boxMax), direction(d) {
-        // Components below 1e-20 count as parallel, as in OcclusionScene (no inf·0 below).
-        for (int a = 0; a < 3; ++a) inverse[a] = Parallel(d[a]) ? 0.0f : 1.0f / d[a];
-    }
+        : lo(boxMin), hi(boxMax), direction(d), inverse(occlusion_detail::InverseDirection(d)) {}
     // Whether a ray from o may meet the box grown by grow_m (≥ 0) on each side: also whether
     // any ray from a point within grow_m of o per axis may meet the box itself.
     bool MayHit(const glm::vec3& o, const glm::vec3& grow_m = glm::vec3(0.0f)) const {
-        float t0 = 0.0f, t1 = std::numeric_limits<float>::infinity();
-        for (int a = 0; a < 3; ++a) {
-            const float l = lo[a] - grow_m[a], h = hi[a] + grow_m[a];
-            if (Parallel(direction[a])) {
-                if (o[a] < l || o[a] > h) return false;
-                continue;
-            }
-            const float tA = (l - o[a]) * inverse[a], tB = (h - o[a]) * inverse[a];
-            t0 = std::max(t0, std::min(tA, tB));
-            t1 = std::min(t1, std::max(tA, tB));
-        }
-        return t0 <= t1;
+        return occlusion_detail::SlabHit(lo - grow_m, hi + grow_m, o, direction, inverse,
+                                         std::numeric_limits<float>::infinity());
     }
-    static bool Parallel(float d) { return std::abs(d) < 1e-20f; }
 };
 
 // Gaussian isotropic slope density of Cox & Munk (1954), J. Opt. Soc. Am. 44(11), with the
