@@ -12,6 +12,7 @@
 #include <numbers>
 
 #include "scene/core/check.h"
+#include "scene/core/int_div.h"
 #include "scene/core/simd4.h"
 #include "scene/core/simd_lanes.h"
 
@@ -353,9 +354,6 @@ float HalfDiagonal(int w, int h) {
     return float(0.5 * std::sqrt(double(w) * double(w) + double(h) * double(h)) + 1e-3);
 }
 
-// ⌊a / b⌋ for b > 0.
-int FloorDiv(int a, int b) { return a >= 0 ? a / b : -((b - 1 - a) / b); }
-
 }  // namespace
 
 inline bool PlumeScreenBins::Reaches(uint32_t k, int x0, int y0, int x1, int y1, float rho) const {
@@ -479,11 +477,6 @@ void PlumeScreenBins::MergeBlocks(std::span<const List> blocks, RowSource& out) 
     out.index.clear(), out.blocks.clear();
     for (size_t k = 0; k < out.mark.size(); ++k)
         if (out.mark[k] != 0) out.index.push_back(uint32_t(k)), out.blocks.push_back(out.mark[k]);
-}
-
-void PlumeScreenBins::OneBlock(const List& list, RowSource& out) {
-    out.index.assign(list.index.begin(), list.index.begin() + ptrdiff_t(list.count));
-    out.blocks.assign(list.count, 1);
 }
 
 void PlumeScreenBins::GatherRow(const RowSource& from, int x0, int y0, int y1, int step, int width,

@@ -14,6 +14,7 @@
 
 #include "radiometry/planck/planck.h"
 #include "scene/core/error.h"
+#include "scene/core/int_div.h"
 
 namespace seasense::sensors {
 
@@ -200,9 +201,6 @@ SamplingKernel BuildSamplingKernel(const radiometry::Band& band, const OpticsGeo
 }
 
 namespace {
-
-// ⌊a / b⌋ for b > 0.
-int FloorDiv(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
 
 // Vectors per step of the tap loop (KernelSteps): eight accumulators, so that a tap pair's
 // broadcast and column offsets serve 64 pixels (eight lanes); and the pixels of the widest step,
