@@ -123,8 +123,6 @@ class PlumeScreenBins {
         std::vector<uint64_t> mark;  // MergeBlocks' scratch, per kept puff
     };
     void MergeBlocks(std::span<const List> blocks, RowSource& out) const;
-    // All the puffs of a list in one block.
-    static void OneBlock(const List& list, RowSource& out);
     static constexpr int kMaxRowCells = 32;  // cells of one block
     // For a row of `cells` rectangles [x0 + c·step, x0 + c·step + width) × [y0, y1),
     // c = 0 … cells − 1, in blocks of cellsPerBlock ≤ kMaxRowCells: Gather(list of block

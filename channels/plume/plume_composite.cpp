@@ -464,10 +464,6 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     FrameBuffersLease lease;
     std::vector<CellRow>& cellRows = lease.buffers->cellRows;
     if (cellRows.size() < size_t(cellsY)) cellRows.resize(size_t(cellsY));
-    // Cell cx's list of row (not copied).
-    const auto TakeList = [](const CellRow& row, int cx, PlumeScreenBins::List& list) {
-        row.lists.Take(size_t(cx), list);
-    };
     // The depths of cell row cy's samples in its cells with puffs, read once in the visibility
     // buffer's order (its rows streamed rather than 2 × 2 samples at a time) into kCell·N rows
     // of vis.width at out; −1 where the sample sees the sky.
@@ -697,7 +693,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                     if (!Used(nx - 1, ny - 1) && !Used(nx, ny - 1) && !Used(nx - 1, ny) &&
                         !Used(nx, ny))
                         continue;
-                    TakeList(row, cx, list);
+                    row.lists.Take(size_t(cx), list);
                     nodes[n] =
                         bins.Trace(list, PixelDirection(nx * kCell, ny * kCell), kPlumeSkyRange_m);
                     nodeT[n] = std::exp(-nodes[n].opticalDepth);
@@ -826,7 +822,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                             _mm_prefetch(reinterpret_cast<const char*>(radiance.At(sx1, sy)),
                                          _MM_HINT_T0);
                         }
-                    TakeList(row, cx, list);
+                    row.lists.Take(size_t(cx), list);
                     // The ranges where the cell's puffs can matter.
                     const float dNear = list.near_m, dFar = list.far_m;
                     const BandTrace* corner[4];

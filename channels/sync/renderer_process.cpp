@@ -28,7 +28,7 @@ std::string Describe(const ProcessExit& e) {
 }
 
 std::vector<std::string> RendererEnvironment(const char* const* env) {
-    constexpr std::string_view kName = "GLIBC_TUNABLES=", kHugePages = "glibc.malloc.hugetlb";
+    constexpr std::string_view kName = "GLIBC_TUNABLES=", kHugePages = "glibc.malloc.hugetlb=";
     std::vector<std::string> out;
     bool tunables = false;
     for (; env && *env; ++env) {
@@ -40,16 +40,15 @@ std::vector<std::string> RendererEnvironment(const char* const* env) {
             for (size_t at = kName.size(); at <= entry.size();) {
                 const size_t end = std::min(entry.find(':', at), entry.size());
                 const std::string_view item = std::string_view(entry).substr(at, end - at);
-                chosen |= item.starts_with(kHugePages) && item.size() > kHugePages.size() &&
-                          item[kHugePages.size()] == '=';
+                chosen |= item.starts_with(kHugePages);
                 at = end + 1;
             }
             if (!chosen)
-                entry += (entry.size() > kName.size() ? ":" : "") + std::string(kHugePages) + "=1";
+                entry += (entry.size() > kName.size() ? ":" : "") + std::string(kHugePages) + "1";
         }
         out.push_back(std::move(entry));
     }
-    if (!tunables) out.push_back(std::string(kName) + std::string(kHugePages) + "=1");
+    if (!tunables) out.push_back(std::string(kName) + std::string(kHugePages) + "1");
     return out;
 }
 

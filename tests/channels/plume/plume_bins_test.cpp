@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstring>
 #include <numbers>
+#include <span>
 #include <string>
 
 #include "channels/plume/plume_composite.h"
@@ -175,6 +176,17 @@ TEST(PlumeScreenBins, GatherFromALargerListEqualsGatherFromTheTiles) {
     EXPECT_GT(nonEmpty, 100u);
 }
 
+// Two views width pixels wide, 150 high, from 20 m up: 40° north over the committed plumes,
+// and 6° on the fire (2 km north, 300 m west, 1.5° up), where puffs span tens of tiles.
+std::array<ChannelCamera, 2> WideAndFireCameras(int width) {
+    ChannelCamera fire = NorthCamera({0.0, 0.0, 20.0}, width, 150, 6.0, 1.5);
+    scene::Attitude attitude;
+    attitude.heading_rad = std::atan2(-300.0, 2000.0);
+    attitude.pitch_rad = 1.5 * std::numbers::pi / 180.0;
+    fire.worldFromCamera.worldFromBody = scene::WorldFromBodyRotation(attitude);
+    return {NorthCamera({0.0, 0.0, 20.0}, width, 150, 40.0, 3.0), fire};
+}
+
 // A row of rectangles gathered in one pass (GatherRow) gets the lists that Gather makes for
 // each rectangle on its own: the same puffs in the same order, ranges and small-puff sums bit
 // for bit, for CompositePlumes' 4 × 4 cells (step 4, width 5) and for other steps and widths,
@@ -187,12 +199,7 @@ TEST(PlumeScreenBins, GatherRowEqualsGatherPerRectangle) {
     // diagonal, can drop a puff whose ellipse meets only the disc round a cell at the strip's
     // end, not the cell: no ray through the cell meets it, so the lists hold every puff that
     // matters either way, but Gather per cell keeps it.)
-    ChannelCamera narrow = NorthCamera({0.0, 0.0, 20.0}, 200, 150, 6.0, 1.5);
-    scene::Attitude attitude;
-    attitude.heading_rad = std::atan2(-300.0, 2000.0);
-    attitude.pitch_rad = 1.5 * std::numbers::pi / 180.0;
-    narrow.worldFromCamera.worldFromBody = scene::WorldFromBodyRotation(attitude);
-    const ChannelCamera cameras[] = {NorthCamera({0.0, 0.0, 20.0}, 200, 150, 40.0, 3.0), narrow};
+    const std::array<ChannelCamera, 2> cameras = WideAndFireCameras(200);
     for (const ChannelCamera& cam : cameras) {
         const bool wide = &cam == &cameras[0];
         // The visible band's bins and the LWIR band's (other cutoffs, so other spans).
@@ -215,7 +222,8 @@ TEST(PlumeScreenBins, GatherRowEqualsGatherPerRectangle) {
             if (x0 == 0) row.Clear();
             const size_t before = row.size();
             bins.Gather(x0, y0, x0 + (cells - 1) * step + width, y0 + 5, 4.0f, false, strip);
-            PlumeScreenBins::OneBlock(wide ? strip : all[b], source);
+            bins.MergeBlocks(std::span<const PlumeScreenBins::List>(wide ? &strip : &all[b], 1),
+                             source);
             bins.GatherRow(source, x0, y0, y0 + 5, step, width, cells, cells, 4.0f, row);
             ASSERT_EQ(row.size(), before + size_t(cells));
             for (int c = 0; c < cells; ++c) {
@@ -249,12 +257,7 @@ TEST(PlumeScreenBins, GatherRowEqualsGatherPerRectangle) {
 // running past the bin area's edge.
 TEST(PlumeScreenBins, GatherRowOfBlocksEqualsGatherFromEachBlock) {
     const scene::PlumeField field = CommittedPlumes();
-    ChannelCamera narrow = NorthCamera({0.0, 0.0, 20.0}, 203, 150, 6.0, 1.5);
-    scene::Attitude attitude;
-    attitude.heading_rad = std::atan2(-300.0, 2000.0);
-    attitude.pitch_rad = 1.5 * std::numbers::pi / 180.0;
-    narrow.worldFromCamera.worldFromBody = scene::WorldFromBodyRotation(attitude);
-    const ChannelCamera cameras[] = {NorthCamera({0.0, 0.0, 20.0}, 203, 150, 40.0, 3.0), narrow};
+    const std::array<ChannelCamera, 2> cameras = WideAndFireCameras(203);
     size_t nonEmpty = 0, compared = 0;
     for (const ChannelCamera& cam : cameras) {
         for (const ObscurantBand band : {ObscurantBand::Visible, ObscurantBand::Lwir}) {
