@@ -594,14 +594,15 @@ SurfaceBounds OceanSurfaceFrame::LocalBoundsNear(double x, double y, double radi
         for (const SurfWaves::Bound& b : cascades)
             local.height_m += b.height_m, local.horizontal_m += b.horizontal_m;
     } else {
-        // As BoundsNear, with the local parts in place of the whole surface's, where the disc's
-        // water is all deeper than the surf's deepest fade: there BoundAtDepths is the deep sea's
-        // bound, the sum of the parts. Nearer the shore the surf's components and depth weights
-        // enter, whose interval-by-interval bound (BoundAtDepths without its per-frame table)
-        // would cost more than the mesh saves: BoundsNear serves.
+        // As BoundsNear, with the local parts in place of the whole surface's: in water deeper
+        // than the surf's deepest fade the sum of the parts, nearer the shore each depth
+        // interval's faded parts plus the surf components (BoundAtDepths over the intervals,
+        // whose depth-dependent parts SurfWaves makes once). Taking BoundsNear there instead put
+        // the bound above a 2 m eye over 15 m of water (configs/five-channel.yaml from frame
+        // ~105), so that no sea near the eye could be culled: the FLIR's mesh grew from 51 k
+        // to 133 k vertices, all surf vertices, none visible.
         const double tide = surf_->Bathy().Tide_m();
         const double zBed = surf_->Bathy().MaxSeabedZWithin_m(x, y, radius_m + surfReach_m_);
-        if (!(tide - zBed >= surf_->FadeDeep_m())) return global;
         const SurfWaves::Bound b = surf_->BoundAtDepths(tide - zBed, cascades, gerstner);
         local = {std::max({tide + b.height_m, zBed, 0.0}), b.horizontal_m};
     }

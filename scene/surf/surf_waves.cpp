@@ -218,6 +218,12 @@ SurfWaves::SurfWaves(const Bathymetry& bathymetry, std::vector<SurfComponent> co
     }
     BuildShelters();
     BuildSwash();
+    // The interval bounds' parts with the surf weights at each interval's shallow end, as the
+    // per-frame bound table and the local bounds near a view (OceanSurfaceFrame::
+    // LocalBoundsNear, several per channel and frame) ask for them: ~800 intervals of a dozen
+    // components and two depth weights' sines each were ~0.4 ms per call.
+    intervalParts_.resize(size_t(std::max(depthSamples_ - 1, 0)));
+    for (int i = 0; i + 1 < depthSamples_; ++i) intervalParts_[size_t(i)] = Parts(i, i * dh_m_);
     // Walk up from the shore to the deepest depth where the bound 2 Σ A_j √(cg0/cg) reaches γ h
     // (energy-flux shoaling; the surf only draws its components shallower than FadeDeep_m).
     // Each component's deep group speed is its track's cg0.
@@ -437,21 +443,13 @@ SurfWaves::Bound SurfWaves::DeepBound(const std::vector<Bound>& cascades,
     return deep;
 }
 
-SurfWaves::Bound SurfWaves::IntervalBound(int i, double surfDepth_m,
-                                          const std::vector<Bound>& cascades,
-                                          const Bound& gerstner) const {
+SurfWaves::IntervalParts SurfWaves::Parts(int i, double surfDepth_m) const {
     const size_t n = incoming_.size();
     const double h0 = i * dh_m_, h1 = (i + 1) * dh_m_;
     // The deep weights grow with depth, the surf weights fall.
     const SurfWeights wDeep = Weights(h1), wSurf = Weights(surfDepth_m);
-    Bound b;
-    b.height_m = wDeep.gerstner * gerstner.height_m;
-    b.horizontal_m = wDeep.gerstner * gerstner.horizontal_m;
-    for (size_t c = 0; c < cascades.size(); ++c) {
-        const double w = cascades_.empty() ? 1.0 : wDeep.cascade[c];
-        b.height_m += w * cascades[c].height_m;
-        b.horizontal_m += w * cascades[c].horizontal_m;
-    }
+    IntervalParts parts;
+    parts.deep = wDeep;
     double amplitude = 0.0, orbit = 0.0, longest = 0.0;
     for (size_t m = 0; m < n; ++m) {
         const DepthSample& s0 = depth_[size_t(i) * n + m];
@@ -468,9 +466,36 @@ SurfWaves::Bound SurfWaves::IntervalBound(int i, double surfDepth_m,
     // Behind a bar the cap only falls (Shelter ≤ 1); the swash adds at most its maximum where
     // it reaches (depth below 2 R2).
     const double halfGammaH = 0.5 * settings_.breakerIndex * h1;
-    b.height_m += std::min(amplitude, halfGammaH);
-    if (swash_.active && h0 < 2.0 * swash_.runup2_m) b.height_m += swash_.max_m;
-    b.horizontal_m += std::min(orbit, halfGammaH * longest);
+    parts.surfHeight_m = std::min(amplitude, halfGammaH);
+    parts.swash_m = swash_.active && h0 < 2.0 * swash_.runup2_m ? swash_.max_m : 0.0;
+    parts.surfHorizontal_m = std::min(orbit, halfGammaH * longest);
+    return parts;
+}
+
+SurfWaves::Bound SurfWaves::IntervalBound(int i, double surfDepth_m,
+                                          const std::vector<Bound>& cascades,
+                                          const Bound& gerstner) const {
+    // The parts with the surf weights at the interval's shallow end are made once
+    // (intervalParts_); only a minimum depth inside the interval needs its own.
+    IntervalParts own;
+    const IntervalParts* p = &intervalParts_[size_t(i)];
+    if (surfDepth_m != i * dh_m_) {
+        own = Parts(i, surfDepth_m);
+        p = &own;
+    }
+    const IntervalParts& parts = *p;
+    Bound b;
+    b.height_m = parts.deep.gerstner * gerstner.height_m;
+    b.horizontal_m = parts.deep.gerstner * gerstner.horizontal_m;
+    for (size_t c = 0; c < cascades.size(); ++c) {
+        const double w = cascades_.empty() ? 1.0 : parts.deep.cascade[c];
+        b.height_m += w * cascades[c].height_m;
+        b.horizontal_m += w * cascades[c].horizontal_m;
+    }
+    b.height_m += parts.surfHeight_m;
+    // + 0 where the swash does not reach: x + 0 is x (the sum is never −0).
+    b.height_m += parts.swash_m;
+    b.horizontal_m += parts.surfHorizontal_m;
     return b;
 }
 

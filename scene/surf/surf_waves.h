@@ -223,9 +223,18 @@ class SurfWaves {
 
   private:
     Bound DeepBound(const std::vector<Bound>& cascades, const Bound& gerstner) const;
-    // Interval i's (depths i·dh … (i+1)·dh) bound with the surf weights at surfDepth_m.
+    // What interval i's (depths i·dh … (i+1)·dh) bound takes from the depth, with the surf
+    // weights at surfDepth_m: the deep parts' weights (at the deep end), the surf components'
+    // height and horizontal excursion, and the swash's maximum where it reaches (else 0).
+    struct IntervalParts {
+        SurfWeights deep;
+        double surfHeight_m = 0.0, swash_m = 0.0, surfHorizontal_m = 0.0;
+    };
+    IntervalParts Parts(int i, double surfDepth_m) const;
+    // Interval i's bound with the surf weights at surfDepth_m.
     Bound IntervalBound(int i, double surfDepth_m, const std::vector<Bound>& cascades,
                         const Bound& gerstner) const;
+    std::vector<IntervalParts> intervalParts_;  // Parts(i, i·dh) per interval
     template <bool kVelocity>
     SurfaceTerms TermsImpl(double x0, double y0, double t_s, SurfPointInfo* info,
                            const TermsOptions& options) const;

@@ -344,11 +344,12 @@ TEST(OceanMesh, SurfVertexHeightsMatchTheQueryAtThatPoint) {
 // hold at every vertex the mesh draws from a rest position inside the disc (whatever mip level
 // and Gerstner footprint weights its ring uses) and at the unfiltered surface there, over many
 // frames: in open water, and with a surf zone from deep water over the bar to the beach. Near
-// an eye in open water they are well below the whole surface's bound they replace.
+// an eye in open water they are well below the whole surface's bound they replace, and so they
+// are over the surf's fade zone, where the waves near the eye enter faded by the depth.
 TEST(OceanMesh, LocalBoundsHoldAtEveryVertexDrawnFromTheDisc) {
     for (const bool surf : {false, true}) {
         const OceanSurface sea(surf ? WithSurf(Beaufort5()) : Beaufort5());
-        int vertices = 0, tighter = 0;
+        int vertices = 0, tighter = 0, fadeDiscs = 0, tighterInFade = 0;
         for (int f = 0; f < 12; ++f) {
             const auto frame = sea.At(1.37 * f);
             for (const double cx : {-20.0, 120.0, 260.0, 900.0}) {
@@ -363,6 +364,15 @@ TEST(OceanMesh, LocalBoundsHoldAtEveryVertexDrawnFromTheDisc) {
                     EXPECT_LE(b.height_m, all.height_m);
                     EXPECT_LE(b.horizontal_m, all.horizontal_m);
                     if (!surf && b.height_m < 0.8 * all.height_m) ++tighter;
+                    if (surf) {
+                        const SurfWaves& w = *frame->Surf();
+                        const double shallowest =
+                            w.Bathy().Tide_m() - w.Bathy().MaxSeabedZWithin_m(eye.x, eye.y, r);
+                        if (shallowest > 0.0 && shallowest < w.FadeDeep_m()) {
+                            ++fadeDiscs;
+                            if (b.height_m < 0.8 * all.height_m) ++tighterInFade;
+                        }
+                    }
                     for (int j = 0; j < m.rings && m.radii_m[size_t(j)] <= r; ++j) {
                         const double rho = m.radii_m[size_t(j)];
                         const double drop = CurvatureDrop_m(rho);
@@ -391,6 +401,9 @@ TEST(OceanMesh, LocalBoundsHoldAtEveryVertexDrawnFromTheDisc) {
         EXPECT_GT(vertices, 10000);
         if (!surf) {
             EXPECT_GT(tighter, 24);  // of 192 discs
+        } else {
+            EXPECT_GT(fadeDiscs, 8);
+            EXPECT_GT(tighterInFade, fadeDiscs / 2) << fadeDiscs;
         }
     }
 }
