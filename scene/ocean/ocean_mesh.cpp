@@ -147,14 +147,15 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
     }
     std::vector<int64_t> bandLo(size_t(rings - 1)), bandHi(size_t(rings - 1));
     if (req.widenByReach) {
-        // Displacement bounds over discs of radius 4^k m around the eye (k = 0 … 6, then the
-        // whole sea): a band uses the smallest disc holding its outer ring. Up to 64 m the
+        // Displacement bounds over discs of radius 2^k m around the eye (k = 0 … 12, then the
+        // whole sea): a band uses the smallest disc holding its outer ring (halving the radius
+        // steps from 4^k kept 2-3 % of the five-channel views' vertices). Up to 64 m the
         // bounds of the waves near the eye (LocalBoundsNear: in the five-channel demo's surf zone
         // ~1.2 m against BoundsNear's ~1.9 m, which widened the rings within ~6 m of the eye by
         // the full 20°); farther discs cover whole cascade patches, where the local bound would
         // scan every texel for about the same value.
         std::vector<double> discR, discReach;
-        for (double R = 1.0; R < 5000.0; R *= 4.0) {
+        for (double R = 1.0; R < 5000.0; R *= 2.0) {
             discR.push_back(R);
             discReach.push_back(
                 R <= 64.0 ? frame.LocalBoundsNear(req.eye_m.x, req.eye_m.y, R).horizontal_m
