@@ -119,20 +119,44 @@ void SpansAzimuthSector(const ChannelCamera& cam, std::span<const PixelSpan> spa
     });
 }
 
+double SteepestViewDirectionZ(const ChannelCamera& cam) {
+    // Outside the nadir, the view direction nearest it lies on the frustum's boundary, four
+    // great-circle arcs between the corner rays (the image edges). On an arc from a to b, −d_z
+    // is largest at an end or where the arc passes nearest the nadir: at the nadir's projection
+    // onto the arc's plane, when that lies between a and b.
+    const double sw = cam.SampleWidth(), sh = cam.SampleHeight();
+    const glm::dvec3 corner[4] = {
+        cam.SampleDirection(-0.5, -0.5), cam.SampleDirection(sw - 0.5, -0.5),
+        cam.SampleDirection(sw - 0.5, sh - 0.5), cam.SampleDirection(-0.5, sh - 0.5)};
+    double z = 1.0;
+    for (int e = 0; e < 4; ++e) {
+        const glm::dvec3 &a = corner[e], &b = corner[(e + 1) % 4];
+        z = std::min(z, a.z);
+        const glm::dvec3 n = glm::normalize(glm::cross(a, b));
+        const glm::dvec3 p = glm::dvec3(0.0, 0.0, -1.0) + n.z * n;  // nadir minus its normal part
+        const double length = glm::length(p);
+        if (!(length > 1e-12)) continue;  // the arc's plane is horizontal: the ends suffice
+        const glm::dvec3 q = p / length;
+        if (glm::dot(glm::cross(a, q), n) >= 0.0 && glm::dot(glm::cross(q, b), n) >= 0.0)
+            z = std::min(z, q.z);
+    }
+    return z;
+}
+
 double NearestVisibleSeaRange_m(const ChannelCamera& cam, double crestHeight_m,
                                 double horizontalReach_m) {
     const double h = cam.worldFromCamera.position_m.z - crestHeight_m;
     if (h <= 0.0 || FrustumContainsNadir(cam)) return 0.0;
-    // The steepest downward view ray meets the crest plane nearest: range = h / slope.
-    double slope = 0.0;
-    ForEachFrustumBoundaryDirection(cam, [&](const glm::dvec3& d) {
-        slope = std::max(slope, -d.z / std::max(std::hypot(d.x, d.y), 1e-9));
-        return true;
-    });
-    if (slope <= 0.0) return std::numeric_limits<double>::infinity();  // no ray looks down
-    // Sampled boundary and straight-line rays: keep a 20 % margin, then allow for vertices
-    // that the waves carry horizontally toward the eye.
-    return std::max(0.0, 0.8 * h / slope - horizontalReach_m);
+    // The steepest downward view ray meets the crest plane nearest: range = h / slope, with
+    // slope = tan(depression) = −d_z / |d_xy| for unit d.
+    const double z = SteepestViewDirectionZ(cam);
+    if (z >= 0.0) return std::numeric_limits<double>::infinity();  // no ray looks down
+    const double slope = -z / std::sqrt(std::max(1.0 - z * z, 1e-18));
+    // A margin of 1e-6 for the rounding of the above; then allow for vertices that the waves
+    // carry horizontally toward the eye. (Sampling the boundary at 33 directions per edge, as
+    // this did before with a 20 % margin, missed the steepest ray near the nadir: a view 80°
+    // down with the nadir just outside it got a range up to 100 times too far.)
+    return std::max(0.0, (1.0 - 1e-6) * h / slope - horizontalReach_m);
 }
 
 double NearestVisibleSeaRange_m(const ChannelCamera& cam, const scene::OceanSurfaceFrame& sea,

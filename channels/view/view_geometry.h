@@ -94,10 +94,12 @@ void FrustumAzimuthSector(const ChannelCamera& camera, double margin_rad, double
 void SpansAzimuthSector(const ChannelCamera& camera, std::span<const PixelSpan> spans,
                         double& min_rad, double& max_rad);
 
-// Horizontal distance (m) inside which no sea can be seen by the camera: the steepest
-// downward view ray meets the plane of the highest crest, less a 20 % margin and the waves'
-// horizontal reach. 0 when the eye is below the crests or looks straight down; +∞ when no
-// view ray points down.
+// z of the unit view direction nearest the nadir among the camera's rays (its frustum's
+// boundary and inside, exactly; not meaningful when the frustum holds the nadir).
+double SteepestViewDirectionZ(const ChannelCamera& camera);
+// Horizontal distance (m) inside which no sea can be seen by the camera: where the steepest
+// downward view ray meets the plane of the highest crest, less the waves' horizontal reach.
+// 0 when the eye is below the crests or looks straight down; +∞ when no view ray points down.
 double NearestVisibleSeaRange_m(const ChannelCamera& camera, double crestHeight_m,
                                 double horizontalReach_m);
 // The same for the sea of a frame seen from eye_m: the crest and reach bounds taken over the
