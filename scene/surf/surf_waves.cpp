@@ -550,7 +550,9 @@ SurfWeights SurfWaves::Weights(double depth_m) const {
     }
     double lost = 0.0;
     for (size_t c = 0; c < cascades_.size(); ++c) {
-        const double f = Fade(depth_m, 0.5 * cascades_[c].wavelength_m);
+        // A cascade holding the peak fades with the Gerstner waves' depth: the same Fade, once.
+        const double deep = 0.5 * cascades_[c].wavelength_m;
+        const double f = deep == peakFadeDeep_m_ ? w.gerstner : Fade(depth_m, deep);
         w.cascade[c] = f;
         lost += cascades_[c].variance_m2 * (1.0 - f * f);
     }

@@ -341,6 +341,28 @@ TEST(SurfWaves, DeepWaterIsTheSeaWithoutSurf) {
     EXPECT_GT(checked, 10);
 }
 
+// Each part fades as cos of the angle (π/2)(deep − h)/(deep − deep/2) between its depths deep =
+// ½ L and ¼ L; a cascade holding the peak (Weights takes the Gerstner waves' weight for it, the
+// same fade) and a shorter one that fades on its own.
+TEST(SurfWaves, CascadeWeightsFollowTheirOwnFades) {
+    const Bathymetry b(Beach(0.05), 10.0);
+    const double peak_m = 16.0, chop_m = 6.0;
+    const SurfWaves w(b, {Wave(0.2, 3.2, 270.0)}, peak_m, {{1.0, peak_m}, {0.3, chop_m}});
+    const auto fade = [](double h, double wavelength_m) {
+        const double deep = 0.5 * wavelength_m, shallow = 0.5 * deep;
+        if (h >= deep) return 1.0;
+        if (h <= shallow) return 0.0;
+        return std::cos(0.5 * kPi * (deep - h) / (deep - shallow));
+    };
+    for (int i = 0; i <= 1000; ++i) {
+        const double h = 0.01 * i;
+        const SurfWeights sw = w.Weights(h);
+        ASSERT_NEAR(sw.gerstner, fade(h, peak_m), 1e-14) << h;
+        ASSERT_EQ(sw.cascade[0], sw.gerstner) << h;
+        ASSERT_NEAR(sw.cascade[1], fade(h, chop_m), 1e-14) << h;
+    }
+}
+
 // Terms runs its component loops eight float lanes wide in the AVX2 build (four double lanes for
 // the phases): per lane the four-lane loops' operations, their products added to the four-lane
 // sums low half then high half. So it must give TermsFourLanes' bits (the SSE2 build's loops)
