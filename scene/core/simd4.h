@@ -5,6 +5,7 @@
 #include <immintrin.h>
 
 #include <cstddef>
+#include <cstdint>
 #include <iterator>
 
 namespace seasense::simd4 {
@@ -65,39 +66,63 @@ inline F4 Acos4(F4 x) {
     return Select4(_mm_cmplt_ps(x, _mm_setzero_ps()), _mm_sub_ps(_mm_set1_ps(3.14159265f), r), r);
 }
 
-// sin x and cos x, four lanes, for |x| ≤ 4 (e.g. phases already reduced to [−π, π]), to about
+// sin x and cos x per lane, for |x| ≤ 4 (e.g. phases already reduced to [−π, π]), to about
 // 2e-7 absolute: x = n π/2 + r with |r| ≤ π/4, π/2 in three parts of which the first two have
 // short mantissas so that n times them is exact (Cody & Waite's reduction as in Cephes' sinf,
 // S. L. Moshier 1989), then the Taylor series of sin r to r⁹ and cos r to r¹⁰ (truncation
 // < 3e-9 at π/4); the quadrant n mod 4 swaps and signs the pair with masks, no branches.
-inline void SinCos4(F4 x, F4& sinX, F4& cosX) {
-    const I4 n = _mm_cvtps_epi32(_mm_mul_ps(x, _mm_set1_ps(0.63661977236f)));  // round(x 2/π)
-    const F4 fn = _mm_cvtepi32_ps(n);
-    F4 r = _mm_sub_ps(x, _mm_mul_ps(fn, _mm_set1_ps(1.5703125f)));
-    r = _mm_sub_ps(r, _mm_mul_ps(fn, _mm_set1_ps(4.837512969970703125e-4f)));
-    r = _mm_sub_ps(r, _mm_mul_ps(fn, _mm_set1_ps(7.54978995489188216e-8f)));
-    const F4 r2 = _mm_mul_ps(r, r);
-    F4 ps = _mm_set1_ps(1.0f / 362880.0f);
-    ps = _mm_add_ps(_mm_mul_ps(ps, r2), _mm_set1_ps(-1.0f / 5040.0f));
-    ps = _mm_add_ps(_mm_mul_ps(ps, r2), _mm_set1_ps(1.0f / 120.0f));
-    ps = _mm_add_ps(_mm_mul_ps(ps, r2), _mm_set1_ps(-1.0f / 6.0f));
-    const F4 s = _mm_add_ps(r, _mm_mul_ps(_mm_mul_ps(r, r2), ps));
-    F4 pc = _mm_set1_ps(-1.0f / 3628800.0f);
-    pc = _mm_add_ps(_mm_mul_ps(pc, r2), _mm_set1_ps(1.0f / 40320.0f));
-    pc = _mm_add_ps(_mm_mul_ps(pc, r2), _mm_set1_ps(-1.0f / 720.0f));
-    pc = _mm_add_ps(_mm_mul_ps(pc, r2), _mm_set1_ps(1.0f / 24.0f));
-    pc = _mm_add_ps(_mm_mul_ps(pc, r2), _mm_set1_ps(-0.5f));
-    const F4 c = _mm_add_ps(_mm_mul_ps(pc, r2), _mm_set1_ps(1.0f));
+// Written once for any float vector F (four or eight lanes, with RoundToInt for its width):
+// every lane does the same IEEE operations, so both widths give the same bits per lane.
+// Integer lanes of a float vector's width (the attribute cannot take a template's size).
+template <size_t kBytes>
+struct IntLanes;
+template <>
+struct IntLanes<16> {
+    using Type = int32_t __attribute__((vector_size(16)));
+};
+template <>
+struct IntLanes<32> {
+    using Type = int32_t __attribute__((vector_size(32)));
+};
+inline I4 RoundToInt(F4 v) { return _mm_cvtps_epi32(v); }  // nearest, ties to even
+#if defined(__AVX2__)
+using F8 = __m256;
+inline __m256i RoundToInt(F8 v) { return _mm256_cvtps_epi32(v); }
+#endif
+template <class F>
+inline void SinCosLanes(F x, F& sinX, F& cosX) {
+    using I = typename IntLanes<sizeof(F)>::Type;
+    const I n = (I)RoundToInt(x * 0.63661977236f);  // round(x 2/π)
+    const F fn = __builtin_convertvector(n, F);
+    F r = x - fn * 1.5703125f;
+    r = r - fn * 4.837512969970703125e-4f;
+    r = r - fn * 7.54978995489188216e-8f;
+    const F r2 = r * r;
+    F ps = F{} + 1.0f / 362880.0f;
+    ps = ps * r2 + -1.0f / 5040.0f;
+    ps = ps * r2 + 1.0f / 120.0f;
+    ps = ps * r2 + -1.0f / 6.0f;
+    const F s = r + r * r2 * ps;
+    F pc = F{} + -1.0f / 3628800.0f;
+    pc = pc * r2 + 1.0f / 40320.0f;
+    pc = pc * r2 + -1.0f / 720.0f;
+    pc = pc * r2 + 1.0f / 24.0f;
+    pc = pc * r2 + -0.5f;
+    const F c = pc * r2 + 1.0f;
     // Quadrant q: sin x = (s, c, −s, −c)[q], cos x = (c, −s, −c, s)[q]; bit 1 of q (of q + 1
     // for the cosine) moved to the sign bit.
-    const I4 one = _mm_set1_epi32(1), two = _mm_set1_epi32(2);
-    const F4 swap = _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(n, one), one));
-    const F4 sinSign = _mm_castsi128_ps(_mm_slli_epi32(_mm_and_si128(n, two), 30));
-    const F4 cosSign =
-        _mm_castsi128_ps(_mm_slli_epi32(_mm_and_si128(_mm_add_epi32(n, one), two), 30));
-    sinX = _mm_xor_ps(Select4(swap, c, s), sinSign);
-    cosX = _mm_xor_ps(Select4(swap, s, c), cosSign);
+    const I swap = (n & 1) == 1;
+    const I sinSign = (n & 2) << 30;
+    const I cosSign = ((n + 1) & 2) << 30;
+    sinX = (F)((I)(swap ? c : s) ^ sinSign);
+    cosX = (F)((I)(swap ? s : c) ^ cosSign);
 }
+inline void SinCos4(F4 x, F4& sinX, F4& cosX) { SinCosLanes(x, sinX, cosX); }
+
+#if defined(__AVX2__)
+// Eight lanes (AVX2): lane for lane SinCos4's operations.
+inline void SinCos8(F8 x, F8& sinX, F8& cosX) { SinCosLanes(x, sinX, cosX); }
+#endif
 
 // Lane 0 of v.
 inline float Lane0(F4 v) { return _mm_cvtss_f32(v); }

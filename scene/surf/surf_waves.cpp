@@ -2,13 +2,15 @@
 // per-point evaluation with shoaling, refraction, the breaker cap and Gerstner steepening.
 #include "scene/surf/surf_waves.h"
 
-#include <emmintrin.h>
+#include <immintrin.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numbers>
+#include <type_traits>
 
 #include "scene/core/check.h"
 #include "scene/core/simd4.h"
@@ -43,6 +45,141 @@ double Interp(const std::vector<double>& t, double x) {
     const size_t i = size_t(x);
     const double f = x - double(i);
     return t[i] + f * (t[i + 1] - t[i]);
+}
+
+// Terms' per-component loops, written once for any vector width: the phases in double lanes
+// (two with SSE2, four with AVX2), the terms in float lanes (four or eight). Each lane does the
+// same IEEE operations at either width, and eight-lane products are added to the four-lane sums
+// low half first, then high half: lane m mod 4 still sums components m, m + 4, m + 8, … in that
+// order, so the wide loops give the four-lane loops' bits (tested).
+template <class V>
+[[gnu::always_inline]] inline V LoadLanes(const void* p) {
+    V v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+}
+template <class V>
+[[gnu::always_inline]] inline void StoreLanes(void* p, V v) {
+    std::memcpy(p, &v, sizeof v);
+}
+// Every lane x: x − 0 is x for every x (x + 0 would turn −0 into +0).
+template <class V, class T>
+[[gnu::always_inline]] inline V Broadcast(T x) {
+    return x - V{};
+}
+
+// kN float lanes, the phases' reduced values.
+using Float2 = float __attribute__((vector_size(8)));
+using Float4 = float __attribute__((vector_size(16)));
+template <size_t kN>
+using FloatLanes = std::conditional_t<kN == 2, Float2, Float4>;
+
+struct PhaseInputs {
+    const double *origin, *ku, *omega, *ks0;  // per lane constants
+    const double *p0, *p1;                    // the cross-shore phases on either side
+    double pf, u_m, t_s, s_m, sRef_m;
+    bool seaward;  // beyond the phase table: ks0 · s
+};
+
+// Phases ψ of lanes m … m + |V| − 1 (into psis) and ψ reduced to [−π, π] by whole turns (in
+// float, into reduced).
+template <class V>
+[[gnu::always_inline]] inline void PhaseGroup(const PhaseInputs& in, size_t m, double* psis,
+                                              float* reduced) {
+    constexpr size_t kN = sizeof(V) / sizeof(double);
+    const V ks0 = LoadLanes<V>(in.ks0 + m);
+    V crossPhase;
+    if (in.seaward) {
+        crossPhase = ks0 * Broadcast<V>(in.s_m);
+    } else {
+        const V a = LoadLanes<V>(in.p0 + m);
+        crossPhase = ks0 * Broadcast<V>(in.sRef_m) +
+                     (a + Broadcast<V>(in.pf) * (LoadLanes<V>(in.p1 + m) - a));
+    }
+    const V psi = ((LoadLanes<V>(in.origin + m) + LoadLanes<V>(in.ku + m) * Broadcast<V>(in.u_m)) +
+                   crossPhase) -
+                  LoadLanes<V>(in.omega + m) * Broadcast<V>(in.t_s);
+    StoreLanes(psis + m, psi);
+    constexpr double kRound = 6755399441055744.0;  // 1.5 · 2⁵²: round to integer
+    const V turns = (psi * (1.0 / kTwoPi) + kRound) - kRound;
+    StoreLanes(reduced + m, __builtin_convertvector(psi - turns * kTwoPi, FloatLanes<kN>));
+}
+
+using simd4::F4;
+// The components' sums, four float lanes (lane m mod 4: components m, m + 4, …).
+struct LaneSums {
+    F4 re{}, im{}, slopeS{}, slopeU{}, orbit{}, longest{};
+    F4 dispS{}, dispU{}, tSS{}, tUU{}, tSU{};
+    F4 velS{}, velU{}, velZ{};
+};
+inline void Add(F4& sum, F4 v) { sum = _mm_add_ps(sum, v); }
+inline void Sub(F4& sum, F4 v) { sum = _mm_sub_ps(sum, v); }
+inline void Longest(F4& sum, F4 v) { sum = _mm_max_ps(sum, v); }
+#if defined(__AVX2__)
+inline void Add(F4& sum, simd4::F8 v) {
+    Add(sum, _mm256_castps256_ps128(v));
+    Add(sum, _mm256_extractf128_ps(v, 1));
+}
+inline void Sub(F4& sum, simd4::F8 v) {
+    Sub(sum, _mm256_castps256_ps128(v));
+    Sub(sum, _mm256_extractf128_ps(v, 1));
+}
+inline void Longest(F4& sum, simd4::F8 v) {
+    Longest(sum, _mm256_castps256_ps128(v));
+    Longest(sum, _mm256_extractf128_ps(v, 1));
+}
+#endif
+
+struct ComponentInputs {
+    const float* reduced;                  // reduced phases per lane
+    const float *kuF, *omegaF, *spectral;  // per lane constants
+    const float *d0, *d1;                  // the depth samples on either side (kLaneFields)
+    size_t lanes;
+    float df, spectralSurf, gerstnerSurf;
+};
+
+// Adds lanes m … m + |F| − 1 to the sums; their amplitudes into amplitudes.
+template <bool kVelocity, class F>
+[[gnu::always_inline]] inline void ComponentGroup(const ComponentInputs& in, size_t m, LaneSums& s,
+                                                  float* amplitudes) {
+    F sn, cs;
+    simd4::SinCosLanes(LoadLanes<F>(in.reduced + m), sn, cs);
+    const F ku = LoadLanes<F>(in.kuF + m), omega = LoadLanes<F>(in.omegaF + m);
+    const F df = Broadcast<F>(in.df);
+    const auto lerp = [&](size_t field) {
+        const F a = LoadLanes<F>(in.d0 + field * in.lanes + m);
+        return a + df * (LoadLanes<F>(in.d1 + field * in.lanes + m) - a);
+    };
+    // Shoaled and refracted, times the weight of the component's part in the fade.
+    const F w = LoadLanes<F>(in.spectral + m) != 0.0f ? Broadcast<F>(in.spectralSurf)
+                                                      : Broadcast<F>(in.gerstnerSurf);
+    const F a = lerp(0) * w;
+    const F invK = lerp(1), kx = lerp(2), invTanh = lerp(3);
+    StoreLanes(amplitudes + m, a);
+    const F asn = a * sn;
+    Add(s.re, a * cs);
+    Add(s.im, asn);
+    Sub(s.slopeS, asn * kx);
+    Sub(s.slopeU, asn * ku);
+    if constexpr (kVelocity) Add(s.velZ, asn * omega);
+    // The orbit a / tanh kh along the unit direction of travel (k_s, k_u) / k.
+    const F hor = a * invTanh;
+    Add(s.orbit, hor);
+    Longest(s.longest, invTanh);
+    const F eS = kx * invK, eU = ku * invK;
+    const F hs = hor * sn, hc = hor * cs;
+    Sub(s.dispS, eS * hs);
+    Sub(s.dispU, eU * hs);
+    // ∂D_i/∂x_j = −hor cos ψ e_i k_j: symmetric, three sums.
+    const F hcS = hc * eS;
+    Sub(s.tSS, hcS * kx);
+    Sub(s.tUU, hc * eU * ku);
+    Sub(s.tSU, hcS * ku);
+    if constexpr (kVelocity) {
+        const F hcw = hc * omega;
+        Add(s.velS, eS * hcw);
+        Add(s.velU, eU * hcw);
+    }
 }
 
 }  // namespace
@@ -413,7 +550,9 @@ SurfWeights SurfWaves::Weights(double depth_m) const {
     }
     double lost = 0.0;
     for (size_t c = 0; c < cascades_.size(); ++c) {
-        const double f = Fade(depth_m, 0.5 * cascades_[c].wavelength_m);
+        // A cascade holding the peak fades with the Gerstner waves' depth: the same Fade, once.
+        const double deep = 0.5 * cascades_[c].wavelength_m;
+        const double f = deep == peakFadeDeep_m_ ? w.gerstner : Fade(depth_m, deep);
         w.cascade[c] = f;
         lost += cascades_[c].variance_m2 * (1.0 - f * f);
     }
@@ -548,11 +687,17 @@ SurfWaves::Bound SurfWaves::BoundAtDepths(double minDepth_m, const BoundTable& t
 
 SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* info,
                               const TermsOptions& options) const {
-    return options.velocity ? TermsImpl<true>(x0, y0, t, info, options)
-                            : TermsImpl<false>(x0, y0, t, info, options);
+    return options.velocity ? TermsImpl<true, true>(x0, y0, t, info, options)
+                            : TermsImpl<false, true>(x0, y0, t, info, options);
 }
 
-template <bool kVelocity>
+SurfaceTerms SurfWaves::TermsFourLanes(double x0, double y0, double t, SurfPointInfo* info,
+                                       const TermsOptions& options) const {
+    return options.velocity ? TermsImpl<true, false>(x0, y0, t, info, options)
+                            : TermsImpl<false, false>(x0, y0, t, info, options);
+}
+
+template <bool kVelocity, bool kWide>
 SurfaceTerms SurfWaves::TermsImpl(double x0, double y0, double t, SurfPointInfo* info,
                                   const TermsOptions& options) const {
     SurfaceTerms out;
@@ -603,98 +748,63 @@ SurfaceTerms SurfWaves::TermsImpl(double x0, double y0, double t, SurfPointInfo*
     const double* p0 = lanePhase_.data() + pi * lanes;
     const double* p1 = p0 + lanes;
 
-    // The phases two at a time in double precision (they grow with time and distance), reduced
-    // to [−π, π] by whole turns; their sines and cosines then four at a time in single precision
-    // (simd4::SinCos4, ~2e-7), and the components' terms summed four at a time in single
-    // precision too (lane m mod 4 holds components m, m + 4, ...; the lanes reduced in double as
-    // (0 + 2) + (1 + 3) at the end): a fixed order, so the mesh and the queries, which both come
-    // here, get the same bits. The surface is stored in floats and a sum of ≤ 20 float terms of
-    // ≤ a few metres is good to ~1e-6 m, so nothing visible is lost, and four lanes cost half of
-    // two. Everything is summed before the breaker cap and the steepness Q, which scale whole
-    // sums (below); the tensors and vectors are summed in the shore frame and turned to the world
-    // once.
-    const __m128d vpf = _mm_set1_pd(pf);
-    const __m128d vu = _mm_set1_pd(p.u_m), vt = _mm_set1_pd(t);
-    const __m128d vs = _mm_set1_pd(p.s_m), vsRef = _mm_set1_pd(sRef_m_);
-    const bool seaward = p.s_m >= sRef_m_;
-    const auto lerp = [&](const double* a, const double* b, __m128d f) {
-        const __m128d va = _mm_loadu_pd(a);
-        return _mm_add_pd(va, _mm_mul_pd(f, _mm_sub_pd(_mm_loadu_pd(b), va)));
-    };
-    alignas(16) std::array<double, kMaxSurfComponents> psis;
-    alignas(16) std::array<float, kMaxSurfComponents> reduced;
-    const __m128d kRound = _mm_set1_pd(6755399441055744.0);  // 1.5 · 2⁵²: round to integer
-    for (size_t m = 0; m < lanes; m += 2) {
-        const __m128d ks0 = _mm_loadu_pd(&laneKs0_[m]);
-        const __m128d crossPhase =
-            seaward ? _mm_mul_pd(ks0, vs)
-                    : _mm_add_pd(_mm_mul_pd(ks0, vsRef), lerp(p0 + m, p1 + m, vpf));
-        const __m128d psi =
-            _mm_sub_pd(_mm_add_pd(_mm_add_pd(_mm_loadu_pd(&laneOrigin_[m]),
-                                             _mm_mul_pd(_mm_loadu_pd(&laneKu_[m]), vu)),
-                                  crossPhase),
-                       _mm_mul_pd(_mm_loadu_pd(&laneOmega_[m]), vt));
-        _mm_store_pd(&psis[m], psi);
-        const __m128d turns =
-            _mm_sub_pd(_mm_add_pd(_mm_mul_pd(psi, _mm_set1_pd(1.0 / kTwoPi)), kRound), kRound);
-        _mm_storel_pi(reinterpret_cast<__m64*>(&reduced[m]),
-                      _mm_cvtpd_ps(_mm_sub_pd(psi, _mm_mul_pd(turns, _mm_set1_pd(kTwoPi)))));
-    }
-    using simd4::F4;
-    const F4 vdf = _mm_set1_ps(float(df));
-    const F4 vws = _mm_set1_ps(float(weights.spectralSurf));
-    const F4 vwg = _mm_set1_ps(float(weights.gerstnerSurf));
-    const F4 zero = _mm_setzero_ps();
-    const auto lerp4 = [&](const float* a, const float* b) {
-        const F4 va = _mm_load_ps(a);
-        return _mm_add_ps(va, _mm_mul_ps(vdf, _mm_sub_ps(_mm_load_ps(b), va)));
-    };
-    F4 re = zero, im = zero, slopeS = zero, slopeU = zero, orbit = zero, longest = zero;
-    F4 dispS = zero, dispU = zero, tSS = zero, tUU = zero, tSU = zero;
-    [[maybe_unused]] F4 velS = zero, velU = zero, velZ = zero;
-    alignas(16) std::array<float, kMaxSurfComponents> amplitudes;
-    for (size_t m = 0; m < lanes; m += 4) {
-        F4 sn, cs;
-        simd4::SinCos4(_mm_load_ps(&reduced[m]), sn, cs);
-        const F4 ku = _mm_load_ps(&laneKuF_[m]), omega = _mm_load_ps(&laneOmegaF_[m]);
-        // Shoaled and refracted, times the weight of the component's part in the fade.
-        const F4 w = simd4::Select4(_mm_cmpneq_ps(_mm_load_ps(&laneSpectral_[m]), zero), vws, vwg);
-        const F4 a = _mm_mul_ps(lerp4(d0 + m, d1 + m), w);
-        const F4 invK = lerp4(d0 + lanes + m, d1 + lanes + m);
-        const F4 kx = lerp4(d0 + 2 * lanes + m, d1 + 2 * lanes + m);
-        const F4 invTanh = lerp4(d0 + 3 * lanes + m, d1 + 3 * lanes + m);
-        _mm_store_ps(&amplitudes[m], a);
-        const F4 asn = _mm_mul_ps(a, sn);
-        re = _mm_add_ps(re, _mm_mul_ps(a, cs));
-        im = _mm_add_ps(im, asn);
-        slopeS = _mm_sub_ps(slopeS, _mm_mul_ps(asn, kx));
-        slopeU = _mm_sub_ps(slopeU, _mm_mul_ps(asn, ku));
-        if constexpr (kVelocity) velZ = _mm_add_ps(velZ, _mm_mul_ps(asn, omega));
-        // The orbit a / tanh kh along the unit direction of travel (k_s, k_u) / k.
-        const F4 hor = _mm_mul_ps(a, invTanh);
-        orbit = _mm_add_ps(orbit, hor);
-        longest = _mm_max_ps(longest, invTanh);
-        const F4 eS = _mm_mul_ps(kx, invK), eU = _mm_mul_ps(ku, invK);
-        const F4 hs = _mm_mul_ps(hor, sn), hc = _mm_mul_ps(hor, cs);
-        dispS = _mm_sub_ps(dispS, _mm_mul_ps(eS, hs));
-        dispU = _mm_sub_ps(dispU, _mm_mul_ps(eU, hs));
-        // ∂D_i/∂x_j = −hor cos ψ e_i k_j: symmetric, three sums.
-        const F4 hcS = _mm_mul_ps(hc, eS);
-        tSS = _mm_sub_ps(tSS, _mm_mul_ps(hcS, kx));
-        tUU = _mm_sub_ps(tUU, _mm_mul_ps(_mm_mul_ps(hc, eU), ku));
-        tSU = _mm_sub_ps(tSU, _mm_mul_ps(hcS, ku));
-        if constexpr (kVelocity) {
-            const F4 hcw = _mm_mul_ps(hc, omega);
-            velS = _mm_add_ps(velS, _mm_mul_ps(eS, hcw));
-            velU = _mm_add_ps(velU, _mm_mul_ps(eU, hcw));
-        }
-    }
+    // The phases two (AVX2: four) at a time in double precision (they grow with time and
+    // distance), reduced to [−π, π] by whole turns; their sines and cosines then four (AVX2:
+    // eight) at a time in single precision (simd4::SinCosLanes, ~2e-7), and the components'
+    // terms summed four at a time in single precision too (lane m mod 4 holds components m, m + 4,
+    // ...; the lanes reduced in double as (0 + 2) + (1 + 3) at the end): a fixed order, so the mesh
+    // and the queries, which both come here, get the same bits. The surface is stored in floats and
+    // a sum of ≤ 20 float terms of ≤ a few metres is good to ~1e-6 m, so nothing visible is lost,
+    // and four lanes cost half of two. Everything is summed before the breaker cap and the
+    // steepness Q, which scale whole sums (below); the tensors and vectors are summed in the shore
+    // frame and turned to the world once.
+    const PhaseInputs phaseIn{laneOrigin_.data(),
+                              laneKu_.data(),
+                              laneOmega_.data(),
+                              laneKs0_.data(),
+                              p0,
+                              p1,
+                              pf,
+                              p.u_m,
+                              t,
+                              p.s_m,
+                              sRef_m_,
+                              p.s_m >= sRef_m_};
+    alignas(32) std::array<double, kMaxSurfComponents> psis;
+    alignas(32) std::array<float, kMaxSurfComponents> reduced;
+    size_t lane = 0;
+#if defined(__AVX2__)
+    if constexpr (kWide)
+        for (; lane + 4 <= lanes; lane += 4)
+            PhaseGroup<__m256d>(phaseIn, lane, psis.data(), reduced.data());
+#endif
+    for (; lane < lanes; lane += 2) PhaseGroup<__m128d>(phaseIn, lane, psis.data(), reduced.data());
+    const ComponentInputs in{reduced.data(),
+                             laneKuF_.data(),
+                             laneOmegaF_.data(),
+                             laneSpectral_.data(),
+                             d0,
+                             d1,
+                             lanes,
+                             float(df),
+                             float(weights.spectralSurf),
+                             float(weights.gerstnerSurf)};
+    LaneSums sums;
+    alignas(32) std::array<float, kMaxSurfComponents> amplitudes;
+    lane = 0;
+#if defined(__AVX2__)
+    if constexpr (kWide)
+        for (; lane + 8 <= lanes; lane += 8)
+            ComponentGroup<kVelocity, simd4::F8>(in, lane, sums, amplitudes.data());
+#endif
+    for (; lane < lanes; lane += 4)
+        ComponentGroup<kVelocity, F4>(in, lane, sums, amplitudes.data());
     // (lane 0 + lane 2) + (lane 1 + lane 3), in double.
     const auto sum = [](F4 v) {
         const __m128d pairs = _mm_add_pd(_mm_cvtps_pd(v), _mm_cvtps_pd(_mm_movehl_ps(v, v)));
         return _mm_cvtsd_f64(_mm_add_sd(pairs, _mm_unpackhi_pd(pairs, pairs)));
     };
-    const double envelopeRe = sum(re), envelopeIm = sum(im);
+    const double envelopeRe = sum(sums.re), envelopeIm = sum(sums.im);
     const double A = std::sqrt(envelopeRe * envelopeRe + envelopeIm * envelopeIm);
     // Behind a sandbar only the energy flux the bar let through arrives (Shelter).
     const double shelter = Shelter(p.s_m, p.u_m, h);
@@ -708,14 +818,14 @@ SurfaceTerms SurfWaves::TermsImpl(double x0, double y0, double t, SurfPointInfo*
     const glm::dvec2 es = bathy_.Frame().WorldFromShoreDirection({1.0, 0.0});
     const glm::dvec2 eu = bathy_.Frame().WorldFromShoreDirection({0.0, 1.0});
     out.displacement.z += cap * envelopeRe;
-    const glm::dvec2 slope = cap * (sum(slopeS) * es + sum(slopeU) * eu);
+    const glm::dvec2 slope = cap * (sum(sums.slopeS) * es + sum(sums.slopeU) * eu);
     out.sx = slope.x;
     out.sy = slope.y;
-    if constexpr (kVelocity) out.velocity_mps.z = cap * sum(velZ);
+    if constexpr (kVelocity) out.velocity_mps.z = cap * sum(sums.velZ);
     const double qc = q * cap;
-    const glm::dvec2 horizontal = qc * (sum(dispS) * es + sum(dispU) * eu);
+    const glm::dvec2 horizontal = qc * (sum(sums.dispS) * es + sum(sums.dispU) * eu);
     // The tensor T = R T_shore Rᵀ with R's columns es, eu.
-    const double ss = qc * sum(tSS), uu = qc * sum(tUU), su = qc * sum(tSU);
+    const double ss = qc * sum(sums.tSS), uu = qc * sum(sums.tUU), su = qc * sum(sums.tSU);
     const double dxx = ss * es.x * es.x + 2.0 * su * es.x * eu.x + uu * eu.x * eu.x;
     const double dyy = ss * es.y * es.y + 2.0 * su * es.y * eu.y + uu * eu.y * eu.y;
     const double dxy = ss * es.x * es.y + su * (es.x * eu.y + eu.x * es.y) + uu * eu.x * eu.y;
@@ -726,10 +836,10 @@ SurfaceTerms SurfWaves::TermsImpl(double x0, double y0, double t, SurfPointInfo*
     // field by one factor keeps its direction; the factor's own gradient is left out of the
     // Jacobian terms.
     alignas(16) std::array<float, 4> longestLanes;
-    _mm_store_ps(longestLanes.data(), longest);
+    _mm_store_ps(longestLanes.data(), sums.longest);
     const double longestInvTanh =
         double(std::max({longestLanes[0], longestLanes[1], longestLanes[2], longestLanes[3]}));
-    const double limit = std::min(cap * sum(orbit), 0.5 * gammaH * longestInvTanh);
+    const double limit = std::min(cap * sum(sums.orbit), 0.5 * gammaH * longestInvTanh);
     const double len = std::sqrt(horizontal.x * horizontal.x + horizontal.y * horizontal.y);
     const double f = len > limit && len > 0.0 ? limit / len : 1.0;
     out.displacement.x = f * horizontal.x;
@@ -738,7 +848,7 @@ SurfaceTerms SurfWaves::TermsImpl(double x0, double y0, double t, SurfPointInfo*
     out.dyy = f * dyy;
     out.dxy = f * dxy;
     if constexpr (kVelocity) {
-        const glm::dvec2 horizontalVelocity = qc * (sum(velS) * es + sum(velU) * eu);
+        const glm::dvec2 horizontalVelocity = qc * (sum(sums.velS) * es + sum(sums.velU) * eu);
         out.velocity_mps.x = f * horizontalVelocity.x;
         out.velocity_mps.y = f * horizontalVelocity.y;
     }

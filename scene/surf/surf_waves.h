@@ -153,6 +153,10 @@ class SurfWaves {
     }
     SurfaceTerms Terms(double x0, double y0, double t_s, SurfPointInfo* info,
                        const TermsOptions& options) const;
+    // Terms with its component loops four float lanes wide, as the SSE2 build runs them: the
+    // reference the AVX2 build's eight-lane loops must equal bit for bit (tests).
+    SurfaceTerms TermsFourLanes(double x0, double y0, double t_s, SurfPointInfo* info,
+                                const TermsOptions& options) const;
 
     // Upper bounds of the sea at still-water depths ≥ minDepth_m: its height above the tide and
     // its horizontal displacement (m). The deep parts enter with their own bounds (each FFT
@@ -235,7 +239,9 @@ class SurfWaves {
     Bound IntervalBound(int i, double surfDepth_m, const std::vector<Bound>& cascades,
                         const Bound& gerstner) const;
     std::vector<IntervalParts> intervalParts_;  // Parts(i, i·dh) per interval
-    template <bool kVelocity>
+    // kWide: the per-component loops eight float (four double) lanes at a time where the build
+    // targets AVX2, else four (two) as in the SSE2 build.
+    template <bool kVelocity, bool kWide>
     SurfaceTerms TermsImpl(double x0, double y0, double t_s, SurfPointInfo* info,
                            const TermsOptions& options) const;
     void BuildSwash();

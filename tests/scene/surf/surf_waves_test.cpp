@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <bit>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numbers>
 
@@ -337,6 +339,70 @@ TEST(SurfWaves, DeepWaterIsTheSeaWithoutSurf) {
         ++checked;
     }
     EXPECT_GT(checked, 10);
+}
+
+// Each part fades as cos of the angle (π/2)(deep − h)/(deep − deep/2) between its depths deep =
+// ½ L and ¼ L; a cascade holding the peak (Weights takes the Gerstner waves' weight for it, the
+// same fade) and a shorter one that fades on its own.
+TEST(SurfWaves, CascadeWeightsFollowTheirOwnFades) {
+    const Bathymetry b(Beach(0.05), 10.0);
+    const double peak_m = 16.0, chop_m = 6.0;
+    const SurfWaves w(b, {Wave(0.2, 3.2, 270.0)}, peak_m, {{1.0, peak_m}, {0.3, chop_m}});
+    const auto fade = [](double h, double wavelength_m) {
+        const double deep = 0.5 * wavelength_m, shallow = 0.5 * deep;
+        if (h >= deep) return 1.0;
+        if (h <= shallow) return 0.0;
+        return std::cos(0.5 * kPi * (deep - h) / (deep - shallow));
+    };
+    for (int i = 0; i <= 1000; ++i) {
+        const double h = 0.01 * i;
+        const SurfWeights sw = w.Weights(h);
+        ASSERT_NEAR(sw.gerstner, fade(h, peak_m), 1e-14) << h;
+        ASSERT_EQ(sw.cascade[0], sw.gerstner) << h;
+        ASSERT_NEAR(sw.cascade[1], fade(h, chop_m), 1e-14) << h;
+    }
+}
+
+// Terms runs its component loops eight float lanes wide in the AVX2 build (four double lanes for
+// the phases): per lane the four-lane loops' operations, their products added to the four-lane
+// sums low half then high half. So it must give TermsFourLanes' bits (the SSE2 build's loops)
+// everywhere: component counts that fill the wide lanes, leave a four-lane tail, or fit only the
+// tail; with and without velocity; on land, in the surf and past the fades.
+TEST(SurfWaves, WideLanesGiveTheFourLaneBits) {
+    const Bathymetry b(Beach(0.05), 10.0);
+    const auto bits = [](double v) { return std::bit_cast<uint64_t>(v); };
+    for (const size_t count : {1u, 5u, 8u, 13u, 19u}) {
+        std::vector<SurfComponent> components;
+        for (size_t j = 0; j < count; ++j) {
+            SurfComponent c = Wave(0.05 + 0.03 * double(j % 5), 5.0 + 0.7 * double(j),
+                                   270.0 + 50.0 * std::sin(1.3 * double(j)));
+            c.phase_rad = 0.9 * double(j);
+            c.spectral = j % 3 != 0;
+            components.push_back(c);
+        }
+        const SurfWaves w(b, components, 60.0);
+        size_t surfPoints = 0;
+        for (int i = 0; i < 4000; ++i) {
+            const double x = -15.0 + 0.16 * i, y = 40.0 * std::sin(0.11 * i);
+            const double t = 1e3 * std::sin(0.07 * i) + 0.013 * i;
+            for (const bool velocity : {true, false}) {
+                SurfWaves::TermsOptions options;
+                options.velocity = velocity;
+                SurfPointInfo wideInfo, fourInfo;
+                const SurfaceTerms wide = w.Terms(x, y, t, &wideInfo, options);
+                const SurfaceTerms four = w.TermsFourLanes(x, y, t, &fourInfo, options);
+                ASSERT_EQ(std::memcmp(&wide, &four, sizeof wide), 0) << count << " " << x;
+                for (const auto field :
+                     {&SurfPointInfo::envelope_m, &SurfPointInfo::unbrokenHeight_m,
+                      &SurfPointInfo::direction_rad, &SurfPointInfo::phaseSpeed_mps,
+                      &SurfPointInfo::groupSpeed_mps, &SurfPointInfo::phase_rad})
+                    ASSERT_EQ(bits(wideInfo.*field), bits(fourInfo.*field)) << count << " " << x;
+                ASSERT_EQ(bits(wideInfo.breaking.intensity), bits(fourInfo.breaking.intensity));
+                if (velocity && wideInfo.surfWeight > 0.0 && wideInfo.depth_m > 0.0) ++surfPoints;
+            }
+        }
+        EXPECT_GT(surfPoints, 1000u) << count;  // the sums ran, not only the early returns
+    }
 }
 
 }  // namespace
