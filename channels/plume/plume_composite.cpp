@@ -23,6 +23,7 @@
 #include "radiometry/bands/builtin_bands.h"
 #include "radiometry/color/rec709.h"
 #include "scene/core/check.h"
+#include "scene/core/simd_lanes.h"
 
 namespace seasense::channels {
 
@@ -72,6 +73,19 @@ auto ThermalEmission(const BandTrace& t, const Emission& emit) {
     return sum;
 }
 
+// ThermalEmission(t, *light.glow): the glow table is zero below kMinT_K, so a trace with no hot
+// part and a temperature below it glows with exactly +0 (its rest temperature is its
+// temperature), which the look-ups are skipped for.
+glm::vec3 VisibleGlow(const BandTrace& t, const PlumeLighting& light) {
+    if (!(t.hotFraction > 0.0f) && !(t.temperature_K >= float(BlackbodyGlowTable::kMinT_K)))
+        return glm::vec3(0.0f);
+    return ThermalEmission(t, [&](float T_K) { return (*light.glow)(T_K); });
+}
+
+}  // namespace
+
+namespace plume_detail {
+
 float InfraredSource(const BandTrace& t, const PlumeLighting& light) {
     const float omega = t.albedo;
     return omega * light.ambient + (1.0f - omega) * ThermalEmission(t, [&](float T_K) {
@@ -79,9 +93,6 @@ float InfraredSource(const BandTrace& t, const PlumeLighting& light) {
                                                          : 0.0f;
                                    });
 }
-}  // namespace
-
-namespace plume_detail {
 
 BandTrace Bilinear(const BandTrace* const t[4], float fx, float fy) {
     const float w[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
@@ -206,8 +217,7 @@ void VisibleSource4(const BandTrace* const t[4], const glm::mat3& worldFromCamer
     // The glow per lane (table look-ups).
     glm::vec3 glow[4] = {glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f)};
     if (light.glow)
-        for (int l = 0; l < n; ++l)
-            glow[l] = ThermalEmission(*t[l], [&](float T_K) { return (*light.glow)(T_K); });
+        for (int l = 0; l < n; ++l) glow[l] = VisibleGlow(*t[l], light);
     alignas(16) float S[3][4];
     for (int c = 0; c < 3; ++c) {
         __m128 Sc =
@@ -220,12 +230,115 @@ void VisibleSource4(const BandTrace* const t[4], const glm::mat3& worldFromCamer
     for (int l = 0; l < n; ++l) out[l] = glm::vec3(S[0][l], S[1][l], S[2][l]);
 }
 
+namespace {
+// Bilinear4's sums on simd lanes: the blend of corners t at (x, y), before the quotients.
+struct BlendSums {
+    simd::VF depth{}, scattering{}, absorbing{}, temperature{}, hot{}, hotT{}, gs{};
+    BlendSums(const BandTrace* const t[4], simd::VF x, simd::VF y) {
+        using simd::VF;
+        const VF x1 = 1.0f - x, y1 = 1.0f - y;
+        const VF w[4] = {x1 * y1, x * y1, x1 * y, x * y};
+        for (int c = 0; c < 4; ++c) {
+            const VF wt = w[c] * t[c]->opticalDepth;
+            depth = depth + wt;
+            const VF ws = wt * t[c]->albedo;
+            scattering = scattering + ws;
+            gs = gs + ws * t[c]->asymmetry;
+            const VF wa = wt * (1.0f - t[c]->albedo);
+            absorbing = absorbing + wa;
+            temperature = temperature + wa * t[c]->temperature_K;
+            const VF wh = wa * t[c]->hotFraction;
+            hot = hot + wh;
+            hotT = hotT + wh * t[c]->hotTemperature_K;
+        }
+    }
+    // Bilinear4's quotients (0 where it takes 0).
+    simd::VF Albedo() const { return simd::Select(depth > 0.0f, scattering / depth, simd::VF{}); }
+    simd::VF Asymmetry() const {
+        return simd::Select(scattering > 0.0f, gs / scattering, simd::VF{});
+    }
+    simd::VF Temperature() const {
+        return simd::Select(absorbing > 0.0f, temperature / absorbing, simd::VF{});
+    }
+    simd::VF HotFraction() const {
+        return simd::Select(absorbing > 0.0f, simd::Min(hot / absorbing, simd::Splat(1.0f)),
+                            simd::VF{});
+    }
+    simd::VF HotTemperature() const { return simd::Select(hot > 0.0f, hotT / hot, simd::VF{}); }
+};
+}  // namespace
+
+void BlendedVisibleSources(const BandTrace* const t[4], const float* fx, const float* fy,
+                           const float* a, const float* b, int n, const glm::mat3& worldFromCamera,
+                           const PlumeLighting& light, float* tau, glm::vec3* S) {
+    using simd::VF;
+    constexpr int kLanes = int(simd::kLanes);
+    for (int k = 0; k < n; k += kLanes) {
+        const size_t m = size_t(std::min(kLanes, n - k));
+        const BlendSums blend(t, simd::Load(fx + k, m), simd::Load(fy + k, m));
+        const VF omega = blend.Albedo(), g = blend.Asymmetry();
+        // VisibleSource4's direction, phase function and source.
+        const VF av = simd::Load(a + k, m), bv = simd::Load(b + k, m);
+        VF v[3];
+        for (int r = 0; r < 3; ++r)
+            v[r] = (worldFromCamera[0][r] * av + simd::Splat(worldFromCamera[1][r] * 1.0f)) +
+                   worldFromCamera[2][r] * bv;
+        const VF inv = 1.0f / simd::Sqrt((v[0] * v[0] + v[1] * v[1]) + v[2] * v[2]);
+        VF toEye[3];
+        for (int r = 0; r < 3; ++r) toEye[r] = -(v[r] * inv);
+        const VF cosTheta = -((light.sunDirection.x * toEye[0] + light.sunDirection.y * toEye[1]) +
+                              light.sunDirection.z * toEye[2]);
+        const VF gg = g * g;
+        const VF denom = (1.0f + gg) - (2.0f * g) * cosTheta;
+        const VF phase = (1.0f - gg) / (((4.0f * kPi) * denom) * simd::Sqrt(denom));
+        alignas(32) float Sc[3][kLanes];
+        for (int c = 0; c < 3; ++c)
+            simd::Store(Sc[c], omega * (light.sunIlluminance[c] * phase + light.ambientRgb[c]));
+        simd::Store(tau + k, blend.depth, m);
+        if (light.glow) {
+            // The glow per lane (table look-ups) from the blended temperatures.
+            alignas(32) float f[4][kLanes];
+            simd::Store(f[0], blend.Temperature()), simd::Store(f[1], blend.HotFraction());
+            simd::Store(f[2], blend.HotTemperature()), simd::Store(f[3], 1.0f - omega);
+            for (size_t l = 0; l < m; ++l) {
+                BandTrace one;
+                one.temperature_K = f[0][l], one.hotFraction = f[1][l];
+                one.hotTemperature_K = f[2][l];
+                const glm::vec3 glow = VisibleGlow(one, light);
+                for (int c = 0; c < 3; ++c) Sc[c][l] = Sc[c][l] + f[3][l] * glow[c];
+            }
+        }
+        for (size_t l = 0; l < m; ++l) S[size_t(k) + l] = glm::vec3(Sc[0][l], Sc[1][l], Sc[2][l]);
+    }
+}
+
+void BlendedInfraredSources(const BandTrace* const t[4], const float* fx, const float* fy, int n,
+                            const PlumeLighting& light, float* tau, float* S) {
+    constexpr int kLanes = int(simd::kLanes);
+    for (int k = 0; k < n; k += kLanes) {
+        const size_t m = size_t(std::min(kLanes, n - k));
+        const BlendSums blend(t, simd::Load(fx + k, m), simd::Load(fy + k, m));
+        alignas(32) float f[4][kLanes];
+        simd::Store(tau + k, blend.depth, m);
+        simd::Store(f[0], blend.Albedo()), simd::Store(f[1], blend.Temperature());
+        simd::Store(f[2], blend.HotFraction()), simd::Store(f[3], blend.HotTemperature());
+        for (size_t l = 0; l < m; ++l) {
+            BandTrace one;
+            one.opticalDepth = tau[size_t(k) + l];
+            one.albedo = f[0][l], one.temperature_K = f[1][l];
+            one.hotFraction = f[2][l], one.hotTemperature_K = f[3][l];
+            S[size_t(k) + l] = one.opticalDepth > 0.0f ? InfraredSource(one, light) : 0.0f;
+        }
+    }
+}
+
 }  // namespace plume_detail
 
 namespace {
 
 using plume_detail::Bilinear;
 using plume_detail::Bilinear4;
+using plume_detail::InfraredSource;
 using plume_detail::VisibleSource;
 
 // One row of cells' lists (cell cx's is lists' list cx).
@@ -1008,6 +1121,46 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                         DeferBlended(corner, blendFx, blendFy, blendPx, blendPy, blended);
                         ApplyCell(pendingTrace, pendingPx, pendingPy, pending);
                     };
+                    // The pixels of a whole sky cell that is smooth: each blended from the cell's
+                    // corners (but the centre pixel when the centre test traced it) with its
+                    // source function made on the blend's lanes (BlendedVisibleSources and
+                    // BlendedInfraredSources, the bits of Bilinear4 and the one-pixel source
+                    // functions), then composited as ApplyCell does.
+                    const auto BlendWholeSkyCell = [&] {
+                        float fx[kCellPixels], fy[kCellPixels], a[kCellPixels], b[kCellPixels];
+                        int px[kCellPixels], py[kCellPixels], n = 0;
+                        for (int ly = 0; ly < kCell; ++ly)
+                            for (int lx = 0; lx < kCell; ++lx) {
+                                if (centreTraced && lx == kHalf && ly == kHalf) continue;
+                                fx[n] = float(lx) / kCell, fy[n] = float(ly) / kCell;
+                                px[n] = cx * kCell + lx, py[n] = cy * kCell + ly;
+                                a[n] = colA[size_t(px[n])], b[n] = rowB[size_t(py[n])];
+                                ++n;
+                            }
+                        float tau[kCellPixels];
+                        if (visible) {
+                            glm::vec3 S[kCellPixels];
+                            plume_detail::BlendedVisibleSources(corner, fx, fy, a, b, n,
+                                                                worldFromCamera, light, tau, S);
+                            for (int l = 0; l < n; ++l) {
+                                if (!(tau[l] > 0.0f)) continue;
+                                const float Sl[3] = {S[l].x, S[l].y, S[l].z};
+                                CompositeAll(px[l], py[l], std::exp(-tau[l]), Sl);
+                            }
+                        } else {
+                            float S[kCellPixels];
+                            plume_detail::BlendedInfraredSources(corner, fx, fy, n, light, tau, S);
+                            for (int l = 0; l < n; ++l) {
+                                if (!(tau[l] > 0.0f)) continue;
+                                const float Sl[3] = {S[l], 0.0f, 0.0f};
+                                CompositeAll(px[l], py[l], std::exp(-tau[l]), Sl);
+                            }
+                        }
+                        if (centreTraced) {
+                            const int cpx = cx * kCell + kHalf, cpy = cy * kCell + kHalf;
+                            ApplyCell(&sub[1][1], &cpx, &cpy, 1);
+                        }
+                    };
                     // A whole cell whose every sample sees the sky, clear or smooth (after the
                     // centre test), takes what the loop below would give each of its pixels
                     // (nothing, or the blend of its corners; the centre pixel its own trace),
@@ -1018,11 +1171,8 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                         if (!clearSky && !smooth && !fine) smooth = CentreMatches();
                         if (clearSky || smooth) {
                             covered += uint64_t(kCellPixels);
-                            if (!clearSky)
-                                for (int py = cy * kCell; py < (cy + 1) * kCell; ++py)
-                                    for (int px = cx * kCell; px < (cx + 1) * kCell; ++px)
-                                        BlendSky(px, py);
-                            BlendAndApply();
+                            if (clearSky) continue;
+                            BlendWholeSkyCell();
                             continue;
                         }
                     }

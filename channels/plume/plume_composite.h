@@ -96,6 +96,21 @@ glm::vec3 VisibleSource(const BandTrace& t, const glm::vec3& toEye, const PlumeL
 // t[l], a[l], b[l] too and dropped.
 void VisibleSource4(const BandTrace* const t[4], const glm::mat3& worldFromCamera, const float a[4],
                     const float b[4], int n, const PlumeLighting& light, glm::vec3 out[4]);
+// For the n pixels l of a cell blended from its corners t: Bilinear(t, fx[l], fy[l])'s optical
+// depth into tau[l] and its VisibleSource along −normalize(worldFromCamera · (a[l], 1, b[l]))
+// into S[l], simd::kLanes pixels at a time with the blended traces kept in registers (the same
+// operations lane for lane as Bilinear4 and VisibleSource4, so each pixel has the bits of the
+// one-pixel forms: tested).
+void BlendedVisibleSources(const BandTrace* const t[4], const float* fx, const float* fy,
+                           const float* a, const float* b, int n, const glm::mat3& worldFromCamera,
+                           const PlumeLighting& light, float* tau, glm::vec3* S);
+// The infrared source function S of PlumeLighting for trace t.
+float InfraredSource(const BandTrace& t, const PlumeLighting& light);
+// For the n pixels l of a cell blended from its corners t: Bilinear(t, fx[l], fy[l])'s optical
+// depth into tau[l] and, where it is positive, its InfraredSource into S[l] (else 0), the
+// blends simd::kLanes pixels at a time (the bits of the one-pixel forms: tested).
+void BlendedInfraredSources(const BandTrace* const t[4], const float* fx, const float* fy, int n,
+                            const PlumeLighting& light, float* tau, float* S);
 }  // namespace plume_detail
 
 struct PlumeCompositeStats {

@@ -126,6 +126,16 @@ PlumeLighting Sunlit(const BlackbodyGlowTable& glow) {
     return light;
 }
 
+// LWIR with an ambient of a 280 K blackbody (the table of band radiances kept by the caller).
+PlumeLighting Lwir(const radiometry::BandRadianceTable& table) {
+    PlumeLighting light;
+    light.kind = PlumeLighting::Kind::Infrared;
+    light.band = ObscurantBand::Lwir;
+    light.planck = &table;
+    light.ambient = float(radiometry::BandRadiance(radiometry::BuiltinBand("LWIR"), 280.0));
+    return light;
+}
+
 TEST(PlumeComposite, PuffTransmittanceMatchesLineIntegral) {
     const glm::dvec3 eye{0.0, 0.0, 10.0};
     scene::Puff puff;
@@ -175,11 +185,7 @@ TEST(PlumeComposite, ThickFlameShowsItsTemperatureInTheInfrared) {
     const scene::PlumeField field = OnePlume(scene::PlumeKind::Flame, albedo, {flame});
     const radiometry::Band lwir = radiometry::BuiltinBand("LWIR");
     const radiometry::BandRadianceTable table(lwir);
-    PlumeLighting light;
-    light.kind = PlumeLighting::Kind::Infrared;
-    light.band = ObscurantBand::Lwir;
-    light.planck = &table;
-    light.ambient = float(radiometry::BandRadiance(lwir, 280.0));
+    const PlumeLighting light = Lwir(table);
     const ChannelCamera cam = NorthCamera(eye, 21, 15, 1);
     const VisibilityBuffer vis = SkyOnly(cam);
     Image radiance(cam.SampleWidth(), cam.SampleHeight(), 1);
@@ -735,6 +741,79 @@ TEST(PlumeComposite, FourPixelFormsMatchTheOnePixelForms) {
             }
         }
     }
+}
+
+// The whole-sky-cell form gives each pixel the bits of the one-pixel forms: Bilinear's optical
+// depth and VisibleSource of the blend along the pixel's direction, over corners of every kind,
+// any number of pixels (a last group of fewer than the lanes), with and without the glow.
+TEST(PlumeComposite, BlendedVisibleSourcesMatchTheOnePixelForms) {
+    const std::vector<BandTrace> traces = VariedTraces();
+    const size_t n = traces.size();
+    const BlackbodyGlowTable glow;
+    scene::Attitude attitude;
+    attitude.heading_rad = -0.4;
+    attitude.pitch_rad = 0.05;
+    attitude.roll_rad = 0.03;
+    const glm::mat3 worldFromCamera(scene::WorldFromBodyRotation(attitude));
+    int compared = 0;
+    for (const bool withGlow : {false, true}) {
+        PlumeLighting light = Sunlit(glow);
+        if (!withGlow) light.glow = nullptr;
+        for (size_t c = 0; c < n * n * n * n; c += 5) {
+            const BandTrace* corner[4] = {&traces[c % n], &traces[c / n % n],
+                                          &traces[c / n / n % n], &traces[c / n / n / n % n]};
+            const int pixels = 1 + int(c % 16);
+            float fx[16], fy[16], a[16], b[16], tau[16];
+            glm::vec3 S[16];
+            for (int l = 0; l < pixels; ++l) {
+                fx[l] = 0.25f * float(l % 4), fy[l] = 0.25f * float(l / 4);
+                a[l] = -0.5f + 0.013f * float(c % 61) + 0.01f * float(l);
+                b[l] = 0.3f - 0.009f * float(c % 53) - 0.01f * float(l);
+            }
+            plume_detail::BlendedVisibleSources(corner, fx, fy, a, b, pixels, worldFromCamera,
+                                                light, tau, S);
+            for (int l = 0; l < pixels; ++l) {
+                const BandTrace blend = plume_detail::Bilinear(corner, fx[l], fy[l]);
+                const glm::vec3 dir = glm::normalize(worldFromCamera * glm::vec3(a[l], 1.0f, b[l]));
+                const glm::vec3 expected = plume_detail::VisibleSource(blend, -dir, light);
+                EXPECT_EQ(std::memcmp(&tau[l], &blend.opticalDepth, sizeof(float)), 0)
+                    << c << " " << l;
+                EXPECT_EQ(std::memcmp(&S[l], &expected, sizeof(glm::vec3)), 0)
+                    << withGlow << " " << c << " " << l;
+                ++compared;
+            }
+        }
+    }
+    EXPECT_GT(compared, 2000);
+}
+
+// The infrared whole-sky-cell form likewise: Bilinear's optical depth and, where it is
+// positive, InfraredSource of the blend (else 0), bit for bit.
+TEST(PlumeComposite, BlendedInfraredSourcesMatchTheOnePixelForms) {
+    const std::vector<BandTrace> traces = VariedTraces();
+    const size_t n = traces.size();
+    const radiometry::BandRadianceTable table(radiometry::BuiltinBand("LWIR"));
+    const PlumeLighting light = Lwir(table);
+    int compared = 0, positive = 0;
+    for (size_t c = 0; c < n * n * n * n; c += 3) {
+        const BandTrace* corner[4] = {&traces[c % n], &traces[c / n % n], &traces[c / n / n % n],
+                                      &traces[c / n / n / n % n]};
+        const int pixels = 1 + int(c % 16);
+        float fx[16], fy[16], tau[16], S[16];
+        for (int l = 0; l < pixels; ++l) fx[l] = 0.25f * float(l % 4), fy[l] = 0.25f * float(l / 4);
+        plume_detail::BlendedInfraredSources(corner, fx, fy, pixels, light, tau, S);
+        for (int l = 0; l < pixels; ++l) {
+            const BandTrace blend = plume_detail::Bilinear(corner, fx[l], fy[l]);
+            const float expected =
+                blend.opticalDepth > 0.0f ? plume_detail::InfraredSource(blend, light) : 0.0f;
+            EXPECT_EQ(std::memcmp(&tau[l], &blend.opticalDepth, sizeof(float)), 0) << c << " " << l;
+            EXPECT_EQ(std::memcmp(&S[l], &expected, sizeof(float)), 0) << c << " " << l;
+            ++compared;
+            positive += blend.opticalDepth > 0.0f;
+        }
+    }
+    EXPECT_GT(compared, 3000);
+    EXPECT_GT(positive, 2000);
 }
 
 // Luminance of a blackbody at the platinum freezing point, 2042 K: 60 cd/cm² (the candela's
