@@ -217,16 +217,22 @@ void ViewGeometry::UpdateEntities(const scene::SceneState& state) {
 }
 
 void ViewGeometry::UpdateCasterBounds() {
-    glm::vec3 lo(std::numeric_limits<float>::infinity()), hi(-lo);
-    for (const scene::TriangleMesh& m : worldMeshes_)
-        for (const glm::vec3& p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
-    // Far wider than OcclusionScene's 1e-5 relative + 0.1 mm margin, so that this test
+    casterBoxes_.clear();
+    const glm::vec3 infinite(std::numeric_limits<float>::infinity());
+    glm::vec3 lo = infinite, hi = -infinite;
+    for (const scene::TriangleMesh& m : worldMeshes_) {
+        AxisBox& box = casterBoxes_.emplace_back(AxisBox{infinite, -infinite});
+        for (const glm::vec3& p : m.positions)
+            box.min = glm::min(box.min, p), box.max = glm::max(box.max, p);
+        lo = glm::min(lo, box.min), hi = glm::max(hi, box.max);
+    }
+    // Far wider than OcclusionScene's 1e-5 relative + 0.1 mm margin at the same largest
+    // coordinate, so that each entity's box contains the scene's box of it and this test
     // passing is implied by MayOcclude passing despite float rounding.
     const float margin_m = 1e-3f * std::max({glm::abs(lo).x, glm::abs(lo).y, glm::abs(lo).z,
                                              glm::abs(hi).x, glm::abs(hi).y, glm::abs(hi).z}) +
                            0.1f;
-    casterMin_ = lo - margin_m;
-    casterMax_ = hi + margin_m;
+    for (AxisBox& box : casterBoxes_) box.min -= margin_m, box.max += margin_m;
 }
 
 void ViewGeometry::UpdateOceanAttributes() {
