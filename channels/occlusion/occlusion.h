@@ -27,8 +27,10 @@ inline glm::vec3 InverseDirection(const glm::vec3& direction) {
 
 // Ray/box slab test (Kay & Kajiya, "Ray tracing complex scenes", SIGGRAPH 1986) restricted
 // to t ∈ [0, tMax_m]. invDirection holds 1/direction per axis (unused for parallel axes).
-inline bool SlabHit(const glm::vec3& boxMin, const glm::vec3& boxMax, const glm::vec3& origin,
-                    const glm::vec3& direction, const glm::vec3& invDirection, float tMax_m) {
+// Inlined into the box loops of RayBoxesTest (a call per box cost more than the test).
+[[gnu::always_inline]] inline bool SlabHit(const glm::vec3& boxMin, const glm::vec3& boxMax,
+                                           const glm::vec3& origin, const glm::vec3& direction,
+                                           const glm::vec3& invDirection, float tMax_m) {
     float t0 = 0.0f;
     float t1 = tMax_m;
     for (int axis = 0; axis < 3; ++axis) {
@@ -94,7 +96,8 @@ class RayBoxesTest {
     }
 
   private:
-    bool Hit(const glm::vec3& lo, const glm::vec3& hi, const glm::vec3& origin) const {
+    [[gnu::always_inline]] bool Hit(const glm::vec3& lo, const glm::vec3& hi,
+                                    const glm::vec3& origin) const {
         return occlusion_detail::SlabHit(lo, hi, origin, direction_, inverse_, maxDistance_m_);
     }
 
