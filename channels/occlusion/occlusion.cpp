@@ -23,9 +23,6 @@ namespace seasense::channels {
 
 namespace {
 
-using occlusion_detail::InverseDirection;
-using occlusion_detail::SlabHit;
-
 static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "vertex copy assumes packed float3");
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
@@ -112,6 +109,7 @@ struct OcclusionScene::Impl {
         RTCBuffer indexBuffer = nullptr;
         size_t vertexCount = 0;
         bool dynamic = false;
+        AxisBox bounds;  // of its vertices, as last added or updated
     };
 
     RTCDevice device = nullptr;
@@ -123,10 +121,9 @@ struct OcclusionScene::Impl {
     bool twoLevel = false;
     glm::vec3 boundsMin{kInf};
     glm::vec3 boundsMax{-kInf};
-    // Bounds enlarged so that float rounding in the slab test never rejects a ray that
-    // Embree's robust traversal would report as a hit.
-    glm::vec3 testMin{kInf};
-    glm::vec3 testMax{-kInf};
+    // Each mesh's bounds enlarged so that float rounding in the slab test never rejects a ray
+    // that Embree's robust traversal would report as a hit (MeshBoxes).
+    std::vector<AxisBox> testBoxes;
 
     mutable std::mutex errorMutex;
     mutable std::string errorMessage;
@@ -213,6 +210,13 @@ struct OcclusionScene::Impl {
                     positions.size() * sizeof(glm::vec3));
     }
 
+    static AxisBox Bounds(std::span<const glm::vec3> positions) {
+        AxisBox box{glm::vec3(kInf), glm::vec3(-kInf)};
+        for (const glm::vec3& p : positions)
+            box.min = glm::min(box.min, p), box.max = glm::max(box.max, p);
+        return box;
+    }
+
     RTCBuffer NewPaddedBuffer(size_t bytes) {
         RTCBuffer buffer = rtcNewBuffer(device, bytes + kBufferPadding_bytes);
         ThrowIfError("rtcNewBuffer");
@@ -274,6 +278,7 @@ uint32_t OcclusionScene::AddMesh(std::span<const glm::vec3> positions,
 
     mesh.vertexBuffer = impl.NewPaddedBuffer(positions.size() * sizeof(glm::vec3));
     Impl::CopyPositions(positions, mesh.vertexBuffer, kWhere);
+    mesh.bounds = Impl::Bounds(positions);
     mesh.indexBuffer = impl.NewPaddedBuffer(indices.size() * sizeof(uint32_t));
     std::memcpy(rtcGetBufferData(mesh.indexBuffer), indices.data(),
                 indices.size() * sizeof(uint32_t));
@@ -311,6 +316,7 @@ void OcclusionScene::UpdateMesh(uint32_t geometryId, std::span<const glm::vec3> 
         throw InputError(message.str());
     }
     Impl::CopyPositions(positions, mesh.vertexBuffer, "OcclusionScene::UpdateMesh");
+    mesh.bounds = Impl::Bounds(positions);
     if (!impl.twoLevel) {
         // Embree 3 refits per geometry only in a two-level scene (scene quality LOW, see
         // rtcSetGeometryBuildQuality); static meshes keep their own high-quality BVHs there.
@@ -332,9 +338,10 @@ void OcclusionScene::Commit() {
     Impl& impl = *impl_;
     rtcCommitScene(impl.scene);
     impl.ThrowIfError("rtcCommitScene");
+    impl.testBoxes.clear();
     if (impl.meshes.empty()) {
-        impl.boundsMin = impl.testMin = glm::vec3(kInf);
-        impl.boundsMax = impl.testMax = glm::vec3(-kInf);
+        impl.boundsMin = glm::vec3(kInf);
+        impl.boundsMax = glm::vec3(-kInf);
     } else {
         RTCBounds bounds;
         rtcGetSceneBounds(impl.scene, &bounds);
@@ -342,12 +349,16 @@ void OcclusionScene::Commit() {
         impl.boundsMin = glm::vec3(bounds.lower_x, bounds.lower_y, bounds.lower_z);
         impl.boundsMax = glm::vec3(bounds.upper_x, bounds.upper_y, bounds.upper_z);
         // Relative part covers float rounding at the coordinates' magnitude (1e-5 ≈ 100 ulp),
-        // the absolute part flat boxes (a single horizontal triangle).
-        const glm::vec3 magnitude = glm::max(glm::abs(impl.boundsMin), glm::abs(impl.boundsMax));
+        // the absolute part flat boxes (a single horizontal triangle). The meshes' own boxes
+        // (their vertices', which hold their triangles') get the margin of the largest.
+        glm::vec3 lo(kInf), hi(-kInf);
+        for (const Impl::Mesh& mesh : impl.meshes)
+            lo = glm::min(lo, mesh.bounds.min), hi = glm::max(hi, mesh.bounds.max);
+        const glm::vec3 magnitude = glm::max(glm::abs(lo), glm::abs(hi));
         const float scale = std::max({magnitude.x, magnitude.y, magnitude.z});
         const float margin_m = 1e-5f * scale + 1e-4f;
-        impl.testMin = impl.boundsMin - margin_m;
-        impl.testMax = impl.boundsMax + margin_m;
+        for (const Impl::Mesh& mesh : impl.meshes)
+            impl.testBoxes.push_back({mesh.bounds.min - margin_m, mesh.bounds.max + margin_m});
     }
     impl.committed = true;
 }
@@ -362,6 +373,11 @@ glm::vec3 OcclusionScene::BoundsMin() const {
 glm::vec3 OcclusionScene::BoundsMax() const {
     CHECK_MSG(impl_->committed, "OcclusionScene::BoundsMax before Commit()");
     return impl_->boundsMax;
+}
+
+std::span<const AxisBox> OcclusionScene::MeshBoxes() const {
+    CHECK_MSG(impl_->committed, "OcclusionScene::MeshBoxes before Commit()");
+    return impl_->testBoxes;
 }
 
 bool OcclusionScene::MayOcclude(const glm::vec3& origin, const glm::vec3& direction,
@@ -379,11 +395,7 @@ OccluderBoundsTest OcclusionScene::BoundsTest(const glm::vec3& direction,
     CHECK_MSG(impl.committed, "OcclusionScene::BoundsTest before Commit()");
     CHECK_MSG(Finite(direction) && !std::isnan(maxDistance_m), "BoundsTest: non-finite ray");
     OccluderBoundsTest test;
-    test.min_ = impl.testMin, test.max_ = impl.testMax;
-    test.direction_ = direction;
-    test.inverse_ = InverseDirection(direction);
-    test.maxDistance_m_ = maxDistance_m;
-    test.empty_ = impl.meshes.empty() || maxDistance_m < 0.0f;
+    test.boxes_ = RayBoxesTest(impl.testBoxes, direction, maxDistance_m);
     return test;
 }
 
@@ -437,7 +449,7 @@ void OcclusionScene::DirectionalVisibility(std::span<const glm::vec3> origins,
         }
         return;
     }
-    const glm::vec3 invDirection = InverseDirection(direction);
+    const OccluderBoundsTest occluders = BoundsTest(direction, kInf);
 
     auto traceBlock = [&](size_t begin, size_t end) {
         RTCIntersectContext context;
@@ -448,8 +460,7 @@ void OcclusionScene::DirectionalVisibility(std::span<const glm::vec3> origins,
         int count = 0;
         for (size_t i = begin; i < end; ++i) {
             CHECK_MSG(Finite(origins[i]), "DirectionalVisibility: origin " << i << " not finite");
-            if (!originsMayOcclude &&
-                !SlabHit(impl.testMin, impl.testMax, origins[i], direction, invDirection, kInf)) {
+            if (!originsMayOcclude && !occluders.MayOcclude(origins[i])) {
                 visible[i] = 1;
                 continue;
             }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <limits>
 #include <memory>
 #include <span>
 #include <utility>
@@ -26,8 +27,10 @@ inline glm::vec3 InverseDirection(const glm::vec3& direction) {
 
 // Ray/box slab test (Kay & Kajiya, "Ray tracing complex scenes", SIGGRAPH 1986) restricted
 // to t ∈ [0, tMax_m]. invDirection holds 1/direction per axis (unused for parallel axes).
-inline bool SlabHit(const glm::vec3& boxMin, const glm::vec3& boxMax, const glm::vec3& origin,
-                    const glm::vec3& direction, const glm::vec3& invDirection, float tMax_m) {
+// Inlined into the box loops of RayBoxesTest (a call per box cost more than the test).
+[[gnu::always_inline]] inline bool SlabHit(const glm::vec3& boxMin, const glm::vec3& boxMax,
+                                           const glm::vec3& origin, const glm::vec3& direction,
+                                           const glm::vec3& invDirection, float tMax_m) {
     float t0 = 0.0f;
     float t1 = tMax_m;
     for (int axis = 0; axis < 3; ++axis) {
@@ -47,22 +50,79 @@ inline bool SlabHit(const glm::vec3& boxMin, const glm::vec3& boxMax, const glm:
 
 }  // namespace occlusion_detail
 
-// OcclusionScene::MayOcclude for one direction and distance, set up once (the inverse
-// direction, the bounds) and inline, for the many shadow-ray origins of a frame: MayOcclude(o)
-// equals the scene's MayOcclude(o, direction, maxDistance_m) for every finite o (checked by the
-// scene's call, not here). Valid while the scene is not changed.
+// An axis-aligned box, world ENU metres.
+struct AxisBox {
+    glm::vec3 min{0.0f}, max{0.0f};
+};
+
+// Whether rays along one direction, t ∈ [0, maxDistance_m], from many origins may meet any of a
+// few boxes (the shadow casters', one each): SlabHit per box, set up once (the inverse
+// direction) and inline. The boxes' union is tested first, so that the many rays that miss all
+// casters cost one test: it passes whenever some box's test passes (SlabHit is monotone in the
+// box, float rounding included, and its min and max are exact), so the answer is that of the
+// boxes alone. Refers to the boxes: valid while they are not changed.
+class RayBoxesTest {
+  public:
+    RayBoxesTest() = default;
+    RayBoxesTest(std::span<const AxisBox> boxes, const glm::vec3& direction, float maxDistance_m)
+        : boxes_(boxes),
+          direction_(direction),
+          inverse_(occlusion_detail::InverseDirection(direction)),
+          maxDistance_m_(maxDistance_m) {
+        union_.min = glm::vec3(std::numeric_limits<float>::infinity());
+        union_.max = -union_.min;
+        for (const AxisBox& box : boxes)
+            union_.min = glm::min(union_.min, box.min), union_.max = glm::max(union_.max, box.max);
+        if (maxDistance_m < 0.0f) boxes_ = {};
+    }
+
+    // Whether the ray from origin may meet some box.
+    bool MayHit(const glm::vec3& origin) const {
+        if (boxes_.empty() || !Hit(union_.min, union_.max, origin)) return false;
+        if (boxes_.size() == 1) return true;  // the union is the box
+        for (const AxisBox& box : boxes_)
+            if (Hit(box.min, box.max, origin)) return true;
+        return false;
+    }
+    // Whether the ray from origin may meet some box grown by grow_m (≥ 0) on each side: also
+    // whether any ray from a point within grow_m of origin per axis may meet that box itself
+    // (Minkowski sum). The grown union is the union of the grown boxes (rounding is monotone).
+    bool MayHit(const glm::vec3& origin, const glm::vec3& grow_m) const {
+        if (boxes_.empty() || !Hit(union_.min - grow_m, union_.max + grow_m, origin)) return false;
+        if (boxes_.size() == 1) return true;
+        for (const AxisBox& box : boxes_)
+            if (Hit(box.min - grow_m, box.max + grow_m, origin)) return true;
+        return false;
+    }
+
+  private:
+    [[gnu::always_inline]] bool Hit(const glm::vec3& lo, const glm::vec3& hi,
+                                    const glm::vec3& origin) const {
+        return occlusion_detail::SlabHit(lo, hi, origin, direction_, inverse_, maxDistance_m_);
+    }
+
+    std::span<const AxisBox> boxes_;  // none: nothing is hit
+    AxisBox union_;
+    glm::vec3 direction_{0.0f, 0.0f, 1.0f}, inverse_{0.0f};
+    float maxDistance_m_ = 0.0f;
+};
+
+// OcclusionScene::MayOcclude for one direction and distance, set up once and inline, for the
+// many shadow-ray origins of a frame: MayOcclude(o) equals the scene's MayOcclude(o, direction,
+// maxDistance_m) for every finite o (checked by the scene's call, not here). Valid while the
+// scene is not changed.
 class OccluderBoundsTest {
   public:
-    bool MayOcclude(const glm::vec3& origin) const {
-        return !empty_ &&
-               occlusion_detail::SlabHit(min_, max_, origin, direction_, inverse_, maxDistance_m_);
+    bool MayOcclude(const glm::vec3& origin) const { return boxes_.MayHit(origin); }
+    // Whether a ray from any point within grow_m (≥ 0, per axis) of origin may be occluded, up
+    // to float rounding in computing grow_m (RayBoxesTest::MayHit).
+    bool MayOcclude(const glm::vec3& origin, const glm::vec3& grow_m) const {
+        return boxes_.MayHit(origin, grow_m);
     }
 
   private:
     friend class OcclusionScene;
-    glm::vec3 min_{0.0f}, max_{0.0f}, direction_{0.0f, 0.0f, 1.0f}, inverse_{0.0f};
-    float maxDistance_m_ = 0.0f;
-    bool empty_ = true;  // no mesh, or maxDistance_m < 0: nothing is occluded
+    RayBoxesTest boxes_;  // the meshes' boxes, each enlarged as OcclusionScene::MeshBoxes says
 };
 
 // Build-then-commit: add meshes, Commit(), then query from any number of threads.
@@ -99,8 +159,13 @@ class OcclusionScene {
     glm::vec3 BoundsMin() const;
     glm::vec3 BoundsMax() const;
 
-    // True when the ray from origin along unit direction can meet the casters' bounding
-    // box within maxDistance_m: a cheap test that lets shading skip shadow rays.
+    // Each mesh's bounding box (in AddMesh order; valid after Commit()), enlarged so that
+    // float rounding in a slab test never rejects a ray that Embree's robust traversal reports
+    // as meeting the mesh: by 1e-5 of the largest coordinate of any mesh plus 0.1 mm.
+    std::span<const AxisBox> MeshBoxes() const;
+
+    // True when the ray from origin along unit direction can meet some mesh's box (MeshBoxes)
+    // within maxDistance_m: a cheap test that lets shading skip shadow rays.
     bool MayOcclude(const glm::vec3& origin, const glm::vec3& direction, float maxDistance_m) const;
     // MayOcclude along one direction, prepared for many origins (OccluderBoundsTest).
     OccluderBoundsTest BoundsTest(const glm::vec3& direction, float maxDistance_m) const;

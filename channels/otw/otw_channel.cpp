@@ -49,21 +49,6 @@ constexpr float kSeaAlbedo = 0.06f;
 // Koschmieder: extinction coefficient for a 2 % contrast threshold, β = 3.912 / V.
 double ExtinctionFromVisibility(double visibility_m) { return 3.912 / visibility_m; }
 
-// Whether the ray origin + t·direction, t ≥ 0, meets the box [lo, hi]: OcclusionScene's slab
-// test (occlusion_detail::SlabHit) for a box of the caller's. Inline for the per-triangle
-// shadow-caster prefilter.
-struct RayBoxTest {
-    glm::vec3 lo, hi, direction, inverse;
-    RayBoxTest(const glm::vec3& boxMin, const glm::vec3& boxMax, const glm::vec3& d)
-        : lo(boxMin), hi(boxMax), direction(d), inverse(occlusion_detail::InverseDirection(d)) {}
-    // Whether a ray from o may meet the box grown by grow_m (≥ 0) on each side: also whether
-    // any ray from a point within grow_m of o per axis may meet the box itself.
-    bool MayHit(const glm::vec3& o, const glm::vec3& grow_m = glm::vec3(0.0f)) const {
-        return occlusion_detail::SlabHit(lo - grow_m, hi + grow_m, o, direction, inverse,
-                                         std::numeric_limits<float>::infinity());
-    }
-};
-
 // Gaussian isotropic slope density of Cox & Munk (1954), J. Opt. Soc. Am. 44(11), with the
 // mean-square slope σ² = 0.003 + 0.00512·W (W wind speed at 12.5 m, m/s); p(tan β) per unit
 // slope area.
@@ -490,12 +475,13 @@ struct FrameShading {
     bool shadows;
     const radiometry::AnalyticSky& sky;
     const OcclusionScene& occlusion;
-    // The casters' box grown (ViewGeometry::CasterMax), for whole triangles (Gather): a sample
-    // on a triangle that misses it cannot be shadowed.
-    RayBoxTest casters;
+    // The casters' boxes grown (ViewGeometry::CasterBoxes), for whole triangles (Gather): a
+    // sample on a triangle whose rays miss them all cannot be shadowed.
+    RayBoxesTest casters;
     // occlusion.MayOcclude along keyDir (to 1e30 m), prepared once: a sample's shadow ray is
-    // traced only where this passes. Its box lies inside the casters' (ViewGeometry::
-    // UpdateCasterBounds), so passing it implies casters.MayHit: that is not tested again.
+    // traced only where this passes. Each caster's box in it lies inside that caster's box in
+    // casters (ViewGeometry::UpdateCasterBounds), so passing it implies casters.MayHit: that is
+    // not tested again.
     OccluderBoundsTest occluders;
     SeaShading sea;
     const std::vector<glm::dvec3>& reflectance;  // per entity
@@ -1174,6 +1160,8 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     // Pixel size on the image plane at unit distance bounds the angle between a pixel's
     // centre ray and its samples' (the plane is at least that far from the eye).
     const double pixelTan = n * (2.0 * g.tanH / sw + 2.0 * g.tanV / sh);
+    const RayBoxesTest casters(geometry_.CasterBoxes(), key.dir,
+                               std::numeric_limits<float>::infinity());
     const FrameShading f{eye,
                          sunDir,
                          glm::vec3(sunAboveClouds / radiometry::SunDiscSolidAngle_sr()),
@@ -1189,7 +1177,7 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
                          settings_.shadows && !occlusion.Empty() && key.dir.z > 0.0f,
                          sky,
                          occlusion,
-                         RayBoxTest(geometry_.CasterMin(), geometry_.CasterMax(), key.dir),
+                         casters,
                          occlusion.BoundsTest(key.dir, 1e30f),
                          SeaShading{eye,
                                     key.dir,

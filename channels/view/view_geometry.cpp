@@ -241,16 +241,21 @@ void ViewGeometry::UpdateEntities(const scene::SceneState& state) {
 }
 
 void ViewGeometry::UpdateCasterBounds() {
-    glm::vec3 lo(std::numeric_limits<float>::infinity()), hi(-lo);
-    for (const scene::TriangleMesh& m : worldMeshes_)
-        for (const glm::vec3& p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
-    // Far wider than OcclusionScene's 1e-5 relative + 0.1 mm margin, so that this test
-    // passing is implied by MayOcclude passing despite float rounding.
-    const float margin_m = 1e-3f * std::max({glm::abs(lo).x, glm::abs(lo).y, glm::abs(lo).z,
-                                             glm::abs(hi).x, glm::abs(hi).y, glm::abs(hi).z}) +
-                           0.1f;
-    casterMin_ = lo - margin_m;
-    casterMax_ = hi + margin_m;
+    // The occlusion scene's box of each entity (its vertices' bounds, already enlarged a little)
+    // enlarged again, far more than OcclusionScene's 1e-5 relative + 0.1 mm: each caster's box
+    // holds the scene's box of it, so that passing MayOcclude implies passing this test, caster
+    // by caster, despite float rounding. (The scene's boxes spare a second pass over the
+    // vertices.)
+    const std::span<const AxisBox> sceneBoxes = occlusion_.MeshBoxes();
+    casterBoxes_.clear();
+    float largest_m = 0.0f;
+    for (uint32_t id : occlusionIds_) {
+        const AxisBox& box = casterBoxes_.emplace_back(sceneBoxes[id]);
+        const glm::vec3 magnitude = glm::max(glm::abs(box.min), glm::abs(box.max));
+        largest_m = std::max({largest_m, magnitude.x, magnitude.y, magnitude.z});
+    }
+    const float margin_m = 1e-3f * largest_m + 0.1f;
+    for (AxisBox& box : casterBoxes_) box.min -= margin_m, box.max += margin_m;
 }
 
 void ViewGeometry::UpdateOceanAttributes() {

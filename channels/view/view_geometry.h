@@ -56,10 +56,10 @@ class ViewGeometry {
     // Entity meshes in the world frame (ENU metres) at the last frame's poses.
     const std::vector<scene::TriangleMesh>& EntityMeshes() const { return worldMeshes_; }
     const OcclusionScene& Occlusion() const { return occlusion_; }
-    // Bounding box (world, m) of all shadow casters, widened well beyond OcclusionScene's own
-    // caster bounds: a cheap inline test that leaves only candidates for MayOcclude.
-    const glm::vec3& CasterMin() const { return casterMin_; }
-    const glm::vec3& CasterMax() const { return casterMax_; }
+    // Bounding box (world, m) of each shadow caster (entity), widened well beyond
+    // OcclusionScene's own boxes of them (MeshBoxes): a cheap inline test for whole triangles
+    // that leaves only candidates for MayOcclude.
+    std::span<const AxisBox> CasterBoxes() const { return casterBoxes_; }
     const ViewFrameStats& Stats() const { return stats_; }
 
   private:
@@ -74,7 +74,7 @@ class ViewGeometry {
     std::vector<scene::TriangleMesh> worldMeshes_;  // entity meshes in the world frame
     std::vector<scene::Pose> entityPoses_;          // the poses worldMeshes_ were built at
     std::vector<uint32_t> occlusionIds_;            // Embree geometry of each entity
-    glm::vec3 casterMin_{0.0f}, casterMax_{0.0f};
+    std::vector<AxisBox> casterBoxes_;              // per entity (CasterBoxes)
     void UpdateOceanAttributes();
 
     scene::OceanMesh ocean_;

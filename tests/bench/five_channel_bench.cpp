@@ -71,6 +71,7 @@ void BM_FiveChannelRenderer(benchmark::State& state) {
         if (ch.kind == scene::ChannelKind::Flir) {
             const FlirFrameStats& s = pipeline->Flir().Stats();
             meshMs += s.view.meshMs, rasterMs += s.view.rasterMs, shadeMs += s.shadeMs;
+            shadowRays += double(s.shadowRays);
         } else {
             const OtwFrameStats& s = ch.kind == scene::ChannelKind::Nvg
                                          ? pipeline->Nvg().Otw().Stats()

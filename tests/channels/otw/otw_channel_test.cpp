@@ -97,6 +97,9 @@ TEST(OtwChannel, BoxShadowOnAPlateHasLengthHeightOverTanElevation) {
     for (double elevation_deg : {30.0, 50.0}) {
         scene::Scenario sc = CalmSeaScenario(100.0, 12.0);
         sc.materials = {{"grey", glm::dvec3(0.5)}};
+        // A caster far out of view, first in the list: the shadow prefilters test each
+        // caster's own box, and must still let the box's shadow rays through.
+        sc.entities.push_back({"far", dir / "box.obj", {-150, 200, 0}, {}, 1.0, "grey"});
         sc.entities.push_back({"plate", dir / "plate.obj", {0, 0, 0}, {}, 1.0, "grey"});
         sc.entities.push_back({"box", dir / "box.obj", {0, 0, 0}, {}, 1.0, "grey"});
         // Sun in the west: the shadow falls toward +x (east).

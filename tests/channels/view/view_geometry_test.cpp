@@ -4,9 +4,12 @@
 
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <numbers>
 #include <random>
 #include <string>
@@ -275,6 +278,61 @@ TEST(ViewGeometry, ContiguousChannelsShareTheirSeaVertices) {
         }
     }
     EXPECT_GT(shared, 1000);  // the overlap holds the widened margins of both sectors
+}
+
+// The per-triangle shadow prefilter's boxes: one per entity, holding that entity's vertices and
+// the occlusion scene's (enlarged) box of it, so that passing the per-sample test implies
+// passing this one, caster by caster; a moving entity's box follows it. Two boats 300 m apart
+// keep boxes apart (the union of them would hold the sea between).
+TEST(ViewGeometry, CasterBoxesHoldEachEntityAndItsOcclusionBox) {
+    const std::filesystem::path obj =
+        std::filesystem::temp_directory_path() /
+        ("seasense_caster_boxes_" + std::to_string(::getpid()) + ".obj");
+    {
+        std::ofstream out(obj);  // a 4 × 3 × 6 m block (glTF axes: y up)
+        for (int c = 0; c < 8; ++c)
+            out << "v " << (c & 1 ? 2 : -2) << " " << (c & 2 ? 3 : -3) << " "
+                << (c & 4 ? 1.5 : -1.5) << "\n";
+        out << "f 1 2 4\nf 1 4 3\nf 5 6 8\nf 5 8 7\nf 1 5 6\nf 1 6 2\n";
+    }
+    scene::Scenario sc = SpectralSea(3.0, -2.0, 0.0);
+    sc.materials = {{"grey", glm::dvec3(0.5)}};
+    sc.entities.push_back({"a", obj, {-150, 200, 0}, {}, 1.0, "grey"});
+    sc.entities.push_back({"b", obj, {150, 250, 0}, {}, 1.0, "grey", 5.0});
+    const scene::World world(sc);
+    ViewGeometry view(world, sc.channels[0]);
+    const AxisBox a0 = view.CasterBoxes()[0], b0 = view.CasterBoxes()[1];
+    const glm::vec3 bVertex0 = view.EntityMeshes()[1].positions[0];
+    for (int frame : {0, 30}) {
+        if (frame > 0) tbb::task_arena(2).execute([&] { view.Update(world.State(frame)); });
+        const std::span<const AxisBox> casters = view.CasterBoxes();
+        const std::span<const AxisBox> meshes = view.Occlusion().MeshBoxes();
+        ASSERT_EQ(casters.size(), 2u);
+        ASSERT_EQ(meshes.size(), 2u);
+        for (size_t i = 0; i < 2; ++i) {
+            for (int axis = 0; axis < 3; ++axis) {
+                EXPECT_LT(casters[i].min[axis], meshes[i].min[axis]) << frame << " " << i;
+                EXPECT_GT(casters[i].max[axis], meshes[i].max[axis]) << frame << " " << i;
+            }
+            for (const glm::vec3& p : view.EntityMeshes()[i].positions) {
+                EXPECT_TRUE(glm::all(glm::lessThan(meshes[i].min, p)) &&
+                            glm::all(glm::lessThan(p, meshes[i].max)))
+                    << frame << " " << i;
+            }
+        }
+        EXPECT_LT(casters[0].max.x, casters[1].min.x - 250.0f) << frame;
+    }
+    // Boat b moved at 5 m/s along its heading, and its box with it; a's stayed. (Both boxes'
+    // margins grow by 1e-3 of the change in the largest coordinate: the tolerance.)
+    const glm::vec3 moved = view.EntityMeshes()[1].positions[0] - bVertex0;
+    EXPECT_GT(glm::length(moved), 1.0f);
+    for (int axis = 0; axis < 3; ++axis) {
+        EXPECT_NEAR(view.CasterBoxes()[1].min[axis] - b0.min[axis], moved[axis], 0.02f) << axis;
+        EXPECT_NEAR(view.CasterBoxes()[1].max[axis] - b0.max[axis], moved[axis], 0.02f) << axis;
+        EXPECT_NEAR(view.CasterBoxes()[0].min[axis], a0.min[axis], 0.02f) << axis;
+        EXPECT_NEAR(view.CasterBoxes()[0].max[axis], a0.max[axis], 0.02f) << axis;
+    }
+    std::filesystem::remove(obj);
 }
 
 }  // namespace
