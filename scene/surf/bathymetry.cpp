@@ -121,31 +121,53 @@ double Bathymetry::SeabedZAtShore_m(double s_m, double u_m) const {
     return z + BarLift(s_m, u_m, z);
 }
 
+namespace {
+
+// The extreme (pick: std::max or std::min of two) of a depth grid's seabed elevations over the
+// nodes of the bounding box of the disc of radius_m about (x, y): bilinear samples lie between
+// their four nodes; outside, the border extends.
+template <class Pick>
+double GridSeabedZWithin(const DepthGridSettings& g, double x, double y, double radius_m,
+                         double start, Pick pick) {
+    const DepthGrid& grid = *g.grid;
+    const double c0 = (x - radius_m - g.origin_m.x) / g.cell_m;
+    const double c1 = (x + radius_m - g.origin_m.x) / g.cell_m;
+    const double r0 = (g.origin_m.y - y - radius_m) / g.cell_m;
+    const double r1 = (g.origin_m.y - y + radius_m) / g.cell_m;
+    const auto clampIndex = [](double v, int n) { return int(std::clamp(v, 0.0, double(n - 1))); };
+    const int ca = clampIndex(std::floor(c0), grid.Width());
+    const int cb = clampIndex(std::ceil(c1), grid.Width());
+    const int ra = clampIndex(std::floor(r0), grid.Height());
+    const int rb = clampIndex(std::ceil(r1), grid.Height());
+    double z = start;
+    for (int r = ra; r <= rb; ++r)
+        for (int c = ca; c <= cb; ++c) {
+            const double v = grid.At(c, r);
+            z = pick(z, g.values == DepthGridValues::Depth ? -v : v);
+        }
+    return z;
+}
+
+}  // namespace
+
+double Bathymetry::MinSeabedZWithin_m(double x, double y, double radius_m) const {
+    CHECK(radius_m >= 0.0);
+    if (settings_.depthGrid)
+        return std::max(GridSeabedZWithin(*settings_.depthGrid, x, y, radius_m,
+                                          std::numeric_limits<double>::infinity(),
+                                          [](double a, double b) { return std::min(a, b); }),
+                        -oceanDepth_m_);
+    // The profile falls monotonically seaward and sandbars only lift it (BarLift ≥ 0).
+    return ProfileZ_m(frame_.ShoreFromWorld(x, y).s_m + radius_m);
+}
+
 double Bathymetry::MaxSeabedZWithin_m(double x, double y, double radius_m) const {
     CHECK(radius_m >= 0.0);
-    if (settings_.depthGrid) {
-        const DepthGridSettings& g = *settings_.depthGrid;
-        const DepthGrid& grid = *g.grid;
-        // Bilinear samples lie between their four nodes; outside, the border extends.
-        const double c0 = (x - radius_m - g.origin_m.x) / g.cell_m;
-        const double c1 = (x + radius_m - g.origin_m.x) / g.cell_m;
-        const double r0 = (g.origin_m.y - y - radius_m) / g.cell_m;
-        const double r1 = (g.origin_m.y - y + radius_m) / g.cell_m;
-        const auto clampIndex = [](double v, int n) {
-            return int(std::clamp(v, 0.0, double(n - 1)));
-        };
-        const int ca = clampIndex(std::floor(c0), grid.Width());
-        const int cb = clampIndex(std::ceil(c1), grid.Width());
-        const int ra = clampIndex(std::floor(r0), grid.Height());
-        const int rb = clampIndex(std::ceil(r1), grid.Height());
-        double z = -std::numeric_limits<double>::infinity();
-        for (int r = ra; r <= rb; ++r)
-            for (int c = ca; c <= cb; ++c) {
-                const double v = grid.At(c, r);
-                z = std::max(z, g.values == DepthGridValues::Depth ? -v : v);
-            }
-        return std::max(z, -oceanDepth_m_);
-    }
+    if (settings_.depthGrid)
+        return std::max(GridSeabedZWithin(*settings_.depthGrid, x, y, radius_m,
+                                          -std::numeric_limits<double>::infinity(),
+                                          [](double a, double b) { return std::max(a, b); }),
+                        -oceanDepth_m_);
     const double s = frame_.ShoreFromWorld(x, y).s_m;
     const double sNear = s - radius_m, sFar = s + radius_m;
     double z = ProfileZ_m(sNear);  // the profile is highest at its landward end

@@ -47,6 +47,10 @@ class Bathymetry {
     // the plane profile falls monotonically seaward, a sandbar lifts it at most to its crest, a
     // grid never exceeds its largest node in the disc's bounding box. +∞ radius: the whole bed.
     double MaxSeabedZWithin_m(double x, double y, double radius_m) const;
+    // A lower bound of the seabed elevation within radius_m of (x, y): the plane profile at the
+    // disc's seaward edge (sandbars only lift it), or the smallest grid node in the disc's
+    // bounding box (never below the ocean floor).
+    double MinSeabedZWithin_m(double x, double y, double radius_m) const;
 
     // A cross-shore distance s (m) seaward of which the still-water depth is at least depth_m
     // everywhere: DepthAtShore_m(s', u) ≥ depth_m for every s' ≥ s and every u (the plane

@@ -612,8 +612,8 @@ SurfWaves::IntervalParts SurfWaves::Parts(int i, double surfDepth_m) const {
 }
 
 SurfWaves::Bound SurfWaves::IntervalBound(int i, double surfDepth_m,
-                                          const std::vector<Bound>& cascades,
-                                          const Bound& gerstner) const {
+                                          const std::vector<Bound>& cascades, const Bound& gerstner,
+                                          double surfCap_m) const {
     // The parts with the surf weights at the interval's shallow end are made once
     // (intervalParts_); only a minimum depth inside the interval needs its own.
     IntervalParts own;
@@ -631,7 +631,7 @@ SurfWaves::Bound SurfWaves::IntervalBound(int i, double surfDepth_m,
         b.height_m += w * cascades[c].height_m;
         b.horizontal_m += w * cascades[c].horizontal_m;
     }
-    b.height_m += parts.surfHeight_m;
+    b.height_m += std::min(parts.surfHeight_m, surfCap_m);
     // + 0 where the swash does not reach: x + 0 is x (the sum is never −0).
     b.height_m += parts.swash_m;
     b.horizontal_m += parts.surfHorizontal_m;
@@ -639,15 +639,67 @@ SurfWaves::Bound SurfWaves::IntervalBound(int i, double surfDepth_m,
 }
 
 SurfWaves::Bound SurfWaves::BoundAtDepths(double minDepth_m, const std::vector<Bound>& cascades,
-                                          const Bound& gerstner) const {
-    Bound out = DeepBound(cascades, gerstner);
+                                          const Bound& gerstner, double surfCap_m,
+                                          double maxDepth_m) const {
+    // A point at depth h in interval i (h0 ≤ h ≤ h1) has deep weights at most interval i's (at
+    // h1) and surf weights at most those at max(h0, minDepth): every interval the depths
+    // [minDepth, maxDepth] meet, and the deep sea where they reach the deepest fade.
+    Bound out = maxDepth_m >= fadeDeep_m_ ? DeepBound(cascades, gerstner) : Bound{};
     for (int i = 0; i + 1 < depthSamples_; ++i) {
         const double h0 = i * dh_m_, h1 = (i + 1) * dh_m_;
         if (h1 < minDepth_m) continue;
-        if (h0 >= fadeDeep_m_) break;
-        MaxInto(out, IntervalBound(i, std::max(h0, minDepth_m), cascades, gerstner));
+        if (h0 >= fadeDeep_m_ || h0 > maxDepth_m) break;
+        MaxInto(out, IntervalBound(i, std::max(h0, minDepth_m), cascades, gerstner, surfCap_m));
     }
     return out;
+}
+
+double SurfWaves::EnvelopeBoundNear(double x, double y, double t, double radius_m,
+                                    double minDepth_m, double maxDepth_m) const {
+    CHECK(radius_m >= 0.0 && minDepth_m <= maxDepth_m);
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    const size_t n = incoming_.size();
+    if (n == 0 || !(maxDepth_m > 0.0)) return 0.0;  // no components, or dry: Terms adds none
+    TermsOptions options;
+    options.velocity = false;
+    options.dominant = Dominant::kWhereBroken;
+    SurfPointInfo centre;
+    Terms(x, y, t, &centre, options);
+    if (!(centre.depth_m > 0.0) || centre.weights.AllDeep()) return kInf;
+    // Each component's weighted amplitude lies between its smallest table amplitude over the
+    // disc's depths times the surf weight at the deepest (the weights fall with depth: Fade
+    // grows) and its largest times the weight at the shallowest wet depth; Terms interpolates
+    // between the table samples bracketing a depth, so those samples bound it.
+    const SurfWeights wShallow = Weights(std::max(minDepth_m, 0.0)), wDeep = Weights(maxDepth_m);
+    const auto sample = [&](double h) {
+        return std::min(std::max(h, kMinDepth_m) / dh_m_, double(depthSamples_ - 1));
+    };
+    const size_t i0 = size_t(sample(minDepth_m));
+    const size_t i1 = std::min(size_t(sample(maxDepth_m)) + 1, size_t(depthSamples_ - 1));
+    // The phase ψ = origin + k_u u + ∫ k_s ds − ω t changes across the disc by at most
+    // (|k_u| + max |k_s|) · radius; the cross-shore table's slopes are k_s at its samples, whose
+    // profile depths are no shallower than at the disc's landward edge one sample further, and
+    // k grows as the water shoals (seaward of the table, |k_s0| ≤ k0 ≤ k anywhere).
+    const ShorePoint p = bathy_.Frame().ShoreFromWorld(x, y);
+    const double landward =
+        std::max(bathy_.Tide_m() - bathy_.ProfileZ_m(p.s_m - radius_m - ds_m_), kMinDepth_m);
+    double bound = 0.5 * centre.unbrokenHeight_m;  // |Σ a e^{iψ}| at (x, y)
+    for (size_t m = 0; m < n; ++m) {
+        double lo = kInf, hi = 0.0;
+        for (size_t i = i0; i <= i1; ++i) {
+            const double a = depth_[i * n + m].amplitude;
+            lo = std::min(lo, a), hi = std::max(hi, a);
+        }
+        const bool spectral = components_[incoming_[m]].spectral;
+        lo *= spectral ? wDeep.spectralSurf : wDeep.gerstnerSurf;
+        hi *= spectral ? wShallow.spectralSurf : wShallow.gerstnerSurf;
+        const Track& tr = tracks_[incoming_[m]];
+        const double kMax = DepthTable(tr.k, landward);
+        const double dPsi = (std::abs(tr.ku) + std::max(kMax, std::abs(tr.ks0))) * radius_m;
+        bound += (hi - lo) + hi * std::min(2.0, dPsi);
+    }
+    // The surface's float sums (a few ulp of the amplitudes) and the tables' float copies.
+    return bound * (1.0 + 1e-5) + 1e-4;
 }
 
 SurfWaves::BoundTable SurfWaves::MakeBoundTable(const std::vector<Bound>& cascades,

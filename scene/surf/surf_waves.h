@@ -168,8 +168,14 @@ class SurfWaves {
         double height_m = 0.0;
         double horizontal_m = 0.0;
     };
+    // surfCap_m, when given, caps the surf components' height in every interval (e.g.
+    // EnvelopeBoundNear's bound for the points in question), and maxDepth_m bounds the depths
+    // from above (no interval deeper, and the deep sea's own bound only if it reaches
+    // FadeDeep_m).
     Bound BoundAtDepths(double minDepth_m, const std::vector<Bound>& cascades,
-                        const Bound& gerstner) const;
+                        const Bound& gerstner,
+                        double surfCap_m = std::numeric_limits<double>::infinity(),
+                        double maxDepth_m = std::numeric_limits<double>::infinity()) const;
     // The same for any minimum depth from one table per set of deep-sea bounds: each depth
     // interval's bound with its surf weights at its shallow end, and their running maximum from
     // the deep end; BoundAtDepths(minDepth, table) then costs one interval, and equals the
@@ -182,6 +188,18 @@ class SurfWaves {
     };
     BoundTable MakeBoundTable(const std::vector<Bound>& cascades, const Bound& gerstner) const;
     Bound BoundAtDepths(double minDepth_m, const BoundTable& table) const;
+
+    // An upper bound (m) of the surf components' envelope |Σ a e^{iψ}| — which bounds the height
+    // they add (Terms: cap · Re Σ a e^{iψ}, cap ≤ 1; the swash apart) — at time t_s over every
+    // rest position within radius_m of world (x, y), whose still-water depths lie in
+    // [minDepth_m, maxDepth_m]: the envelope at (x, y) itself, plus for each component the
+    // spread of its weighted, shoaled amplitude over those depths and its amplitude times
+    // min(2, |Δψ|) for the largest phase change across the disc (|k_u| + max |k_s|) · radius.
+    // Local in time as well as in space, unlike Σ a, which all components reach only together;
+    // it grows with the radius and is worth taking only over a few metres (the sea under an
+    // eye). +∞ where (x, y) is dry or all deep (no envelope there to start from).
+    double EnvelopeBoundNear(double x, double y, double t_s, double radius_m, double minDepth_m,
+                             double maxDepth_m) const;
 
     // Mean breaker line (cross-shore s, m) of the plane beach: +∞ if no component, −∞ if the waves
     // never break before the shore.
@@ -237,7 +255,8 @@ class SurfWaves {
     IntervalParts Parts(int i, double surfDepth_m) const;
     // Interval i's bound with the surf weights at surfDepth_m.
     Bound IntervalBound(int i, double surfDepth_m, const std::vector<Bound>& cascades,
-                        const Bound& gerstner) const;
+                        const Bound& gerstner,
+                        double surfCap_m = std::numeric_limits<double>::infinity()) const;
     std::vector<IntervalParts> intervalParts_;  // Parts(i, i·dh) per interval
     // kWide: the per-component loops eight float (four double) lanes at a time where the build
     // targets AVX2, else four (two) as in the SSE2 build.

@@ -11,6 +11,7 @@
 #include <cstring>
 #include <limits>
 #include <numbers>
+#include <random>
 
 #include "scene/ocean/ocean_surface.h"
 #include "tests/scene/surf/linear_wave_theory.h"
@@ -234,6 +235,54 @@ TEST(SurfWaves, BoundTableEqualsTheIntervalLoop) {
         ASSERT_EQ(a.height_m, b.height_m) << d;
         ASSERT_EQ(a.horizontal_m, b.horizontal_m) << d;
     }
+}
+
+// The surf components' envelope over a disc (EnvelopeBoundNear) bounds |Σ a e^{iψ}| at every
+// wet rest position in it — Terms' own envelope before the breaker cap — over the fade zone,
+// the bar and the beach, at many instants and radii; and over a metre or less it is well below
+// the sum of the amplitudes at the disc's shallowest depth (the bound it tightens).
+TEST(SurfWaves, EnvelopeBoundHoldsOverTheDisc) {
+    const OceanSurface sea(SpectralBeach(true));
+    const SurfWaves& surf = *sea.Surf();
+    const Bathymetry& bathy = surf.Bathy();
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u01(0.0, 1.0);
+    int checked = 0, discs = 0, tighter = 0;
+    for (int f = 0; f < 40; ++f) {
+        const double t = 0.77 * f;
+        for (double s = 5.0; s < 1.05 * surf.FadeDeep_m() / 0.03; s += 23.0) {
+            const glm::dvec2 c = bathy.Frame().WorldFromShore(s, 40.0 + 3.0 * f);
+            for (const double radius : {0.0, 0.5, 2.0, 6.0}) {
+                const double shallow = bathy.Tide_m() - bathy.MaxSeabedZWithin_m(c.x, c.y, radius);
+                const double deep = bathy.Tide_m() - bathy.MinSeabedZWithin_m(c.x, c.y, radius);
+                const double bound = surf.EnvelopeBoundNear(c.x, c.y, t, radius, shallow, deep);
+                if (!std::isfinite(bound)) continue;
+                ++discs;
+                // Σ a at the shallowest depth: what the interval bound takes for the surf.
+                SurfPointInfo at;
+                surf.Terms(c.x, c.y, t, &at);
+                double sum = 0.0;
+                const SurfWeights w = surf.Weights(std::max(shallow, 0.0));
+                for (const SurfComponent& k : surf.Components())
+                    sum += k.amplitude_m * (k.spectral ? w.spectralSurf : w.gerstnerSurf);
+                if (radius <= 0.5 && bound < 0.7 * sum) ++tighter;
+                for (int k = 0; k < 60; ++k) {
+                    const double r = radius * std::sqrt(u01(rng)), a = 6.2832 * u01(rng);
+                    const double x = c.x + r * std::cos(a), y = c.y + r * std::sin(a);
+                    SurfPointInfo info;
+                    surf.Terms(x, y, t, &info);
+                    if (!(info.depth_m > 0.0)) continue;
+                    ASSERT_GE(info.depth_m, shallow - 1e-9);
+                    ASSERT_LE(info.depth_m, deep + 1e-9);
+                    EXPECT_LE(0.5 * info.unbrokenHeight_m, bound)
+                        << "s " << s << " radius " << radius << " t " << t;
+                    ++checked;
+                }
+            }
+        }
+    }
+    EXPECT_GT(checked, 20000);
+    EXPECT_GT(tighter, discs / 8) << discs;
 }
 
 TEST(SurfWaves, ChopKeepsItsWeightWhereItIsDeepWaterForItsWavelength) {
