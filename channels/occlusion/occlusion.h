@@ -114,11 +114,6 @@ class RayBoxesTest {
 class OccluderBoundsTest {
   public:
     bool MayOcclude(const glm::vec3& origin) const { return boxes_.MayHit(origin); }
-    // Whether a ray from any point within grow_m (≥ 0, per axis) of origin may be occluded, up
-    // to float rounding in computing grow_m (RayBoxesTest::MayHit).
-    bool MayOcclude(const glm::vec3& origin, const glm::vec3& grow_m) const {
-        return boxes_.MayHit(origin, grow_m);
-    }
 
   private:
     friend class OcclusionScene;

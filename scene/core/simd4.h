@@ -119,11 +119,6 @@ inline void SinCosLanes(F x, F& sinX, F& cosX) {
 }
 inline void SinCos4(F4 x, F4& sinX, F4& cosX) { SinCosLanes(x, sinX, cosX); }
 
-#if defined(__AVX2__)
-// Eight lanes (AVX2): lane for lane SinCos4's operations.
-inline void SinCos8(F8 x, F8& sinX, F8& cosX) { SinCosLanes(x, sinX, cosX); }
-#endif
-
 // Lane 0 of v.
 inline float Lane0(F4 v) { return _mm_cvtss_f32(v); }
 

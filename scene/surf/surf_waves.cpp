@@ -659,7 +659,9 @@ double SurfWaves::EnvelopeBoundNear(double x, double y, double t, double radius_
     CHECK(radius_m >= 0.0 && minDepth_m <= maxDepth_m);
     constexpr double kInf = std::numeric_limits<double>::infinity();
     const size_t n = incoming_.size();
-    if (n == 0 || !(maxDepth_m > 0.0)) return 0.0;  // no components, or dry: Terms adds none
+    // No components, all dry, or all at or below the deepest fade (surf weights 0): Terms adds
+    // none.
+    if (n == 0 || !(maxDepth_m > 0.0) || minDepth_m >= fadeDeep_m_) return 0.0;
     TermsOptions options;
     options.velocity = false;
     options.dominant = Dominant::kWhereBroken;

@@ -321,6 +321,7 @@ TEST(OcclusionScene, BoundsTestEqualsMayOccludeAndPrefilteredOriginsTraceTheSame
     for (const glm::vec3& direction : directions) {
         for (float maxDistance_m : {1e30f, 6.0f, 0.0f, -1.0f}) {
             const OccluderBoundsTest test = scene.BoundsTest(direction, maxDistance_m);
+            const RayBoxesTest boxes(scene.MeshBoxes(), direction, maxDistance_m);
             for (const glm::vec3& o : origins) {
                 const bool may = scene.MayOcclude(o, direction, maxDistance_m);
                 ASSERT_EQ(test.MayOcclude(o), may) << maxDistance_m;
@@ -364,8 +365,9 @@ std::vector<TestMesh> ThreeCasters() {
             Translated(MakeBox({-6, -5, -1}, {6, 5, 9}), {232, 386, 0})};
 }
 
-// The prepared test (plain and grown) is the per-mesh slab test, mesh by mesh, for many random
-// origins around and between the casters and several directions (a low sun among them).
+// The prepared test (and RayBoxesTest of the scene's boxes, grown) is the per-mesh slab test,
+// mesh by mesh, for many random origins around and between the casters and several directions (a
+// low sun among them).
 TEST(OcclusionScene, BoundsTestIsTheSlabTestOfEachMeshsOwnBox) {
     const std::vector<TestMesh> meshes = ThreeCasters();
     OcclusionScene scene;
@@ -386,6 +388,7 @@ TEST(OcclusionScene, BoundsTestIsTheSlabTestOfEachMeshsOwnBox) {
         const glm::vec3 inverse = occlusion_detail::InverseDirection(direction);
         for (float maxDistance_m : {1e30f, 150.0f}) {
             const OccluderBoundsTest test = scene.BoundsTest(direction, maxDistance_m);
+            const RayBoxesTest boxes(scene.MeshBoxes(), direction, maxDistance_m);
             for (size_t i = 0; i < count; ++i) {
                 auto u = [&](uint64_t stream) { return float(scene::Uniform01(78, stream, i)); };
                 const glm::vec3 o(700 * u(0) - 300, 400 * u(1) + 100, 12 * u(2) - 1);
@@ -399,7 +402,7 @@ TEST(OcclusionScene, BoundsTestIsTheSlabTestOfEachMeshsOwnBox) {
                 }
                 ASSERT_EQ(test.MayOcclude(o), any) << i;
                 ASSERT_EQ(scene.MayOcclude(o, direction, maxDistance_m), any) << i;
-                ASSERT_EQ(test.MayOcclude(o, grow), anyGrown) << i;
+                ASSERT_EQ(boxes.MayHit(o, grow), anyGrown) << i;
                 hits += any, grownHits += anyGrown;
             }
         }
@@ -469,8 +472,9 @@ TEST(OcclusionScene, ARayBetweenTwoDistantBoxesIsRejected) {
         EXPECT_TRUE(scene.Occluded(behind, behind + 1e3f * sun)) << x;
     }
     // Grown by 99 m along x, the boxes reach the ray between them.
-    EXPECT_FALSE(test.MayOcclude(between, glm::vec3(98.0f, 0.0f, 0.0f)));
-    EXPECT_TRUE(test.MayOcclude(between, glm::vec3(99.5f, 0.0f, 0.0f)));
+    const RayBoxesTest boxes(scene.MeshBoxes(), sun, 1e30f);
+    EXPECT_FALSE(boxes.MayHit(between, glm::vec3(98.0f, 0.0f, 0.0f)));
+    EXPECT_TRUE(boxes.MayHit(between, glm::vec3(99.5f, 0.0f, 0.0f)));
 }
 
 // UpdateMesh + Commit moves that mesh's box (and only its): the prefilter follows the mesh.
