@@ -178,56 +178,51 @@ glm::vec3 VisibleSource(const BandTrace& t, const glm::vec3& toEye, const PlumeL
     return S;
 }
 
+namespace {
+
+// VisibleSource's scattered light on simd lanes, ω (E_sun p_HG(cos θ, g) + L_ambient) per
+// colour into Sc[c], for the rays to the eye along −normalize(worldFromCamera · (a, 1, b)):
+// glm::normalize's and glm::dot's operations in their order (each row's products summed left to
+// right, v · (1 / √((v_x² + v_y²) + v_z²))), and HenyeyGreensteinPhase's, lane for lane.
+void ScatteredSources(simd::VF omega, simd::VF g, simd::VF av, simd::VF bv,
+                      const glm::mat3& worldFromCamera, const PlumeLighting& light,
+                      float (*Sc)[simd::kLanes]) {
+    using simd::VF;
+    VF v[3];
+    for (int r = 0; r < 3; ++r)
+        v[r] = (worldFromCamera[0][r] * av + simd::Splat(worldFromCamera[1][r] * 1.0f)) +
+               worldFromCamera[2][r] * bv;
+    const VF inv = 1.0f / simd::Sqrt((v[0] * v[0] + v[1] * v[1]) + v[2] * v[2]);
+    VF toEye[3];
+    for (int r = 0; r < 3; ++r) toEye[r] = -(v[r] * inv);
+    // Light from the sun travels along −sunDirection, light to the eye along toEye.
+    const VF cosTheta = -((light.sunDirection.x * toEye[0] + light.sunDirection.y * toEye[1]) +
+                          light.sunDirection.z * toEye[2]);
+    const VF gg = g * g;
+    const VF denom = (1.0f + gg) - (2.0f * g) * cosTheta;
+    const VF phase = (1.0f - gg) / (((4.0f * kPi) * denom) * simd::Sqrt(denom));
+    for (int c = 0; c < 3; ++c)
+        simd::Store(Sc[c], omega * (light.sunIlluminance[c] * phase + light.ambientRgb[c]));
+}
+
+}  // namespace
+
 void VisibleSource4(const BandTrace* const t[4], const glm::mat3& worldFromCamera, const float a[4],
                     const float b[4], int n, const PlumeLighting& light, glm::vec3 out[4]) {
-    const auto lanes = [&](auto value) {
-        return _mm_setr_ps(value(0), value(1), value(2), value(3));
-    };
-    // glm::normalize(worldFromCamera * glm::vec3(a, 1, b)): each row's products summed left to
-    // right, then v · (1 / √((v_x² + v_y²) + v_z²)).
-    const __m128 av = _mm_loadu_ps(a), bv = _mm_loadu_ps(b);
-    __m128 v[3];
-    for (int r = 0; r < 3; ++r)
-        v[r] = _mm_add_ps(
-            _mm_add_ps(_mm_mul_ps(_mm_set1_ps(worldFromCamera[0][r]), av),
-                       _mm_mul_ps(_mm_set1_ps(worldFromCamera[1][r]), _mm_set1_ps(1.0f))),
-            _mm_mul_ps(_mm_set1_ps(worldFromCamera[2][r]), bv));
-    const __m128 one = _mm_set1_ps(1.0f), sign = _mm_set1_ps(-0.0f);
-    const __m128 vv = _mm_add_ps(_mm_add_ps(_mm_mul_ps(v[0], v[0]), _mm_mul_ps(v[1], v[1])),
-                                 _mm_mul_ps(v[2], v[2]));
-    const __m128 inv = _mm_div_ps(one, _mm_sqrt_ps(vv));
-    // VisibleSource with toEye = −dir: cos θ = −(sun · toEye), glm's dot summed left to right.
-    __m128 toEye[3];
-    for (int r = 0; r < 3; ++r) toEye[r] = _mm_xor_ps(_mm_mul_ps(v[r], inv), sign);
-    const __m128 cosTheta =
-        _mm_xor_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_set1_ps(light.sunDirection.x), toEye[0]),
-                                         _mm_mul_ps(_mm_set1_ps(light.sunDirection.y), toEye[1])),
-                              _mm_mul_ps(_mm_set1_ps(light.sunDirection.z), toEye[2])),
-                   sign);
-    // HenyeyGreensteinPhase(cos θ, g).
-    const __m128 g = lanes([&](int l) { return t[l]->asymmetry; });
-    const __m128 gg = _mm_mul_ps(g, g);
-    const __m128 denom =
-        _mm_sub_ps(_mm_add_ps(one, gg), _mm_mul_ps(_mm_mul_ps(_mm_set1_ps(2.0f), g), cosTheta));
-    const __m128 phase =
-        _mm_div_ps(_mm_sub_ps(one, gg),
-                   _mm_mul_ps(_mm_mul_ps(_mm_set1_ps(4.0f * kPi), denom), _mm_sqrt_ps(denom)));
-    const __m128 omega = lanes([&](int l) { return t[l]->albedo; });
-    const __m128 rest = _mm_sub_ps(one, omega);
-    // The glow per lane (table look-ups).
-    glm::vec3 glow[4] = {glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f)};
-    if (light.glow)
-        for (int l = 0; l < n; ++l) glow[l] = VisibleGlow(*t[l], light);
-    alignas(16) float S[3][4];
-    for (int c = 0; c < 3; ++c) {
-        __m128 Sc =
-            _mm_mul_ps(omega, _mm_add_ps(_mm_mul_ps(_mm_set1_ps(light.sunIlluminance[c]), phase),
-                                         _mm_set1_ps(light.ambientRgb[c])));
-        if (light.glow)
-            Sc = _mm_add_ps(Sc, _mm_mul_ps(rest, lanes([&](int l) { return glow[l][c]; })));
-        _mm_store_ps(S[c], Sc);
+    // Four lanes of ScatteredSources (eight-lane builds compute four more from zeros and drop
+    // them), then each trace's glow per lane (table look-ups).
+    float omega[4], g[4];
+    for (int l = 0; l < 4; ++l) omega[l] = t[l]->albedo, g[l] = t[l]->asymmetry;
+    alignas(32) float S[3][simd::kLanes];
+    ScatteredSources(simd::Load(omega, 4), simd::Load(g, 4), simd::Load(a, 4), simd::Load(b, 4),
+                     worldFromCamera, light, S);
+    for (int l = 0; l < n; ++l) {
+        out[l] = glm::vec3(S[0][l], S[1][l], S[2][l]);
+        if (light.glow) {
+            const glm::vec3 glow = VisibleGlow(*t[l], light);
+            for (int c = 0; c < 3; ++c) out[l][c] = out[l][c] + (1.0f - omega[l]) * glow[c];
+        }
     }
-    for (int l = 0; l < n; ++l) out[l] = glm::vec3(S[0][l], S[1][l], S[2][l]);
 }
 
 namespace {
@@ -276,24 +271,10 @@ void BlendedVisibleSources(const BandTrace* const t[4], const float* fx, const f
     for (int k = 0; k < n; k += kLanes) {
         const size_t m = size_t(std::min(kLanes, n - k));
         const BlendSums blend(t, simd::Load(fx + k, m), simd::Load(fy + k, m));
-        const VF omega = blend.Albedo(), g = blend.Asymmetry();
-        // VisibleSource4's direction, phase function and source.
-        const VF av = simd::Load(a + k, m), bv = simd::Load(b + k, m);
-        VF v[3];
-        for (int r = 0; r < 3; ++r)
-            v[r] = (worldFromCamera[0][r] * av + simd::Splat(worldFromCamera[1][r] * 1.0f)) +
-                   worldFromCamera[2][r] * bv;
-        const VF inv = 1.0f / simd::Sqrt((v[0] * v[0] + v[1] * v[1]) + v[2] * v[2]);
-        VF toEye[3];
-        for (int r = 0; r < 3; ++r) toEye[r] = -(v[r] * inv);
-        const VF cosTheta = -((light.sunDirection.x * toEye[0] + light.sunDirection.y * toEye[1]) +
-                              light.sunDirection.z * toEye[2]);
-        const VF gg = g * g;
-        const VF denom = (1.0f + gg) - (2.0f * g) * cosTheta;
-        const VF phase = (1.0f - gg) / (((4.0f * kPi) * denom) * simd::Sqrt(denom));
+        const VF omega = blend.Albedo();
         alignas(32) float Sc[3][kLanes];
-        for (int c = 0; c < 3; ++c)
-            simd::Store(Sc[c], omega * (light.sunIlluminance[c] * phase + light.ambientRgb[c]));
+        ScatteredSources(omega, blend.Asymmetry(), simd::Load(a + k, m), simd::Load(b + k, m),
+                         worldFromCamera, light, Sc);
         simd::Store(tau + k, blend.depth, m);
         if (light.glow) {
             // The glow per lane (table look-ups) from the blended temperatures.
