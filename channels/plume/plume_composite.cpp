@@ -121,42 +121,55 @@ BandTrace Bilinear(const BandTrace* const t[4], float fx, float fy) {
     return out;
 }
 
-// The same operations lane for lane as Bilinear (SSE2, no fused multiply-add; a quotient
-// where Bilinear takes 0 is masked to +0).
+namespace {
+// Bilinear's sums on simd lanes, the same operations lane for lane (no fused multiply-add): the
+// blend of corners t at (x, y), before the quotients.
+struct BlendSums {
+    simd::VF depth{}, scattering{}, absorbing{}, temperature{}, hot{}, hotT{}, gs{};
+    BlendSums(const BandTrace* const t[4], simd::VF x, simd::VF y) {
+        using simd::VF;
+        const VF x1 = 1.0f - x, y1 = 1.0f - y;
+        const VF w[4] = {x1 * y1, x * y1, x1 * y, x * y};
+        for (int c = 0; c < 4; ++c) {
+            const VF wt = w[c] * t[c]->opticalDepth;
+            depth = depth + wt;
+            const VF ws = wt * t[c]->albedo;
+            scattering = scattering + ws;
+            gs = gs + ws * t[c]->asymmetry;
+            const VF wa = wt * (1.0f - t[c]->albedo);
+            absorbing = absorbing + wa;
+            temperature = temperature + wa * t[c]->temperature_K;
+            const VF wh = wa * t[c]->hotFraction;
+            hot = hot + wh;
+            hotT = hotT + wh * t[c]->hotTemperature_K;
+        }
+    }
+    // Bilinear's quotients (+0 where it takes 0).
+    simd::VF Albedo() const { return simd::Select(depth > 0.0f, scattering / depth, simd::VF{}); }
+    simd::VF Asymmetry() const {
+        return simd::Select(scattering > 0.0f, gs / scattering, simd::VF{});
+    }
+    simd::VF Temperature() const {
+        return simd::Select(absorbing > 0.0f, temperature / absorbing, simd::VF{});
+    }
+    simd::VF HotFraction() const {
+        return simd::Select(absorbing > 0.0f, simd::Min(hot / absorbing, simd::Splat(1.0f)),
+                            simd::VF{});
+    }
+    simd::VF HotTemperature() const { return simd::Select(hot > 0.0f, hotT / hot, simd::VF{}); }
+};
+}  // namespace
+
 void Bilinear4(const BandTrace* const t[4], const float fx[4], const float fy[4],
                BandTrace out[4]) {
-    const __m128 one = _mm_set1_ps(1.0f), zero = _mm_setzero_ps();
-    const __m128 x = _mm_loadu_ps(fx), y = _mm_loadu_ps(fy);
-    const __m128 x1 = _mm_sub_ps(one, x), y1 = _mm_sub_ps(one, y);
-    const __m128 w[4] = {_mm_mul_ps(x1, y1), _mm_mul_ps(x, y1), _mm_mul_ps(x1, y),
-                         _mm_mul_ps(x, y)};
-    __m128 tau = zero, scattering = zero, absorbing = zero, temperature = zero, hot = zero,
-           hotT = zero, g = zero;
-    for (int k = 0; k < 4; ++k) {
-        const __m128 wt = _mm_mul_ps(w[k], _mm_set1_ps(t[k]->opticalDepth));
-        tau = _mm_add_ps(tau, wt);
-        const __m128 ws = _mm_mul_ps(wt, _mm_set1_ps(t[k]->albedo));
-        scattering = _mm_add_ps(scattering, ws);
-        g = _mm_add_ps(g, _mm_mul_ps(ws, _mm_set1_ps(t[k]->asymmetry)));
-        const __m128 wa = _mm_mul_ps(wt, _mm_set1_ps(1.0f - t[k]->albedo));
-        absorbing = _mm_add_ps(absorbing, wa);
-        temperature = _mm_add_ps(temperature, _mm_mul_ps(wa, _mm_set1_ps(t[k]->temperature_K)));
-        const __m128 wh = _mm_mul_ps(wa, _mm_set1_ps(t[k]->hotFraction));
-        hot = _mm_add_ps(hot, wh);
-        hotT = _mm_add_ps(hotT, _mm_mul_ps(wh, _mm_set1_ps(t[k]->hotTemperature_K)));
-    }
-    // q where mask, else +0.
-    const auto masked = [&](__m128 mask, __m128 q) { return _mm_and_ps(mask, q); };
-    const __m128 anyTau = _mm_cmpgt_ps(tau, zero), anyAbs = _mm_cmpgt_ps(absorbing, zero);
-    const __m128 anyHot = _mm_cmpgt_ps(hot, zero), anyScat = _mm_cmpgt_ps(scattering, zero);
-    alignas(16) float f[6][4];
-    _mm_store_ps(f[0], tau);
-    _mm_store_ps(f[1], masked(anyTau, _mm_div_ps(scattering, tau)));
-    _mm_store_ps(f[2], masked(anyAbs, _mm_div_ps(temperature, absorbing)));
-    // std::min(q, 1) is (1 < q ? 1 : q), which _mm_min_ps(1, q) is.
-    _mm_store_ps(f[3], masked(anyAbs, _mm_min_ps(one, _mm_div_ps(hot, absorbing))));
-    _mm_store_ps(f[4], masked(anyHot, _mm_div_ps(hotT, hot)));
-    _mm_store_ps(f[5], masked(anyScat, _mm_div_ps(g, scattering)));
+    const BlendSums blend(t, simd::Load(fx, 4), simd::Load(fy, 4));
+    alignas(32) float f[6][simd::kLanes];
+    simd::Store(f[0], blend.depth);
+    simd::Store(f[1], blend.Albedo());
+    simd::Store(f[2], blend.Temperature());
+    simd::Store(f[3], blend.HotFraction());
+    simd::Store(f[4], blend.HotTemperature());
+    simd::Store(f[5], blend.Asymmetry());
     for (int l = 0; l < 4; ++l) {
         out[l].opticalDepth = f[0][l];
         out[l].albedo = f[1][l];
@@ -224,44 +237,6 @@ void VisibleSource4(const BandTrace* const t[4], const glm::mat3& worldFromCamer
         }
     }
 }
-
-namespace {
-// Bilinear4's sums on simd lanes: the blend of corners t at (x, y), before the quotients.
-struct BlendSums {
-    simd::VF depth{}, scattering{}, absorbing{}, temperature{}, hot{}, hotT{}, gs{};
-    BlendSums(const BandTrace* const t[4], simd::VF x, simd::VF y) {
-        using simd::VF;
-        const VF x1 = 1.0f - x, y1 = 1.0f - y;
-        const VF w[4] = {x1 * y1, x * y1, x1 * y, x * y};
-        for (int c = 0; c < 4; ++c) {
-            const VF wt = w[c] * t[c]->opticalDepth;
-            depth = depth + wt;
-            const VF ws = wt * t[c]->albedo;
-            scattering = scattering + ws;
-            gs = gs + ws * t[c]->asymmetry;
-            const VF wa = wt * (1.0f - t[c]->albedo);
-            absorbing = absorbing + wa;
-            temperature = temperature + wa * t[c]->temperature_K;
-            const VF wh = wa * t[c]->hotFraction;
-            hot = hot + wh;
-            hotT = hotT + wh * t[c]->hotTemperature_K;
-        }
-    }
-    // Bilinear4's quotients (0 where it takes 0).
-    simd::VF Albedo() const { return simd::Select(depth > 0.0f, scattering / depth, simd::VF{}); }
-    simd::VF Asymmetry() const {
-        return simd::Select(scattering > 0.0f, gs / scattering, simd::VF{});
-    }
-    simd::VF Temperature() const {
-        return simd::Select(absorbing > 0.0f, temperature / absorbing, simd::VF{});
-    }
-    simd::VF HotFraction() const {
-        return simd::Select(absorbing > 0.0f, simd::Min(hot / absorbing, simd::Splat(1.0f)),
-                            simd::VF{});
-    }
-    simd::VF HotTemperature() const { return simd::Select(hot > 0.0f, hotT / hot, simd::VF{}); }
-};
-}  // namespace
 
 void BlendedVisibleSources(const BandTrace* const t[4], const float* fx, const float* fy,
                            const float* a, const float* b, int n, const glm::mat3& worldFromCamera,
