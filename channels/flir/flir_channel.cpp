@@ -701,6 +701,7 @@ void FlirChannel::Render(const scene::SceneState& state, Image& radiance) {
         radiance);
     // Plumes (channels/plume) over the finished radiance.
     plumes_->CompositeFlir(state, cam, vis, *this, radiance);
+    stats_.plumes = plumes_->Stats();
 }
 
 }  // namespace seasense::channels

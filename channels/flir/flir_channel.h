@@ -12,6 +12,7 @@
 
 #include "channels/flir/flir_imager.h"
 #include "channels/flir/surf_infrared.h"
+#include "channels/plume/plume_composite.h"
 #include "channels/view/view_geometry.h"
 #include "radiometry/atmosphere/atmosphere.h"
 #include "radiometry/materials/material_table.h"
@@ -24,11 +25,12 @@ namespace seasense::channels {
 
 struct FlirFrameStats {
     ViewFrameStats view;
-    uint64_t shadowRays = 0;   // rays traced for sunlit/shaded model samples
-    double thermalMs = 0.0;    // model surface temperatures for the frame
-    double shadeMs = 0.0;      // shadow rays and shading
-    double cloudMs = 0.0;      // cloud layers over the sky (channels/flir/cloud_infrared)
-    uint64_t cloudTraces = 0;  // cloud grid rays traced
+    uint64_t shadowRays = 0;     // rays traced for sunlit/shaded model samples
+    double thermalMs = 0.0;      // model surface temperatures for the frame
+    double shadeMs = 0.0;        // shadow rays and shading
+    double cloudMs = 0.0;        // cloud layers over the sky (channels/flir/cloud_infrared)
+    uint64_t cloudTraces = 0;    // cloud grid rays traced
+    PlumeCompositeStats plumes;  // plume compositing (zero without plumes)
 };
 
 // The band of a flir channel (Band::Lwir 8–12 µm or Band::Mwir 3–5 µm).

@@ -1313,13 +1313,18 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     // Plumes (channels/plume) over the finished radiance.
     if (!basis_) {
         plumes_->CompositeOtw(state, cam, vis, sky, radiance);
+        stats_.plumes = plumes_->Stats();
         return;
     }
     if (!plumes_->Active()) return;
     if (!basisGlow_ && basis_->blackbody)
         basisGlow_ = std::make_unique<BlackbodyGlowTable>(basis_->blackbody);
     const PlumeLighting light = BasisPlumeLighting(key, downwelling, sky, basisGlow_.get());
-    CompositePlumes(plumes_->FieldAt(state.time_s), cam, vis, light, radiance, renderSpans_);
+    const auto start = std::chrono::steady_clock::now();
+    stats_.plumes =
+        CompositePlumes(plumes_->FieldAt(state.time_s), cam, vis, light, radiance, renderSpans_);
+    stats_.plumes.ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
 }  // namespace seasense::channels

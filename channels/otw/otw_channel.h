@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "channels/otw/shore_shading.h"
+#include "channels/plume/plume_composite.h"
 #include "channels/view/view_geometry.h"
 #include "radiometry/sky/analytic_sky.h"
 #include "scene/core/image.h"
@@ -44,6 +45,7 @@ struct OtwFrameStats {
     double cloudMs = 0.0;      // cloud layers over the sky (channels/otw/cloud_layer)
     uint64_t cloudTraces = 0;  // cloud rays traced (grid nodes and exact sun/moon samples)
     RasterStats raster;
+    PlumeCompositeStats plumes;  // plume compositing (zero without plumes)
 };
 
 class OtwChannel {

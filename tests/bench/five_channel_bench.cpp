@@ -59,6 +59,10 @@ void BM_FiveChannelRenderer(benchmark::State& state) {
     // raster and the shading pass.
     double renderMs = 0.0, sensorMs = 0.0, meshMs = 0.0, rasterMs = 0.0, shadeMs = 0.0;
     double shadowRays = 0.0;
+    double plumeMs = 0.0, plumeTraces = 0.0, plumeTests = 0.0;
+    const auto addPlumes = [&](const PlumeCompositeStats& p) {
+        plumeMs += p.ms, plumeTraces += double(p.traces), plumeTests += double(p.puffTests);
+    };
     for (auto _ : state) {
         state.PauseTiming();
         const scene::FrameState fs = world.Advance(first + i++ % kWindow);
@@ -73,12 +77,14 @@ void BM_FiveChannelRenderer(benchmark::State& state) {
             const FlirFrameStats& s = pipeline->Flir().Stats();
             meshMs += s.view.meshMs, rasterMs += s.view.rasterMs, shadeMs += s.shadeMs;
             shadowRays += double(s.shadowRays);
+            addPlumes(s.plumes);
         } else {
             const OtwFrameStats& s = ch.kind == scene::ChannelKind::Nvg
                                          ? pipeline->Nvg().Otw().Stats()
                                          : pipeline->Otw().Stats();
             meshMs += s.meshMs, rasterMs += s.rasterMs, shadeMs += s.shadeMs;
             shadowRays += double(s.shadowRays);
+            addPlumes(s.plumes);
         }
     }
     const double n = double(state.iterations());
@@ -88,6 +94,9 @@ void BM_FiveChannelRenderer(benchmark::State& state) {
     state.counters["raster_ms"] = rasterMs / n;
     state.counters["shade_ms"] = shadeMs / n;
     state.counters["shadow_rays"] = shadowRays / n;
+    state.counters["plume_ms"] = plumeMs / n;
+    state.counters["plume_traces"] = plumeTraces / n;
+    state.counters["plume_tests"] = plumeTests / n;
 }
 BENCHMARK(BM_FiveChannelRenderer)
     ->ArgNames({"channel", "threads", "first"})
