@@ -604,17 +604,17 @@ SurfaceBounds OceanSurfaceFrame::LocalBoundsNear(double x, double y, double radi
         const Bathymetry& bathy = surf_->Bathy();
         const double tide = bathy.Tide_m();
         const double zBed = bathy.MaxSeabedZWithin_m(x, y, radius_m + surfReach_m_);
-        // The surf components' height over the disc's rest positions also bounded by their
-        // envelope here and now (EnvelopeBoundNear): over a few metres about an eye above the
-        // fade zone it is well below the sum of their amplitudes, which from frame ~145 of the
-        // five-channel demo put the crests' bound within 0.3 m of the 2 m eye.
+        // The surf components' height over the disc's rest positions also bounded by their sum
+        // here and now (HeightBoundNear): over a few metres about an eye above the fade zone it
+        // is well below the sum of their amplitudes, which from frame ~145 of the five-channel
+        // demo put the crests' bound within 0.3 m of the 2 m eye.
         // The rest positions' depths lie in [shallow, deep]; the seabed clamp below looks under
         // displaced points (zBed, the disc grown by the reach).
         const double shallow = tide - bathy.MaxSeabedZWithin_m(x, y, radius_m);
         const double deep = tide - bathy.MinSeabedZWithin_m(x, y, radius_m);
-        const double envelope = surf_->EnvelopeBoundNear(x, y, t_s_, radius_m, shallow, deep);
+        const double surfHeight = surf_->HeightBoundNear(x, y, t_s_, radius_m, shallow, deep);
         const SurfWaves::Bound b =
-            surf_->BoundAtDepths(tide - zBed, cascades, gerstner, envelope, deep);
+            surf_->BoundAtDepths(tide - zBed, cascades, gerstner, surfHeight, deep);
         local = {std::max({tide + b.height_m, zBed, 0.0}), b.horizontal_m};
     }
     return {std::min(local.height_m + kLocalBoundMargin_m, global.height_m),

@@ -654,8 +654,8 @@ SurfWaves::Bound SurfWaves::BoundAtDepths(double minDepth_m, const std::vector<B
     return out;
 }
 
-double SurfWaves::EnvelopeBoundNear(double x, double y, double t, double radius_m,
-                                    double minDepth_m, double maxDepth_m) const {
+double SurfWaves::HeightBoundNear(double x, double y, double t, double radius_m, double minDepth_m,
+                                  double maxDepth_m) const {
     CHECK(radius_m >= 0.0 && minDepth_m <= maxDepth_m);
     constexpr double kInf = std::numeric_limits<double>::infinity();
     const size_t n = incoming_.size();
@@ -685,7 +685,32 @@ double SurfWaves::EnvelopeBoundNear(double x, double y, double t, double radius_
     const ShorePoint p = bathy_.Frame().ShoreFromWorld(x, y);
     const double landward =
         std::max(bathy_.Tide_m() - bathy_.ProfileZ_m(p.s_m - radius_m - ds_m_), kMinDepth_m);
-    double bound = 0.5 * centre.unbrokenHeight_m;  // |Σ a e^{iψ}| at (x, y)
+    double bound = 0.0;  // Re Σ a e^{iψ} at (x, y) (eRe below) plus the change across the disc
+    // A second bound, from the envelope's first-order change across the disc: with a_m(c) and
+    // ψ_m(c) the weighted amplitude and phase at the centre and Δψ_m = g_m · d + ε_m over the
+    // disc (d = the shore-frame offset, |d| ≤ radius; g_m = (g_s, k_u) with g_s the middle of
+    // the cross-shore phase slopes over the disc, so |ε_m| ≤ σ_m radius, σ_m their half
+    // spread),
+    //   Σ a_m(x) e^{iψ_m(x)} = E(c) + i G · d + Σ a_m(c) e^{iψ_m(c)} (e^{iΔψ_m} − 1 − i g_m · d)
+    //                          + Σ (a_m(x) − a_m(c)) e^{iψ_m(x)},
+    // E(c) = Σ a_m(c) e^{iψ_m(c)}, G = Σ a_m(c) e^{iψ_m(c)} g_m (two complex components), and
+    // |e^{iΔψ} − 1 − i g·d| ≤ |ε| + (g·d)²/2 (Taylor: |e^{iφ} − 1 − iφ| ≤ φ²/2) or ≤ 2 + |g·d|.
+    // E(c) and G keep the components' cancellation here and now, which the first bound gives
+    // up for all but E(c): over a disc of a few metres, where |g| radius is well below 1, the
+    // remainder is second order.
+    const double hc = std::max(centre.depth_m, kMinDepth_m);
+    const double cx = std::min(hc / dh_m_, double(depthSamples_ - 1));
+    const size_t ci = std::min(size_t(cx), size_t(depthSamples_ - 2));
+    const double cf = cx - double(ci);
+    const int phaseSamples = int(lanePhase_.size() / lanes_);
+    const auto tableIndex = [&](double s_m) { return (sRef_m_ - s_m) / ds_m_; };
+    // The table's cells that the disc's cross-shore positions reach (t: table index; seaward of
+    // the table the phase is k_s0 s, landward of its last sample constant).
+    const double tLo = tableIndex(p.s_m + radius_m), tHi = tableIndex(p.s_m - radius_m);
+    const int cellLo = int(std::clamp(std::floor(tLo), 0.0, double(phaseSamples - 2)));
+    const int cellHi = int(std::clamp(std::ceil(tHi) - 1.0, 0.0, double(phaseSamples - 2)));
+    double eRe = 0.0, eIm = 0.0, gsRe = 0.0, gsIm = 0.0, guRe = 0.0, guIm = 0.0;
+    double remainder = 0.0, spread = 0.0;
     for (size_t m = 0; m < n; ++m) {
         double lo = kInf, hi = 0.0;
         for (size_t i = i0; i <= i1; ++i) {
@@ -699,9 +724,48 @@ double SurfWaves::EnvelopeBoundNear(double x, double y, double t, double radius_
         const double kMax = DepthTable(tr.k, landward);
         const double dPsi = (std::abs(tr.ku) + std::max(kMax, std::abs(tr.ks0))) * radius_m;
         bound += (hi - lo) + hi * std::min(2.0, dPsi);
+        spread += hi - lo;
+
+        // The centre's weighted amplitude and phase as Terms forms them (in double).
+        const double a0 = depth_[ci * n + m].amplitude, a1 = depth_[(ci + 1) * n + m].amplitude;
+        const double ac = (a0 + cf * (a1 - a0)) *
+                          (spectral ? centre.weights.spectralSurf : centre.weights.gerstnerSurf);
+        const double* phase = lanePhase_.data() + m;
+        const auto tablePhase = [&](int i) { return phase[size_t(i) * lanes_]; };
+        double cross = tr.ks0 * p.s_m;
+        if (p.s_m < sRef_m_) {
+            const double tc = std::clamp(tableIndex(p.s_m), 0.0, double(phaseSamples - 1));
+            const int pi = std::min(int(tc), phaseSamples - 2);
+            const double pf = tc - double(pi);
+            cross =
+                tr.ks0 * sRef_m_ + (tablePhase(pi) + pf * (tablePhase(pi + 1) - tablePhase(pi)));
+        }
+        const double psi =
+            (tr.phaseOrigin + tr.ku * p.u_m + cross) - components_[incoming_[m]].omega_radps * t;
+        // ∂ψ/∂s over the disc: −Δphase / ds on the table's cells, k_s0 seaward of it, 0 beyond
+        // its landward end.
+        double sLo = kInf, sHi = -kInf;
+        for (int i = cellLo; i <= cellHi; ++i) {
+            const double slope = -(tablePhase(i + 1) - tablePhase(i)) / ds_m_;
+            sLo = std::min(sLo, slope), sHi = std::max(sHi, slope);
+        }
+        if (tLo < 0.0) sLo = std::min(sLo, tr.ks0), sHi = std::max(sHi, tr.ks0);
+        if (tHi > double(phaseSamples - 1)) sLo = std::min(sLo, 0.0), sHi = std::max(sHi, 0.0);
+        const double gs = 0.5 * (sLo + sHi), sigma = 0.5 * (sHi - sLo);
+        const double gLength = std::sqrt(gs * gs + tr.ku * tr.ku) * radius_m;
+        const double re = ac * std::cos(psi), im = ac * std::sin(psi);
+        eRe += re, eIm += im;
+        gsRe += re * gs, gsIm += im * gs;
+        guRe += re * tr.ku, guIm += im * tr.ku;
+        remainder += ac * std::min(sigma * radius_m + 0.5 * gLength * gLength, 2.0 + gLength);
     }
-    // The surface's float sums (a few ulp of the amplitudes) and the tables' float copies.
-    return bound * (1.0 + 1e-5) + 1e-4;
+    const double firstOrder =
+        radius_m * std::sqrt(gsRe * gsRe + gsIm * gsIm + guRe * guRe + guIm * guIm) + remainder +
+        spread;
+    // The height Terms adds is cap · Re Σ a e^{iψ} with 0 < cap ≤ 1: at most the positive part
+    // of Re E(c) plus the change. The surface's float sums (a few ulp of the amplitudes) and the
+    // tables' float copies: the relative and absolute margins.
+    return std::max(eRe + std::min(bound, firstOrder), 0.0) * (1.0 + 1e-5) + 1e-4;
 }
 
 SurfWaves::BoundTable SurfWaves::MakeBoundTable(const std::vector<Bound>& cascades,

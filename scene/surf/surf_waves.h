@@ -169,7 +169,7 @@ class SurfWaves {
         double horizontal_m = 0.0;
     };
     // surfCap_m, when given, caps the surf components' height in every interval (e.g.
-    // EnvelopeBoundNear's bound for the points in question), and maxDepth_m bounds the depths
+    // HeightBoundNear's bound for the points in question), and maxDepth_m bounds the depths
     // from above (no interval deeper, and the deep sea's own bound only if it reaches
     // FadeDeep_m).
     Bound BoundAtDepths(double minDepth_m, const std::vector<Bound>& cascades,
@@ -189,17 +189,21 @@ class SurfWaves {
     BoundTable MakeBoundTable(const std::vector<Bound>& cascades, const Bound& gerstner) const;
     Bound BoundAtDepths(double minDepth_m, const BoundTable& table) const;
 
-    // An upper bound (m) of the surf components' envelope |Σ a e^{iψ}| — which bounds the height
-    // they add (Terms: cap · Re Σ a e^{iψ}, cap ≤ 1; the swash apart) — at time t_s over every
-    // rest position within radius_m of world (x, y), whose still-water depths lie in
-    // [minDepth_m, maxDepth_m]: the envelope at (x, y) itself, plus for each component the
-    // spread of its weighted, shoaled amplitude over those depths and its amplitude times
-    // min(2, |Δψ|) for the largest phase change across the disc (|k_u| + max |k_s|) · radius.
+    // An upper bound (m) of the height the surf components add (Terms: cap · Re Σ a e^{iψ},
+    // 0 < cap ≤ 1; the swash apart) at time t_s over every rest position within radius_m of
+    // world (x, y), whose still-water depths lie in [minDepth_m, maxDepth_m]: the positive part
+    // of Re Σ a e^{iψ} at (x, y) itself plus the least of two bounds on its change across the
+    // disc, (1) per component the spread of its weighted, shoaled amplitude over those depths
+    // and its amplitude times min(2, |Δψ|) for the largest phase change (|k_u| + max |k_s|) ·
+    // radius; (2) the first-order change |G · d| ≤ radius ‖G‖ of the sum with the centre's
+    // amplitudes (G = Σ a e^{iψ} ∇ψ at the centre, the cross-shore slope taken mid-way between
+    // the phase table's slopes over the disc) plus, per component, the amplitude spread and
+    // its amplitude times the Taylor remainder (phase-slope spread × radius + (|∇ψ| radius)²/2).
     // Local in time as well as in space, unlike Σ a, which all components reach only together;
     // it grows with the radius and is worth taking only over a few metres (the sea under an
-    // eye). +∞ where (x, y) is dry or all deep (no envelope there to start from).
-    double EnvelopeBoundNear(double x, double y, double t_s, double radius_m, double minDepth_m,
-                             double maxDepth_m) const;
+    // eye). +∞ where (x, y) is dry or all deep (no sum there to start from).
+    double HeightBoundNear(double x, double y, double t_s, double radius_m, double minDepth_m,
+                           double maxDepth_m) const;
 
     // Mean breaker line (cross-shore s, m) of the plane beach: +∞ if no component, −∞ if the waves
     // never break before the shore.
