@@ -604,17 +604,18 @@ SurfaceBounds OceanSurfaceFrame::LocalBoundsNear(double x, double y, double radi
         const Bathymetry& bathy = surf_->Bathy();
         const double tide = bathy.Tide_m();
         const double zBed = bathy.MaxSeabedZWithin_m(x, y, radius_m + surfReach_m_);
-        // The surf components' height over the disc's rest positions also bounded by their sum
-        // here and now (HeightBoundNear): over a few metres about an eye above the fade zone it
-        // is well below the sum of their amplitudes, which from frame ~145 of the five-channel
-        // demo put the crests' bound within 0.3 m of the 2 m eye.
+        // The surf components' height and reach over the disc's rest positions also bounded by
+        // their sums here and now (SurfWaves::BoundNear): over a few metres about an eye above
+        // the fade zone they are well below the sums of their amplitudes and orbits, which from
+        // frame ~145 of the five-channel demo put the crests' bound within 0.3 m of the 2 m eye
+        // and widened the FLIR's rings near the eye to over twice its sector.
         // The rest positions' depths lie in [shallow, deep]; the seabed clamp below looks under
         // displaced points (zBed, the disc grown by the reach).
         const double shallow = tide - bathy.MaxSeabedZWithin_m(x, y, radius_m);
         const double deep = tide - bathy.MinSeabedZWithin_m(x, y, radius_m);
-        const double surfHeight = surf_->HeightBoundNear(x, y, t_s_, radius_m, shallow, deep);
+        const SurfWaves::Bound surfNear = surf_->BoundNear(x, y, t_s_, radius_m, shallow, deep);
         const SurfWaves::Bound b =
-            surf_->BoundAtDepths(tide - zBed, cascades, gerstner, surfHeight, deep);
+            surf_->BoundAtDepths(tide - zBed, cascades, gerstner, surfNear, deep);
         local = {std::max({tide + b.height_m, zBed, 0.0}), b.horizontal_m};
     }
     return {std::min(local.height_m + kLocalBoundMargin_m, global.height_m),

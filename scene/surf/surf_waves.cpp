@@ -613,7 +613,7 @@ SurfWaves::IntervalParts SurfWaves::Parts(int i, double surfDepth_m) const {
 
 SurfWaves::Bound SurfWaves::IntervalBound(int i, double surfDepth_m,
                                           const std::vector<Bound>& cascades, const Bound& gerstner,
-                                          double surfCap_m) const {
+                                          const Bound& surfCap) const {
     // The parts with the surf weights at the interval's shallow end are made once
     // (intervalParts_); only a minimum depth inside the interval needs its own.
     IntervalParts own;
@@ -631,15 +631,15 @@ SurfWaves::Bound SurfWaves::IntervalBound(int i, double surfDepth_m,
         b.height_m += w * cascades[c].height_m;
         b.horizontal_m += w * cascades[c].horizontal_m;
     }
-    b.height_m += std::min(parts.surfHeight_m, surfCap_m);
+    b.height_m += std::min(parts.surfHeight_m, surfCap.height_m);
     // + 0 where the swash does not reach: x + 0 is x (the sum is never −0).
     b.height_m += parts.swash_m;
-    b.horizontal_m += parts.surfHorizontal_m;
+    b.horizontal_m += std::min(parts.surfHorizontal_m, surfCap.horizontal_m);
     return b;
 }
 
 SurfWaves::Bound SurfWaves::BoundAtDepths(double minDepth_m, const std::vector<Bound>& cascades,
-                                          const Bound& gerstner, double surfCap_m,
+                                          const Bound& gerstner, const Bound& surfCap,
                                           double maxDepth_m) const {
     // A point at depth h in interval i (h0 ≤ h ≤ h1) has deep weights at most interval i's (at
     // h1) and surf weights at most those at max(h0, minDepth): every interval the depths
@@ -649,25 +649,25 @@ SurfWaves::Bound SurfWaves::BoundAtDepths(double minDepth_m, const std::vector<B
         const double h0 = i * dh_m_, h1 = (i + 1) * dh_m_;
         if (h1 < minDepth_m) continue;
         if (h0 >= fadeDeep_m_ || h0 > maxDepth_m) break;
-        MaxInto(out, IntervalBound(i, std::max(h0, minDepth_m), cascades, gerstner, surfCap_m));
+        MaxInto(out, IntervalBound(i, std::max(h0, minDepth_m), cascades, gerstner, surfCap));
     }
     return out;
 }
 
-double SurfWaves::HeightBoundNear(double x, double y, double t, double radius_m, double minDepth_m,
-                                  double maxDepth_m) const {
+SurfWaves::Bound SurfWaves::BoundNear(double x, double y, double t, double radius_m,
+                                      double minDepth_m, double maxDepth_m) const {
     CHECK(radius_m >= 0.0 && minDepth_m <= maxDepth_m);
     constexpr double kInf = std::numeric_limits<double>::infinity();
     const size_t n = incoming_.size();
     // No components, all dry, or all at or below the deepest fade (surf weights 0): Terms adds
     // none.
-    if (n == 0 || !(maxDepth_m > 0.0) || minDepth_m >= fadeDeep_m_) return 0.0;
+    if (n == 0 || !(maxDepth_m > 0.0) || minDepth_m >= fadeDeep_m_) return Bound{};
     TermsOptions options;
     options.velocity = false;
     options.dominant = Dominant::kWhereBroken;
     SurfPointInfo centre;
     Terms(x, y, t, &centre, options);
-    if (!(centre.depth_m > 0.0) || centre.weights.AllDeep()) return kInf;
+    if (!(centre.depth_m > 0.0) || centre.weights.AllDeep()) return Bound{kInf, kInf};
     // Each component's weighted amplitude lies between its smallest table amplitude over the
     // disc's depths times the surf weight at the deepest (the weights fall with depth: Fade
     // grows) and its largest times the weight at the shallowest wet depth; Terms interpolates
@@ -708,14 +708,36 @@ double SurfWaves::HeightBoundNear(double x, double y, double t, double radius_m,
     // the table the phase is k_s0 s, landward of its last sample constant).
     const double tLo = tableIndex(p.s_m + radius_m), tHi = tableIndex(p.s_m - radius_m);
     const int cellLo = int(std::clamp(std::floor(tLo), 0.0, double(phaseSamples - 2)));
-    const int cellHi = int(std::clamp(std::ceil(tHi) - 1.0, 0.0, double(phaseSamples - 2)));
+    // (At least the cell of the disc's seaward end: a centre on a sample with radius 0 reads
+    // none but takes the slopes either side into account through its cell's.)
+    const int cellHi = int(
+        std::clamp(std::max(std::ceil(tHi) - 1.0, std::floor(tLo)), 0.0, double(phaseSamples - 2)));
     double eRe = 0.0, eIm = 0.0, gsRe = 0.0, gsIm = 0.0, guRe = 0.0, guIm = 0.0;
     double remainder = 0.0, spread = 0.0;
+    // The horizontal sum V = Σ P_m sin ψ_m, P_m = a_m / tanh(k_m h) (k_s, k_u)_m / k_m (Terms'
+    // dispS, dispU before q, the cap and the orbit limit, which only shrink it), bounded the
+    // same way: V(c) + M d, M = Σ P_m(c) cos ψ_m(c) g_mᵀ, plus per component |P_m| times the
+    // remainder and the box of P_m over the disc's depths (|P_m(x) − P_m(c)|).
+    double vS = 0.0, vU = 0.0, mSS = 0.0, mSU = 0.0, mUS = 0.0, mUU = 0.0;
+    double remainderH = 0.0, spreadH = 0.0;
+    const auto lerp = [&](size_t m, auto field) {
+        const double v0 = field(depth_[ci * n + m]), v1 = field(depth_[(ci + 1) * n + m]);
+        return v0 + cf * (v1 - v0);
+    };
+    const auto productRange = [](double aLo, double aHi, double bLo, double bHi, double& lo,
+                                 double& hi) {
+        const double p[4] = {aLo * bLo, aLo * bHi, aHi * bLo, aHi * bHi};
+        lo = std::min({p[0], p[1], p[2], p[3]}), hi = std::max({p[0], p[1], p[2], p[3]});
+    };
     for (size_t m = 0; m < n; ++m) {
         double lo = kInf, hi = 0.0;
+        double itLo = kInf, itHi = -kInf, kxLo = kInf, kxHi = -kInf, ikLo = kInf, ikHi = -kInf;
         for (size_t i = i0; i <= i1; ++i) {
-            const double a = depth_[i * n + m].amplitude;
-            lo = std::min(lo, a), hi = std::max(hi, a);
+            const DepthSample& d = depth_[i * n + m];
+            lo = std::min(lo, d.amplitude), hi = std::max(hi, d.amplitude);
+            itLo = std::min(itLo, d.invTanh), itHi = std::max(itHi, d.invTanh);
+            kxLo = std::min(kxLo, d.kx), kxHi = std::max(kxHi, d.kx);
+            ikLo = std::min(ikLo, 1.0 / d.k), ikHi = std::max(ikHi, 1.0 / d.k);
         }
         const bool spectral = components_[incoming_[m]].spectral;
         lo *= spectral ? wDeep.spectralSurf : wDeep.gerstnerSurf;
@@ -757,7 +779,25 @@ double SurfWaves::HeightBoundNear(double x, double y, double t, double radius_m,
         eRe += re, eIm += im;
         gsRe += re * gs, gsIm += im * gs;
         guRe += re * tr.ku, guIm += im * tr.ku;
-        remainder += ac * std::min(sigma * radius_m + 0.5 * gLength * gLength, 2.0 + gLength);
+        const double taylor = std::min(sigma * radius_m + 0.5 * gLength * gLength, 2.0 + gLength);
+        remainder += ac * taylor;
+
+        // P_m at the centre (Terms interpolates a, 1/tanh, k_s and 1/k separately) and its box.
+        const double invK = lerp(m, [](const DepthSample& d) { return 1.0 / d.k; });
+        const double hor = ac * lerp(m, [](const DepthSample& d) { return d.invTanh; });
+        const double pS = hor * lerp(m, [](const DepthSample& d) { return d.kx; }) * invK;
+        const double pU = hor * tr.ku * invK;
+        const double sn = std::sin(psi), cs = std::cos(psi);
+        vS += pS * sn, vU += pU * sn;
+        mSS += pS * cs * gs, mSU += pS * cs * tr.ku, mUS += pU * cs * gs, mUU += pU * cs * tr.ku;
+        remainderH += std::sqrt(pS * pS + pU * pU) * taylor;
+        double horLo, horHi, eSLo, eSHi, eULo, eUHi, pSLo, pSHi, pULo, pUHi;
+        productRange(lo, hi, itLo, itHi, horLo, horHi);
+        productRange(kxLo, kxHi, ikLo, ikHi, eSLo, eSHi);
+        productRange(tr.ku, tr.ku, ikLo, ikHi, eULo, eUHi);
+        productRange(horLo, horHi, eSLo, eSHi, pSLo, pSHi);
+        productRange(horLo, horHi, eULo, eUHi, pULo, pUHi);
+        spreadH += std::hypot(pSHi - pSLo, pUHi - pULo);
     }
     const double firstOrder =
         radius_m * std::sqrt(gsRe * gsRe + gsIm * gsIm + guRe * guRe + guIm * guIm) + remainder +
@@ -765,7 +805,11 @@ double SurfWaves::HeightBoundNear(double x, double y, double t, double radius_m,
     // The height Terms adds is cap · Re Σ a e^{iψ} with 0 < cap ≤ 1: at most the positive part
     // of Re E(c) plus the change. The surface's float sums (a few ulp of the amplitudes) and the
     // tables' float copies: the relative and absolute margins.
-    return std::max(eRe + std::min(bound, firstOrder), 0.0) * (1.0 + 1e-5) + 1e-4;
+    const double height = std::max(eRe + std::min(bound, firstOrder), 0.0);
+    const double horizontal = std::hypot(vS, vU) +
+                              radius_m * std::sqrt(mSS * mSS + mSU * mSU + mUS * mUS + mUU * mUU) +
+                              remainderH + spreadH;
+    return {height * (1.0 + 1e-5) + 1e-4, horizontal * (1.0 + 1e-5) + 1e-4};
 }
 
 SurfWaves::BoundTable SurfWaves::MakeBoundTable(const std::vector<Bound>& cascades,

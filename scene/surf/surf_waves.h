@@ -168,13 +168,14 @@ class SurfWaves {
         double height_m = 0.0;
         double horizontal_m = 0.0;
     };
-    // surfCap_m, when given, caps the surf components' height in every interval (e.g.
-    // HeightBoundNear's bound for the points in question), and maxDepth_m bounds the depths
-    // from above (no interval deeper, and the deep sea's own bound only if it reaches
+    static constexpr Bound kNoCap{std::numeric_limits<double>::infinity(),
+                                  std::numeric_limits<double>::infinity()};
+    // surfCap, when given, caps the surf components' height and horizontal excursion in every
+    // interval (e.g. BoundNear's bounds for the points in question), and maxDepth_m bounds the
+    // depths from above (no interval deeper, and the deep sea's own bound only if it reaches
     // FadeDeep_m).
     Bound BoundAtDepths(double minDepth_m, const std::vector<Bound>& cascades,
-                        const Bound& gerstner,
-                        double surfCap_m = std::numeric_limits<double>::infinity(),
+                        const Bound& gerstner, const Bound& surfCap = kNoCap,
                         double maxDepth_m = std::numeric_limits<double>::infinity()) const;
     // The same for any minimum depth from one table per set of deep-sea bounds: each depth
     // interval's bound with its surf weights at its shallow end, and their running maximum from
@@ -189,21 +190,27 @@ class SurfWaves {
     BoundTable MakeBoundTable(const std::vector<Bound>& cascades, const Bound& gerstner) const;
     Bound BoundAtDepths(double minDepth_m, const BoundTable& table) const;
 
-    // An upper bound (m) of the height the surf components add (Terms: cap · Re Σ a e^{iψ},
-    // 0 < cap ≤ 1; the swash apart) at time t_s over every rest position within radius_m of
-    // world (x, y), whose still-water depths lie in [minDepth_m, maxDepth_m]: the positive part
-    // of Re Σ a e^{iψ} at (x, y) itself plus the least of two bounds on its change across the
-    // disc, (1) per component the spread of its weighted, shoaled amplitude over those depths
-    // and its amplitude times min(2, |Δψ|) for the largest phase change (|k_u| + max |k_s|) ·
-    // radius; (2) the first-order change |G · d| ≤ radius ‖G‖ of the sum with the centre's
-    // amplitudes (G = Σ a e^{iψ} ∇ψ at the centre, the cross-shore slope taken mid-way between
-    // the phase table's slopes over the disc) plus, per component, the amplitude spread and
-    // its amplitude times the Taylor remainder (phase-slope spread × radius + (|∇ψ| radius)²/2).
+    // Upper bounds (m) of the height and of the horizontal excursion the surf components add at
+    // time t_s over every rest position within radius_m of world (x, y), whose still-water
+    // depths lie in [minDepth_m, maxDepth_m] (Terms; the swash apart).
+    // Height, cap · Re Σ a e^{iψ} (0 < cap ≤ 1): the positive part of Re Σ a e^{iψ} at (x, y)
+    // itself plus the lesser of two bounds on its change across the disc, (1) per component
+    // the spread of its weighted, shoaled amplitude over those depths and its amplitude times
+    // min(2, |Δψ|) for the largest phase change (|k_u| + max |k_s|) · radius; (2) the
+    // first-order change |G · d| ≤ radius ‖G‖ of the sum with the centre's amplitudes (G =
+    // Σ a e^{iψ} ∇ψ at the centre, the cross-shore slope taken mid-way between the phase
+    // table's slopes over the disc) plus, per component, the amplitude spread and its amplitude
+    // times the Taylor remainder (phase-slope spread × radius + (|∇ψ| radius)²/2, at most
+    // 2 + |∇ψ| radius).
+    // Horizontal, q · cap · |Σ P sin ψ| shrunk by the orbit limit (P = a / tanh(kh) times the
+    // unit direction of travel): |Σ P sin ψ| at (x, y) plus radius ‖M‖ (M = Σ P cos ψ ∇ψᵀ at the
+    // centre, Frobenius norm) plus per component |P| times the same remainder and the extent of
+    // P's box over those depths.
     // Local in time as well as in space, unlike Σ a, which all components reach only together;
-    // it grows with the radius and is worth taking only over a few metres (the sea under an
+    // they grow with the radius and are worth taking only over a few metres (the sea under an
     // eye). +∞ where (x, y) is dry or all deep (no sum there to start from).
-    double HeightBoundNear(double x, double y, double t_s, double radius_m, double minDepth_m,
-                           double maxDepth_m) const;
+    Bound BoundNear(double x, double y, double t_s, double radius_m, double minDepth_m,
+                    double maxDepth_m) const;
 
     // Mean breaker line (cross-shore s, m) of the plane beach: +∞ if no component, −∞ if the waves
     // never break before the shore.
@@ -259,8 +266,7 @@ class SurfWaves {
     IntervalParts Parts(int i, double surfDepth_m) const;
     // Interval i's bound with the surf weights at surfDepth_m.
     Bound IntervalBound(int i, double surfDepth_m, const std::vector<Bound>& cascades,
-                        const Bound& gerstner,
-                        double surfCap_m = std::numeric_limits<double>::infinity()) const;
+                        const Bound& gerstner, const Bound& surfCap = kNoCap) const;
     std::vector<IntervalParts> intervalParts_;  // Parts(i, i·dh) per interval
     // kWide: the per-component loops eight float (four double) lanes at a time where the build
     // targets AVX2, else four (two) as in the SSE2 build.

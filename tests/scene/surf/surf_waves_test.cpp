@@ -237,28 +237,45 @@ TEST(SurfWaves, BoundTableEqualsTheIntervalLoop) {
     }
 }
 
-// The surf components' height bound over a disc (HeightBoundNear) holds at every wet rest
-// position in it — Terms' vertical displacement less the swash, cap · Re Σ a e^{iψ} — over the
-// fade zone, the bar and the beach, at many instants and radii; over a metre or less it is well
-// below the sum of the amplitudes at the disc's shallowest depth (the bound it tightens), and
-// over 2-6 m often below the first, per-component bound (its first-order form pays there).
-TEST(SurfWaves, HeightBoundHoldsOverTheDisc) {
+// The surf components' bounds over a disc (BoundNear) hold at every wet rest position in it —
+// the height, Terms' vertical displacement less the swash (cap · Re Σ a e^{iψ}), and the reach,
+// the length of its horizontal displacement — over the fade zone, the bar and the beach, at many
+// instants and radii; over 2 m or less they are well below the sums of the amplitudes and of the
+// orbits over the disc's depths (the bounds they tighten), and the height's below the envelope
+// |Σ a e^{iψ}| itself in many discs of 2-6 m.
+// The same surf with Gerstner steepness Q = 1 everywhere (deepSteepness 1): its horizontal
+// displacement outside the breakers is the whole sum Σ P sin ψ that the reach bounds, not half
+// of it, so the reach is tested without that slack.
+TEST(SurfWaves, BoundNearHoldsOverTheDisc) {
     const OceanSurface sea(SpectralBeach(true));
-    const SurfWaves& surf = *sea.Surf();
-    const Bathymetry& bathy = surf.Bathy();
+    const SurfWaves& own = *sea.Surf();
+    SurfWaveSettings fullSteepness;
+    fullSteepness.deepSteepness = 1.0;
+    const SurfWaves steep(own.Bathy(), own.Components(), sea.Summary().peakWavelength_m,
+                          own.Cascades(), fullSteepness);
+    const Bathymetry& bathy = own.Bathy();
     std::mt19937 rng(3);
     std::uniform_real_distribution<double> u01(0.0, 1.0);
-    int checked = 0, discs = 0, tighter = 0, wide = 0, belowEnvelope = 0;
-    double worstSlack = std::numeric_limits<double>::infinity();
-    for (int f = 0; f < 40; ++f) {
-        const double t = 0.77 * f;
+    int checked = 0, discs = 0, tighter = 0, narrower = 0, wide = 0, belowEnvelope = 0;
+    const std::vector<SurfWaves::Bound> noDeepSea(own.Cascades().size());
+    double worstSlack = std::numeric_limits<double>::infinity(), worstReachSlack = worstSlack;
+    for (int f = 0; f < 80; ++f) {
+        const SurfWaves& surf = f % 2 == 0 ? own : steep;
+        const double t = 0.77 * (f / 2);
         for (double s = 5.0; s < 1.05 * surf.FadeDeep_m() / 0.03; s += 23.0) {
-            const glm::dvec2 c = bathy.Frame().WorldFromShore(s, 40.0 + 3.0 * f);
+            const glm::dvec2 c = bathy.Frame().WorldFromShore(s, 40.0 + 3.0 * (f / 2));
             for (const double radius : {0.0, 0.5, 2.0, 6.0}) {
                 const double shallow = bathy.Tide_m() - bathy.MaxSeabedZWithin_m(c.x, c.y, radius);
                 const double deep = bathy.Tide_m() - bathy.MinSeabedZWithin_m(c.x, c.y, radius);
-                const double bound = surf.HeightBoundNear(c.x, c.y, t, radius, shallow, deep);
+                const SurfWaves::Bound near = surf.BoundNear(c.x, c.y, t, radius, shallow, deep);
+                const double bound = near.height_m;
                 if (!std::isfinite(bound)) continue;
+                ASSERT_TRUE(std::isfinite(near.horizontal_m));
+                // The surf's reach over the disc's depths without it (the sums of the orbits).
+                const double orbits = surf.BoundAtDepths(shallow, noDeepSea, SurfWaves::Bound{},
+                                                         SurfWaves::kNoCap, deep)
+                                          .horizontal_m;
+                if (radius <= 2.0 && near.horizontal_m < 0.7 * orbits) ++narrower;
                 ++discs;
                 // Σ a at the shallowest depth: what the interval bound takes for the surf.
                 SurfPointInfo at;
@@ -281,6 +298,12 @@ TEST(SurfWaves, HeightBoundHoldsOverTheDisc) {
                     const double height =
                         terms.displacement.z - surf.Swash_m(p.s_m, p.u_m, t, info.depth_m);
                     EXPECT_LE(height, bound) << "s " << s << " radius " << radius << " t " << t;
+                    EXPECT_LE(std::hypot(terms.displacement.x, terms.displacement.y),
+                              near.horizontal_m)
+                        << "s " << s << " radius " << radius << " t " << t;
+                    worstReachSlack = std::min(
+                        worstReachSlack,
+                        near.horizontal_m - std::hypot(terms.displacement.x, terms.displacement.y));
                     worstSlack = std::min(worstSlack, bound - height);
                     envelopeMax = std::max(envelopeMax, 0.5 * info.unbrokenHeight_m);
                     ++checked;
@@ -294,13 +317,15 @@ TEST(SurfWaves, HeightBoundHoldsOverTheDisc) {
     }
     EXPECT_GT(checked, 20000);
     EXPECT_GT(tighter, discs / 8) << discs;
+    EXPECT_GT(narrower, discs / 8) << discs;
     // A bound on the height, not on the envelope |Σ a e^{iψ}|: below the envelope's sampled
     // maximum in some wide discs (where the sum's real part stays below its modulus).
     EXPECT_GT(belowEnvelope, 0) << wide;
     std::printf(
-        "HeightBoundNear: %d points in %d discs, least slack %.4f m, %d of %d discs of 2-6 m "
-        "below the envelope's maximum\n",
-        checked, discs, worstSlack, belowEnvelope, wide);
+        "BoundNear: %d points in %d discs, least slack %.4f m (reach %.4f m); below 0.7 of the "
+        "sums in %d (height) and %d (reach) discs; %d of %d discs of 2-6 m below the envelope's "
+        "maximum\n",
+        checked, discs, worstSlack, worstReachSlack, tighter, narrower, belowEnvelope, wide);
 }
 
 TEST(SurfWaves, ChopKeepsItsWeightWhereItIsDeepWaterForItsWavelength) {
