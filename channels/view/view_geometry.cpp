@@ -201,6 +201,14 @@ scene::OceanMeshRequest SeaMeshRequest(const ChannelCamera& cam,
         SpansAzimuthSector(cam, renderSpans, req.azimuthMin_rad, req.azimuthMax_rad);
     req.widenByReach = true;
     req.minRange_m = NearestVisibleSeaRange_m(cam, sea, req.eye_m);
+    // The rings near the eye are seen no steeper than the lowest view ray: its depression's
+    // tangent rounded up to a step of 2^(1/8) (9 %), so that a view that pitches and rolls a
+    // little (an eyepoint on a ship) keeps the same near rings, which would otherwise move.
+    const double z = SteepestViewDirectionZ(cam);
+    if (z < 0.0) {
+        const double tan = -z / std::sqrt(std::max(1.0 - z * z, 1e-18));
+        req.maxDepressionTan = std::exp2(std::ceil(8.0 * std::log2(tan)) / 8.0);
+    }
     return req;
 }
 

@@ -78,6 +78,31 @@ std::vector<double> OceanMeshRadii(double eyeHeight_m, double significantHeight_
     return radii;
 }
 
+std::vector<double> ThinnedOceanMeshRadii(const std::vector<double>& radii, double eyeHeight_m,
+                                          double significantHeight_m, double dphi,
+                                          double maxDepressionTan) {
+    CHECK(dphi > 0.0 && maxDepressionTan > 0.0);
+    const double hEff = std::max(eyeHeight_m, 0.05) + 0.5 * significantHeight_m;
+    std::vector<double> out;
+    out.reserve(radii.size());
+    for (size_t i = 0; i < radii.size();) {
+        out.push_back(radii[i]);
+        const double r = radii[i];
+        size_t next = i + 1;
+        // The largest visible H. (Where it exceeds r, the step below is shorter than
+        // OceanMeshRadii's: (r² + H²) / H grows with H beyond r, and H < h; nothing is dropped.)
+        const double H = std::min(hEff, r * maxDepressionTan);
+        if (r > 0.0 && H < hEff) {
+            // The step of OceanMeshRadii with H for h (a hair shorter, for its rounding).
+            const double step =
+                std::min(dphi * (r * r + H * H) / H, std::max(8.0 * r, hEff) * dphi);
+            while (next + 1 < radii.size() && radii[next + 1] <= r + step * (1.0 - 1e-12)) ++next;
+        }
+        i = next;
+    }
+    return out;
+}
+
 void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req, OceanMesh& out) {
     CHECK(req.angularStep_rad > 0.0);
     const double eyeHeight = std::max(req.eye_m.z, 0.05);
@@ -100,6 +125,9 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
     // Rings: the fixed sequence, from the last ring at or inside the nearest visible range.
     std::vector<double> all =
         OceanMeshRadii(req.eye_m.z, frame.SignificantHeight_m(), dphi, maxRange);
+    if (std::isfinite(req.maxDepressionTan))
+        all = ThinnedOceanMeshRadii(all, req.eye_m.z, frame.SignificantHeight_m(), dphi,
+                                    req.maxDepressionTan);
     size_t j0 = 0;
     while (j0 + 1 < all.size() && all[j0 + 1] <= req.minRange_m) ++j0;
     std::vector<double> radii(all.begin() + std::ptrdiff_t(j0), all.end());

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <limits>
 #include <vector>
 
 #include "scene/ocean/ocean_surface.h"
@@ -42,6 +43,11 @@ struct OceanMeshRequest {
     // configs/surf.yaml, against D ≈ 3 m), which 20° covers beyond ~2.3 m. So near the eye this
     // is the old margin, not a proof.
     bool widenByReach = false;
+    // tan of the steepest depression below the horizontal of any view ray (∞: unknown). A sea
+    // point at range r and height H below the eye is seen only if H ≤ r · tan: the rings are
+    // thinned where that lowest visible surface lies above OceanMeshRadii's trough (see
+    // ThinnedOceanMeshRadii).
+    double maxDepressionTan = std::numeric_limits<double>::infinity();
     // False (tests only): no shortcut that provably changes no bit (see ocean_mesh.cpp): every
     // vertex of a surf zone through the whole surf path, also where
     // OceanSurfaceFrame::OpenSeaFrom_m proves it the deep sea's, and the Gerstner waves summed
@@ -93,6 +99,18 @@ struct OceanMesh {
 // them, capped at 8× the tangential spacing. A function of these arguments only.
 std::vector<double> OceanMeshRadii(double eyeHeight_m, double significantHeight_m,
                                    double angularStep_rad, double maxRange_m);
+// OceanMeshRadii's rings thinned for a view whose rays look at most atan(maxDepressionTan) below
+// the horizontal: a surface at range r is seen only if it lies at most H = r · maxDepressionTan
+// below the eye, and two rings dr apart on a surface H' below the eye are seen H' dr / (r² + H'²)
+// apart, which grows with H' up to H' = r; so where H is below the trough's depth h under the
+// eye (and below r: else nothing is dropped) the rings need only be dphi (r² + H²) / H apart
+// (the angular step for every surface the view can see there) rather than dphi (r² + h²) / h
+// (capped as there). A subsequence of radii: each ring is followed by the farthest ring of radii
+// within that step (at least the next), so from where the visible surface reaches the trough's
+// depth on it keeps every ring.
+std::vector<double> ThinnedOceanMeshRadii(const std::vector<double>& radii, double eyeHeight_m,
+                                          double significantHeight_m, double dphi,
+                                          double maxDepressionTan);
 
 // Builds the mesh for one view from a surface frame (see ocean_mesh.cpp for the choice of a
 // polar grid). Parallel over rings with oneTBB; bit-identical for any thread count.

@@ -662,6 +662,63 @@ TEST(OceanMesh, BitIdenticalForAnyThreadCount) {
         }
 }
 
+// Rings thinned for a view that looks at most atan(tan) down: where rings were dropped, every
+// surface the view can see between the two that remain (H below the eye, H ≤ r · tan at the
+// outer ring, H ≤ the trough's depth) sees them within the angular step (exact angles,
+// atan(H / r_a) − atan(H / r_b), 2 % over for the finite step); a subsequence that keeps every
+// ring from where the visible surface reaches the trough's depth; and for a 20° view 1° down
+// from 2 m, at most 55 % of the rings between 2.5 and 8 m (the FLIR of configs/five-channel.yaml
+// from frame ~145).
+TEST(OceanMesh, ThinnedRingsAreSeenWithinTheAngularStep) {
+    for (const double eye : {2.0, 12.0}) {
+        for (const double hs : {0.0, 3.0}) {
+            for (const double fov_deg : {20.0, 60.0}) {
+                const double dphi = 6.0 * (fov_deg * kPi / 180.0) / 640.0;
+                const std::vector<double> all = OceanMeshRadii(eye, hs, dphi, 6000.0);
+                const double hEff = eye + 0.5 * hs;
+                for (const double tan : {0.05, 0.1486, 0.435, 1.0, 3.0}) {
+                    const std::vector<double> thin = ThinnedOceanMeshRadii(all, eye, hs, dphi, tan);
+                    ASSERT_GE(thin.size(), 2u);
+                    EXPECT_EQ(thin.front(), all.front());
+                    EXPECT_EQ(thin.back(), all.back());
+                    size_t k = 0, near = 0, nearAll = 0;
+                    for (const double r : all) {
+                        if (r >= 2.5 && r <= 8.0) ++nearAll;
+                        const bool kept = k < thin.size() && thin[k] == r;
+                        if (kept) {
+                            if (r >= 2.5 && r <= 8.0) ++near;
+                            ++k;
+                        }
+                        if (r * std::min(tan, 1.0) >= hEff) {
+                            EXPECT_TRUE(kept) << r;
+                        }
+                    }
+                    ASSERT_EQ(k, thin.size()) << "not a subsequence";
+                    double worst = 0.0;
+                    int dropped = 0;
+                    for (size_t j = 1; j + 1 < thin.size(); ++j) {
+                        const double ra = thin[j], rb = thin[j + 1];
+                        // Neighbours in the full sequence too: no ring dropped between them.
+                        const auto at = std::lower_bound(all.begin(), all.end(), ra);
+                        if (at + 1 != all.end() && *(at + 1) == rb) continue;
+                        ++dropped;
+                        const double hMax = std::min(hEff, rb * tan);
+                        for (int i = 1; i <= 64; ++i) {
+                            const double H = hMax * i / 64.0;
+                            worst = std::max(worst, (std::atan(H / ra) - std::atan(H / rb)) / dphi);
+                        }
+                    }
+                    EXPECT_LE(worst, 1.02) << eye << " " << hs << " " << fov_deg << " " << tan;
+                    if (eye == 2.0 && hs == 0.0 && fov_deg == 20.0 && tan == 0.1486) {
+                        EXPECT_GT(dropped, 0);
+                        EXPECT_LE(100 * near, 55 * nearAll) << near << " of " << nearAll;
+                    }
+                }
+            }
+        }
+    }
+}
+
 TEST(OceanMesh, TurningOrTiltingTheViewMovesNoVertex) {
     // Azimuths are world-fixed and the rings do not depend on the view direction or the
     // nearest visible range: a vertex seen before and after is the same vertex.
