@@ -179,14 +179,18 @@ void UniformTable::operator()(size_t count, const float* x, float* out) const {
     const float* nodes = nodes_.data();
     const VF scale = simd::Splat(scale_), last = simd::Splat(last_),
              lastCell = simd::Splat(float(nodes_.size() - 2));
-    for (size_t i = 0; i < count; i += simd::kLanes) {
-        const size_t lanes = std::min(simd::kLanes, count - i);
-        const VF u = simd::Min(simd::Max(simd::Load(x + i, lanes, 0.0f) * scale, VF{}), last);
+    const auto Lookup = [&](VF x) {
+        const VF u = simd::Min(simd::Max(x * scale, VF{}), last);
         const VI cell = __builtin_convertvector(simd::Min(u, lastCell), VI);
         VF a, b;
         simd::GatherPair(nodes, cell, a, b);
-        simd::Store(out + i, a + (b - a) * (u - __builtin_convertvector(cell, VF)), lanes);
-    }
+        return a + (b - a) * (u - __builtin_convertvector(cell, VF));
+    };
+    // Whole lane groups, then the rest padded with zeros.
+    size_t i = 0;
+    for (; i + simd::kLanes <= count; i += simd::kLanes)
+        simd::Store(out + i, Lookup(simd::Load(x + i)));
+    if (i < count) simd::Store(out + i, Lookup(simd::Load(x + i, count - i, 0.0f)), count - i);
 }
 
 FlirChannel::FlirChannel(const scene::World& world, const scene::ChannelSettings& settings)
@@ -471,13 +475,18 @@ void FlirChannel::ShadeSea(const FrameShading& f, ShadeBlock& sc, size_t count, 
         std::copy_n(sc.seaPN + 8 * (count - 1), 8, sc.seaPN + 8 * i);
         std::copy_n(sc.seaA + 4 * (count - 1), 4, sc.seaA + 4 * i);
     }
+    // The frame's constants in locals: the stores to sc could alias f's members, which would
+    // be read again for every lane group.
+    const VF eyeX = simd::Splat(f.eye.x), eyeY = simd::Splat(f.eye.y), eyeZ = simd::Splat(f.eye.z);
+    const SurfInfrared surf = f.surf;
+    const VF airB = simd::Splat(f.airB);
     for (size_t i = 0; i < count; i += simd::kLanes) {
         VF nx, ny, nz, px, py, pz, unused;
         RecordLanes(sc.seaPN + 8 * i + 4, 8, nx, ny, nz, unused);
         RecordLanes(sc.seaPN + 8 * i, 8, px, py, pz, unused);
         const VF invN = 1.0f / simd::Sqrt(simd::Dot(nx, ny, nz, nx, ny, nz));
         nx = nx * invN, ny = ny * invN, nz = nz * invN;
-        const VF tx = f.eye.x - px, ty = f.eye.y - py, tz = f.eye.z - pz;
+        const VF tx = eyeX - px, ty = eyeY - py, tz = eyeZ - pz;
         const VF range = simd::Sqrt(simd::Dot(tx, ty, tz, tx, ty, tz));
         const VF invRange = 1.0f / range;
         const VF ndv = simd::Dot(nx, ny, nz, tx, ty, tz) * invRange;
@@ -493,10 +502,10 @@ void FlirChannel::ShadeSea(const FrameShading& f, ShadeBlock& sc, size_t count, 
     for (size_t i = 0; i < count; i += simd::kLanes) {
         VF depth, wet, foam, unused;
         RecordLanes(sc.seaA + 4 * i, 4, depth, wet, foam, unused);
-        const VF L = SurfInfraredRadiance(f.surf, simd::Load(sc.d + i), seaB, simd::Load(sc.e + i),
+        const VF L = SurfInfraredRadiance(surf, simd::Load(sc.d + i), seaB, simd::Load(sc.e + i),
                                           depth, wet, foam);
         const VF tau = simd::Load(sc.a + i);
-        simd::Store(sc.b + i, tau * L + (1.0f - tau) * f.airB);
+        simd::Store(sc.b + i, tau * L + (1.0f - tau) * airB);
     }
     const float* L = sc.b;
     for (size_t r = 0; r < sc.seaRuns; L += sc.seaRunLength[r], ++r)

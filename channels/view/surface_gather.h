@@ -96,30 +96,42 @@ class SeaGather {
                float* attributes, size_t& records) {
         using namespace simd4;
         size_t r = records;
-        for (; x < sw; ++x) {
+        // A run of samples on one triangle at a time, its vertices in locals (registers: the
+        // record stores could alias the members, which would be reloaded for every sample).
+        while (x < sw && r < kCapacity) {
             const uint32_t prim = prims[x];
             if (!IsSea(prim)) break;
             if (prim != prim_) Fetch(prim);
-            const float u = b1[x], v = b2[x];
+            const int first = x, end = x + int(std::min(size_t(sw - x), kCapacity - r));
+            float* record = pn + 8 * r;
+            float* attribute = attributes + 4 * r;
 #if defined(__AVX__)
-            const __m256 w0 = _mm256_set1_ps(1.0f - u - v), w1 = _mm256_set1_ps(u),
-                         w2 = _mm256_set1_ps(v);
-            _mm256_storeu_ps(pn + 8 * r, _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(w0, pn_[0]),
-                                                                     _mm256_mul_ps(w1, pn_[1])),
-                                                       _mm256_mul_ps(w2, pn_[2])));
-            _mm_storeu_ps(attributes + 4 * r,
-                          Interpolate(_mm256_castps256_ps128(w0), _mm256_castps256_ps128(w1),
-                                      _mm256_castps256_ps128(w2), a_));
+            const __m256 v0 = pn_[0], v1 = pn_[1], v2 = pn_[2];
 #else
-            const F4 w0 = Set4(1.0f - u - v), w1 = Set4(u), w2 = Set4(v);
-            _mm_storeu_ps(pn + 8 * r, Interpolate(w0, w1, w2, p_));
-            _mm_storeu_ps(pn + 8 * r + 4, Interpolate(w0, w1, w2, n_));
-            _mm_storeu_ps(attributes + 4 * r, Interpolate(w0, w1, w2, a_));
+            const F4 p[3] = {p_[0], p_[1], p_[2]}, n[3] = {n_[0], n_[1], n_[2]};
 #endif
-            if (++r == kCapacity) {
-                ++x;
-                break;
-            }
+            const F4 a[3] = {a_[0], a_[1], a_[2]};
+            do {
+                const float u = b1[x], v = b2[x];
+#if defined(__AVX__)
+                const __m256 w0 = _mm256_set1_ps(1.0f - u - v), w1 = _mm256_set1_ps(u),
+                             w2 = _mm256_set1_ps(v);
+                _mm256_storeu_ps(record, _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(w0, v0),
+                                                                     _mm256_mul_ps(w1, v1)),
+                                                       _mm256_mul_ps(w2, v2)));
+                _mm_storeu_ps(attribute,
+                              Interpolate(_mm256_castps256_ps128(w0), _mm256_castps256_ps128(w1),
+                                          _mm256_castps256_ps128(w2), a));
+#else
+                const F4 w0 = Set4(1.0f - u - v), w1 = Set4(u), w2 = Set4(v);
+                _mm_storeu_ps(record, Interpolate(w0, w1, w2, p));
+                _mm_storeu_ps(record + 4, Interpolate(w0, w1, w2, n));
+                _mm_storeu_ps(attribute, Interpolate(w0, w1, w2, a));
+#endif
+                record += 8;
+                attribute += 4;
+            } while (++x < end && prims[x] == prim);
+            r += size_t(x - first);
         }
         records = r;
         return x;

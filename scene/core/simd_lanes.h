@@ -46,7 +46,8 @@ inline void Store(float* p, VF v, size_t count = kLanes) {
 // pair by one 8-byte load, split four lanes at a time. On the AMD cores this project runs on,
 // two eight-lane gather instructions are slower than these loads (BM_UniformTableLanes).
 inline void GatherPair(const float* base, VI index, VF& lo, VF& hi) {
-    alignas(32) int32_t at[kLanes];
+    // Unsigned, so that each lane's offset needs no sign extension (the indices are ≥ 0).
+    alignas(32) uint32_t at[kLanes];
     std::memcpy(at, &index, sizeof at);
     const auto Pair = [&](size_t l) { return reinterpret_cast<const __m64*>(base + at[l]); };
     __m128 even[kLanes / 4], odd[kLanes / 4];
