@@ -15,6 +15,7 @@
 #include "channels/otw/celestial.h"
 #include "channels/otw/cloud_layer.h"
 #include "channels/otw/lightning_overlay.h"
+#include "channels/otw/quad_pixels.h"
 #include "channels/otw/sea_glint.h"
 #include "channels/otw/shore_shading.h"
 #include "channels/otw/spray_overlay.h"
@@ -524,8 +525,15 @@ class BlockClassifier {
         }
         const glm::vec3 pixelRow = g_.RowBase(1.0 - 2.0 * (py * n + 0.5 * n) / g_.sampleHeight);
         const uint32_t kRow = uint32_t(size_t(py * n - y0_) * size_t(sw));
+        int px = pxBegin;
+        if constexpr (kN == 2) {
+            // Whole row segments of kLanes pixels, their decisions on lanes (QuadPixels); the
+            // rest pixel by pixel below.
+            for (; px + int(simd::kLanes) <= pxEnd; px += int(simd::kLanes))
+                QuadGroup(px, kRow, pixelRow);
+        }
         const uint32_t* prim = primitive_;
-        for (int px = pxBegin; px < pxEnd; ++px) {
+        for (; px < pxEnd; ++px) {
             const int x0 = px * n;
             const uint32_t prim0 = prim[rowIndex_[0] + size_t(x0)];
             bool same = true, allSea = true;
@@ -557,13 +565,73 @@ class BlockClassifier {
             } else if (allSea && (same ? SeaTrianglePixel(x0, k, prim0) : SeaPixel(x0, k))) {
                 continue;
             }
-            for (int j = 0; j < n; ++j)
-                for (int i = 0; i < n; ++i) Sample(x0 + i, j, k + uint32_t(j * sw + i));
+            Samples(x0, k);
         }
     }
 
   private:
     int N() const { return kN > 0 ? kN : g_.n; }
+
+    // Every sample of the pixel with top-left sample x0 (entry k) on its own.
+    void Samples(int x0, uint32_t k) {
+        for (int j = 0; j < N(); ++j)
+            for (int i = 0; i < N(); ++i) Sample(x0 + i, j, k + uint32_t(j * g_.sampleWidth + i));
+    }
+
+    // Pixels [px, px + kLanes) of the pixel row (N = 2) as Pixels classifies them one by one,
+    // their decisions made on lanes; a segment of sky pixels away from the sun is added at once.
+    void QuadGroup(int px, uint32_t kRow, const glm::vec3& pixelRow) {
+        using namespace simd;
+        const size_t i0 = rowIndex_[0] + size_t(2 * px), i1 = rowIndex_[1] + size_t(2 * px);
+        const QuadPixels q = ClassifyQuadPixels(
+            primitive_ + i0, primitive_ + i1, depth_ + i0, depth_ + i1, b1_ + i0, b1_ + i1,
+            b2_ + i0, b2_ + i1, g_.firstModelPrimitive, kMaxSeaPixelDepthRatio);
+        alignas(32) int32_t x0[kLanes];
+        for (size_t l = 0; l < kLanes; ++l) x0[l] = 2 * px + int(2 * l);
+        if (All(q.sky)) {
+            // The pixels' centre rays and NearSun as the scalar code computes them, lane by lane
+            // (glm::dot's (x + y) + z).
+            VI xs;
+            std::memcpy(&xs, x0, sizeof xs);
+            const VF u = __builtin_convertvector(xs, VF) + 1.0f;  // float(x0) + 0.5 · N
+            const VF dx = pixelRow.x + u * g_.colStep.x, dy = pixelRow.y + u * g_.colStep.y,
+                     dz = pixelRow.z + u * g_.colStep.z;
+            const VF c = Dot(dx, dy, dz, Splat(f_.sunDir.x), Splat(f_.sunDir.y),
+                             Splat(f_.sunDir.z));
+            const VI near = (c > 0.0f) & (c * c >= (f_.cosNearSun * f_.cosNearSun) *
+                                                       Dot(dx, dy, dz, dx, dy, dz));
+            if (!Any(near)) {
+                const size_t e = sc_.skyCount;
+                sc_.skyCount += kLanes;
+                const VI keys = (xs + int32_t(kRow)) | int32_t(kPixelEntry);
+                std::memcpy(&sc_.skyK[e], &keys, sizeof keys);
+                Store(&sc_.skyX[e], dx), Store(&sc_.skyY[e], dy), Store(&sc_.skyZ[e], dz);
+                return;
+            }
+        }
+        alignas(32) int32_t same[kLanes], allSea[kLanes], sky[kLanes], close[kLanes];
+        alignas(32) float b1Sum[kLanes], b2Sum[kLanes];
+        std::memcpy(same, &q.same, sizeof same), std::memcpy(allSea, &q.allSea, sizeof allSea);
+        std::memcpy(sky, &q.sky, sizeof sky), std::memcpy(close, &q.depthsClose, sizeof close);
+        Store(b1Sum, q.b1Sum), Store(b2Sum, q.b2Sum);
+        for (size_t l = 0; l < kLanes; ++l) {
+            const uint32_t k = kRow + uint32_t(x0[l]);
+            if (sky[l]) {
+                const glm::vec3 d = pixelRow + (float(x0[l]) + 0.5f * float(kN)) * g_.colStep;
+                if (!f_.NearSun(d)) {
+                    AddSky(k | kPixelEntry, d);
+                    continue;
+                }
+            } else if (allSea[l] && close[l]) {
+                if (same[l])
+                    SeaTriangleClosePixel(x0[l], k, primitive_[i0 + 2 * l], b1Sum[l], b2Sum[l]);
+                else
+                    SeaClosePixel(x0[l], k);
+                continue;
+            }
+            Samples(x0[l], k);
+        }
+    }
 
     // The cached triangle prim. The hit, most calls, is inlined; the gathering is not.
     __attribute__((always_inline)) const CachedTriangle& Triangle(uint32_t prim) {
@@ -622,21 +690,31 @@ class BlockClassifier {
     // (then its samples are added one by one, as Sample adds them) or depth does (then returns
     // false, nothing added). On one triangle c is linear in the barycentrics.
     __attribute__((always_inline)) bool SeaTrianglePixel(int x0, uint32_t k, uint32_t prim) {
-        const int n = N(), count = n * n;
         if (!DepthsClose(x0)) return false;
+        float b1Sum = 0.0f, b2Sum = 0.0f;
+        for (int j = 0; j < N(); ++j) {
+            const size_t index = rowIndex_[j] + size_t(x0);
+            for (int i = 0; i < N(); ++i) {
+                b1Sum += b1_[index + size_t(i)];
+                b2Sum += b2_[index + size_t(i)];
+            }
+        }
+        SeaTriangleClosePixel(x0, k, prim, b1Sum, b2Sum);
+        return true;
+    }
+
+    // SeaTrianglePixel once the depths are close, with the sums of the samples' barycentrics.
+    __attribute__((always_inline)) void SeaTriangleClosePixel(int x0, uint32_t k, uint32_t prim,
+                                                              float b1Sum, float b2Sum) {
+        const int n = N(), count = n * n;
         const CachedTriangle& tri = Triangle(prim);
         // The samples' barycentrics are read in place, row by row (a local copy of them cost a
         // memmove call per row).
         const float *b1[kMaxSupersampling], *b2[kMaxSupersampling];
-        float b1Sum = 0.0f, b2Sum = 0.0f;
         for (int j = 0; j < n; ++j) {
             const size_t index = rowIndex_[j] + size_t(x0);
             b1[j] = b1_ + index;
             b2[j] = b2_ + index;
-            for (int i = 0; i < n; ++i) {
-                b1Sum += b1[j][i];
-                b2Sum += b2[j][i];
-            }
         }
         // The mean (a power-of-two scale for N = 1, 2, 4: exact).
         const float inv = 1.0f / float(count);
@@ -656,7 +734,7 @@ class BlockClassifier {
             for (int j = 0; j < n; ++j)
                 for (int i = 0; i < n; ++i)
                     SeaSample(tri, b1[j][i], b2[j][i], k + uint32_t(j * g_.sampleWidth + i));
-            return true;
+            return;
         }
         const size_t e =
             AddSea(k | kPixelEntry, p, nSum, InterpolateAttributes(tri, b1Sum * inv, b2Sum * inv));
@@ -667,14 +745,19 @@ class BlockClassifier {
                     Interpolate(tri, b1[j][i], b2[j][i], samples[j * n + i], unused);
             SeaShadowRays(e, samples, count);
         }
-        return true;
     }
 
     // As SeaTrianglePixel, for a pixel whose sea samples lie on different triangles: the
     // samples' positions and normals are interpolated one by one and averaged.
     bool SeaPixel(int x0, uint32_t k) {
-        const int n = N(), count = n * n;
         if (!DepthsClose(x0)) return false;
+        SeaClosePixel(x0, k);
+        return true;
+    }
+
+    // SeaPixel once the depths are close.
+    void SeaClosePixel(int x0, uint32_t k) {
+        const int n = N(), count = n * n;
         constexpr int kMaxSamples = kMaxSupersampling * kMaxSupersampling;
         F4 p[kMaxSamples], nrm[kMaxSamples], a[kMaxSamples];
         bool sampleShadowable[kMaxSamples];
@@ -712,12 +795,11 @@ class BlockClassifier {
                     if (sampleShadowable[s]) SeaShadowRays(e, &p[s], 1);
                 }
             }
-            return true;
+            return;
         }
         const size_t e =
             AddSea(k | kPixelEntry, mean, nSum, _mm_mul_ps(aSum, Set4(1.0f / float(count))));
         if (shadowable) SeaShadowRays(e, p, count);
-        return true;
     }
 
     // A lit sea entry at position p with normal nSum (unnormalized: SeaShading::Shade normalizes
