@@ -731,6 +731,12 @@ class BlockClassifier {
             }
         }
         if (!CosSpreadSmall(cMin, cMax, std::sqrt(Dot3(toEye, toEye)))) {
+            if constexpr (kN == 2) {
+                if (!tri.shadowable) {
+                    SeaSamplesOnTriangle(tri, b1[0], b1[1], b2[0], b2[1], k);
+                    return;
+                }
+            }
             for (int j = 0; j < n; ++j)
                 for (int i = 0; i < n; ++i)
                     SeaSample(tri, b1[j][i], b2[j][i], k + uint32_t(j * g_.sampleWidth + i));
@@ -787,6 +793,20 @@ class BlockClassifier {
         }
         if (!CosSpreadSmall(cMin, cMax, std::sqrt(Dot3(toEye, toEye)))) {
             // The samples one by one, from the values just interpolated.
+            if constexpr (kN == 2) {
+                if (!shadowable) {
+                    // Their components sample by sample on lanes: the same values, stored at once.
+                    const auto Components = [](const F4* v, F4 (&c)[3]) {
+                        F4 r0 = v[0], r1 = v[1], r2 = v[2], r3 = v[3];
+                        _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+                        c[0] = r0, c[1] = r1, c[2] = r2;
+                    };
+                    F4 pc[3], nc[3], ac[3];
+                    Components(p, pc), Components(nrm, nc), Components(a, ac);
+                    AddSeaSamples(k, pc, nc, ac);
+                    return;
+                }
+            }
             for (int j = 0; j < n; ++j) {
                 for (int i = 0; i < n; ++i) {
                     const int s = j * n + i;
@@ -833,6 +853,49 @@ class BlockClassifier {
                 sc_.originOwner.push_back(kSeaOwner | uint32_t(e));
             }
         }
+    }
+
+    // The four samples of a pixel (N = 2, entry k) on unshadowable triangle tri as SeaSample
+    // adds them one by one, on four lanes (sample (j, i) in lane 2j + i, the barycentrics of
+    // row j from b1j, b2j): Interpolate's and InterpolateAttributes' operations per component
+    // in the same order, stored to the sea arrays at once.
+    __attribute__((always_inline)) void SeaSamplesOnTriangle(const CachedTriangle& tri, const float* b10, const float* b11,
+                              const float* b20, const float* b21, uint32_t k) {
+        const auto Rows = [](const float* row0, const float* row1) {
+            return _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), reinterpret_cast<const __m64*>(row0)),
+                                reinterpret_cast<const __m64*>(row1));
+        };
+        const F4 w1 = Rows(b10, b11), w2 = Rows(b20, b21);
+        const F4 w0 = _mm_sub_ps(_mm_sub_ps(Set4(1.0f), w1), w2);
+        // Component c of vertex attributes v0, v1, v2 interpolated.
+        const auto Component = [&](const F4& v0, const F4& v1, const F4& v2, int c) {
+            return Interpolate3(w0, w1, w2, Set4(v0[c]), Set4(v1[c]), Set4(v2[c]));
+        };
+        F4 p[3], nrm[3], a[3];
+        for (int c = 0; c < 3; ++c) {
+            p[c] = Component(tri.p0, tri.p1, tri.p2, c);
+            nrm[c] = Component(tri.n0, tri.n1, tri.n2, c);
+            a[c] = Component(tri.a0, tri.a1, tri.a2, c);
+        }
+        AddSeaSamples(k, p, nrm, a);
+    }
+
+    // The four samples of a pixel (N = 2, entry k) as four lit sea entries, as AddSea adds
+    // them one by one: sample (j, i) in lane 2j + i of the positions', normals' and
+    // attributes' components (x, y, z).
+    __attribute__((always_inline)) void AddSeaSamples(uint32_t k, const F4 (&p)[3], const F4 (&nrm)[3], const F4 (&a)[3]) {
+        const size_t e = sc_.seaCount;
+        sc_.seaCount += 4;
+        _mm_storeu_ps(&sc_.seaPx[e], p[0]), _mm_storeu_ps(&sc_.seaPy[e], p[1]);
+        _mm_storeu_ps(&sc_.seaPz[e], p[2]);
+        _mm_storeu_ps(&sc_.seaNx[e], nrm[0]), _mm_storeu_ps(&sc_.seaNy[e], nrm[1]);
+        _mm_storeu_ps(&sc_.seaNz[e], nrm[2]);
+        _mm_storeu_ps(&sc_.seaDepth[e], a[0]), _mm_storeu_ps(&sc_.seaWet[e], a[1]);
+        _mm_storeu_ps(&sc_.seaFoam[e], a[2]);
+        const uint32_t sw = uint32_t(g_.sampleWidth);
+        const uint32_t keys[4] = {k, k + 1, k + sw, k + sw + 1};
+        std::memcpy(&sc_.seaK[e], keys, sizeof keys);
+        std::memset(&sc_.seaUnlit[e], 0, 4 * sizeof(uint16_t));
     }
 
     // Sea sample k at barycentrics (1 − b1 − b2, b1, b2) of triangle tri, shaded on its own.
