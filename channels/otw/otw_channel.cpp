@@ -362,8 +362,10 @@ struct BlockScratch {
     // pixel rows the same ones again (sea vertices are ~6 pixels apart), so each is gathered
     // about once per block. Entries of another frame or primitive are gathered anew; the
     // gathered values depend only on the frame and the primitive, so whatever the cache holds
-    // the shading is the same.
-    static constexpr uint32_t kTriangleCacheSize = 1024;
+    // the shading is the same. 2048 entries (360 kB) keep more of the previous block's
+    // triangles than 1024: otw-center at frames 120-121 gathered 32.3 k triangles, not 41.8 k
+    // (4096 entries: 30.1 k).
+    static constexpr uint32_t kTriangleCacheSize = 2048;
     std::vector<CachedTriangle> triangles = std::vector<CachedTriangle>(kTriangleCacheSize);
 
     // Empties the lists and makes the sky and sea lists hold at least n entries.
