@@ -588,13 +588,12 @@ class BlockClassifier {
         const QuadPixels q = ClassifyQuadPixels(
             primitive_ + i0, primitive_ + i1, depth_ + i0, depth_ + i1, b1_ + i0, b1_ + i1,
             b2_ + i0, b2_ + i1, g_.firstModelPrimitive, kMaxSeaPixelDepthRatio);
-        alignas(32) int32_t x0[kLanes];
-        for (size_t l = 0; l < kLanes; ++l) x0[l] = 2 * px + int(2 * l);
         if (All(q.sky)) {
             // The pixels' centre rays and NearSun as the scalar code computes them, lane by lane
             // (glm::dot's (x + y) + z).
             VI xs;
-            std::memcpy(&xs, x0, sizeof xs);
+            for (size_t l = 0; l < kLanes; ++l) xs[l] = int32_t(2 * l);
+            xs += 2 * px;  // the pixels' first samples
             const VF u = __builtin_convertvector(xs, VF) + 1.0f;  // float(x0) + 0.5 · N
             const VF dx = pixelRow.x + u * g_.colStep.x, dy = pixelRow.y + u * g_.colStep.y,
                      dz = pixelRow.z + u * g_.colStep.z;
@@ -611,27 +610,28 @@ class BlockClassifier {
                 return;
             }
         }
-        alignas(32) int32_t same[kLanes], allSea[kLanes], sky[kLanes], close[kLanes];
+        const unsigned sky = LaneBits(q.sky), sea = LaneBits(q.allSea & q.depthsClose),
+                       same = LaneBits(q.same);
         alignas(32) float b1Sum[kLanes], b2Sum[kLanes];
-        std::memcpy(same, &q.same, sizeof same), std::memcpy(allSea, &q.allSea, sizeof allSea);
-        std::memcpy(sky, &q.sky, sizeof sky), std::memcpy(close, &q.depthsClose, sizeof close);
         Store(b1Sum, q.b1Sum), Store(b2Sum, q.b2Sum);
         for (size_t l = 0; l < kLanes; ++l) {
-            const uint32_t k = kRow + uint32_t(x0[l]);
-            if (sky[l]) {
-                const glm::vec3 d = pixelRow + (float(x0[l]) + 0.5f * float(kN)) * g_.colStep;
+            const unsigned bit = 1u << l;
+            const int x0 = 2 * px + int(2 * l);
+            const uint32_t k = kRow + uint32_t(x0);
+            if (sky & bit) {
+                const glm::vec3 d = pixelRow + (float(x0) + 0.5f * float(kN)) * g_.colStep;
                 if (!f_.NearSun(d)) {
                     AddSky(k | kPixelEntry, d);
                     continue;
                 }
-            } else if (allSea[l] && close[l]) {
-                if (same[l])
-                    SeaTriangleClosePixel(x0[l], k, primitive_[i0 + 2 * l], b1Sum[l], b2Sum[l]);
+            } else if (sea & bit) {
+                if (same & bit)
+                    SeaTriangleClosePixel(x0, k, primitive_[i0 + 2 * l], b1Sum[l], b2Sum[l]);
                 else
-                    SeaClosePixel(x0[l], k);
+                    SeaClosePixel(x0, k);
                 continue;
             }
-            Samples(x0[l], k);
+            Samples(x0, k);
         }
     }
 
