@@ -504,10 +504,13 @@ struct FrameShading {
 template <int kN>
 class BlockClassifier {
   public:
-    BlockClassifier(const FrameGeometry& g, const FrameShading& f, int py0, BlockScratch& sc)
+    // lanes: whether the N = 2 lane code runs (OtwChannel::SetClassifyPixelByPixel).
+    BlockClassifier(const FrameGeometry& g, const FrameShading& f, int py0, BlockScratch& sc,
+                    bool lanes = true)
         : g_(g),
           f_(f),
           sc_(sc),
+          lanes_(kN == 2 && lanes),
           y0_(py0 * g.n),
           primitive_(g.vis.primitive.data()),
           depth_(g.vis.depth.data()),
@@ -531,8 +534,9 @@ class BlockClassifier {
         if constexpr (kN == 2) {
             // Whole row segments of kLanes pixels, their decisions on lanes (QuadPixels); the
             // rest pixel by pixel below.
-            for (; px + int(simd::kLanes) <= pxEnd; px += int(simd::kLanes))
-                QuadGroup(px, kRow, pixelRow);
+            if (lanes_)
+                for (; px + int(simd::kLanes) <= pxEnd; px += int(simd::kLanes))
+                    QuadGroup(px, kRow, pixelRow);
         }
         const uint32_t* prim = primitive_;
         for (; px < pxEnd; ++px) {
@@ -585,20 +589,20 @@ class BlockClassifier {
     void QuadGroup(int px, uint32_t kRow, const glm::vec3& pixelRow) {
         using namespace simd;
         const size_t i0 = rowIndex_[0] + size_t(2 * px), i1 = rowIndex_[1] + size_t(2 * px);
-        const QuadPixels q = ClassifyQuadPixels(
-            primitive_ + i0, primitive_ + i1, depth_ + i0, depth_ + i1, b1_ + i0, b1_ + i1,
-            b2_ + i0, b2_ + i1, g_.firstModelPrimitive, kMaxSeaPixelDepthRatio);
+        const QuadPixels q = ClassifyQuadPixels(primitive_ + i0, primitive_ + i1, depth_ + i0,
+                                                depth_ + i1, b1_ + i0, b1_ + i1, b2_ + i0, b2_ + i1,
+                                                g_.firstModelPrimitive, kMaxSeaPixelDepthRatio);
         if (All(q.sky)) {
             // The pixels' centre rays and NearSun as the scalar code computes them, lane by lane
             // (glm::dot's (x + y) + z).
             VI xs;
             for (size_t l = 0; l < kLanes; ++l) xs[l] = int32_t(2 * l);
-            xs += 2 * px;  // the pixels' first samples
+            xs += 2 * px;                                         // the pixels' first samples
             const VF u = __builtin_convertvector(xs, VF) + 1.0f;  // float(x0) + 0.5 · N
             const VF dx = pixelRow.x + u * g_.colStep.x, dy = pixelRow.y + u * g_.colStep.y,
                      dz = pixelRow.z + u * g_.colStep.z;
-            const VF c = Dot(dx, dy, dz, Splat(f_.sunDir.x), Splat(f_.sunDir.y),
-                             Splat(f_.sunDir.z));
+            const VF c =
+                Dot(dx, dy, dz, Splat(f_.sunDir.x), Splat(f_.sunDir.y), Splat(f_.sunDir.z));
             const VI near = (c > 0.0f) & (c * c >= (f_.cosNearSun * f_.cosNearSun) *
                                                        Dot(dx, dy, dz, dx, dy, dz));
             if (!Any(near)) {
@@ -734,7 +738,7 @@ class BlockClassifier {
         }
         if (!CosSpreadSmall(cMin, cMax, std::sqrt(Dot3(toEye, toEye)))) {
             if constexpr (kN == 2) {
-                if (!tri.shadowable) {
+                if (lanes_ && !tri.shadowable) {
                     SeaSamplesOnTriangle(tri, b1[0], b1[1], b2[0], b2[1], k);
                     return;
                 }
@@ -796,9 +800,9 @@ class BlockClassifier {
         if (!CosSpreadSmall(cMin, cMax, std::sqrt(Dot3(toEye, toEye)))) {
             // The samples one by one, from the values just interpolated.
             if constexpr (kN == 2) {
-                if (!shadowable) {
+                if (lanes_ && !shadowable) {
                     // Their components sample by sample on lanes: the same values, stored at once.
-                    const auto Components = [](const F4* v, F4 (&c)[3]) {
+                    const auto Components = [](const F4* v, F4(&c)[3]) {
                         F4 r0 = v[0], r1 = v[1], r2 = v[2], r3 = v[3];
                         _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
                         c[0] = r0, c[1] = r1, c[2] = r2;
@@ -861,11 +865,14 @@ class BlockClassifier {
     // adds them one by one, on four lanes (sample (j, i) in lane 2j + i, the barycentrics of
     // row j from b1j, b2j): Interpolate's and InterpolateAttributes' operations per component
     // in the same order, stored to the sea arrays at once.
-    __attribute__((always_inline)) void SeaSamplesOnTriangle(const CachedTriangle& tri, const float* b10, const float* b11,
-                              const float* b20, const float* b21, uint32_t k) {
+    __attribute__((always_inline)) void SeaSamplesOnTriangle(const CachedTriangle& tri,
+                                                             const float* b10, const float* b11,
+                                                             const float* b20, const float* b21,
+                                                             uint32_t k) {
         const auto Rows = [](const float* row0, const float* row1) {
-            return _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), reinterpret_cast<const __m64*>(row0)),
-                                reinterpret_cast<const __m64*>(row1));
+            return _mm_loadh_pi(
+                _mm_loadl_pi(_mm_setzero_ps(), reinterpret_cast<const __m64*>(row0)),
+                reinterpret_cast<const __m64*>(row1));
         };
         const F4 w1 = Rows(b10, b11), w2 = Rows(b20, b21);
         const F4 w0 = _mm_sub_ps(_mm_sub_ps(Set4(1.0f), w1), w2);
@@ -885,7 +892,8 @@ class BlockClassifier {
     // The four samples of a pixel (N = 2, entry k) as four lit sea entries, as AddSea adds
     // them one by one: sample (j, i) in lane 2j + i of the positions', normals' and
     // attributes' components (x, y, z).
-    __attribute__((always_inline)) void AddSeaSamples(uint32_t k, const F4 (&p)[3], const F4 (&nrm)[3], const F4 (&a)[3]) {
+    __attribute__((always_inline)) void AddSeaSamples(uint32_t k, const F4 (&p)[3],
+                                                      const F4 (&nrm)[3], const F4 (&a)[3]) {
         const size_t e = sc_.seaCount;
         sc_.seaCount += 4;
         _mm_storeu_ps(&sc_.seaPx[e], p[0]), _mm_storeu_ps(&sc_.seaPy[e], p[1]);
@@ -945,6 +953,7 @@ class BlockClassifier {
     const FrameGeometry& g_;
     const FrameShading& f_;
     BlockScratch& sc_;
+    const bool lanes_;
     const int y0_;  // first sample row of the block
     // The visibility buffer's arrays and the frame count, read per sample: one load away here,
     // not three through g_.
@@ -1359,7 +1368,7 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
             return renderSpans_.empty() ? PixelSpan{0, cam.width} : renderSpans_[size_t(py)];
         };
         if (n == 2) {
-            BlockClassifier<2> classify(g, f, py0, s);
+            BlockClassifier<2> classify(g, f, py0, s, !classifyPixelByPixel_);
             for (int py = py0; py < py1; ++py) classify.Pixels(py, span(py).begin, span(py).end);
         } else {
             BlockClassifier<0> classify(g, f, py0, s);

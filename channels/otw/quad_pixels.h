@@ -55,8 +55,8 @@ inline QuadPixels ClassifyQuadPixels(const uint32_t* prim0, const uint32_t* prim
     EvenOdd(prim0, a, b);
     EvenOdd(prim1, c, d);
     q.same = (a == b) & (a == c) & (a == d);
-    q.allSea = (a < firstModelPrimitive) & (b < firstModelPrimitive) &
-               (c < firstModelPrimitive) & (d < firstModelPrimitive);
+    q.allSea = (a < firstModelPrimitive) & (b < firstModelPrimitive) & (c < firstModelPrimitive) &
+               (d < firstModelPrimitive);
     q.sky = q.same & (a == 0xffffffffu);
     // std::min / std::max from +∞ and 0, sample by sample.
     VF s0, s1, s2, s3;

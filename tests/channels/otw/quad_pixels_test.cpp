@@ -82,10 +82,10 @@ TEST(QuadPixels, EqualsTheScalarDecisionsLaneForLane) {
             }
         }
         for (size_t x0 = 0; x0 + 2 * kLanes <= width; ++x0) {
-            const QuadPixels q = ClassifyQuadPixels(
-                prim[0].data() + x0, prim[1].data() + x0, depth[0].data() + x0,
-                depth[1].data() + x0, b1[0].data() + x0, b1[1].data() + x0, b2[0].data() + x0,
-                b2[1].data() + x0, kFirstModel, kRatio);
+            const QuadPixels q =
+                ClassifyQuadPixels(prim[0].data() + x0, prim[1].data() + x0, depth[0].data() + x0,
+                                   depth[1].data() + x0, b1[0].data() + x0, b1[1].data() + x0,
+                                   b2[0].data() + x0, b2[1].data() + x0, kFirstModel, kRatio);
             for (size_t l = 0; l < kLanes; ++l) {
                 const Reference r = Scalar(prim, depth, b1, b2, x0 + 2 * l);
                 ASSERT_EQ(q.same[l] != 0, r.same) << x0 << " " << l;
