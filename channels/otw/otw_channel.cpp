@@ -775,11 +775,23 @@ class BlockClassifier {
         bool sampleShadowable[kMaxSamples];
         F4 pSum = _mm_setzero_ps(), nSum = _mm_setzero_ps(), aSum = _mm_setzero_ps();
         bool shadowable = false;
+        // The samples' triangles first (a gathering call spills no interpolated value), each
+        // looked up once for a run of samples on it.
+        const CachedTriangle* tris[kMaxSamples];
+        uint32_t lastPrim = kNoPrimitive;  // not a sea triangle
+        for (int j = 0; j < n; ++j) {
+            for (int i = 0; i < n; ++i) {
+                const uint32_t prim = primitive_[rowIndex_[j] + size_t(x0 + i)];
+                const int s = j * n + i;
+                tris[s] = prim == lastPrim ? tris[s - 1] : &Triangle(prim);
+                lastPrim = prim;
+            }
+        }
         for (int j = 0; j < n; ++j) {
             for (int i = 0; i < n; ++i) {
                 const size_t index = rowIndex_[j] + size_t(x0 + i);
                 const int s = j * n + i;
-                const CachedTriangle& tri = Triangle(primitive_[index]);
+                const CachedTriangle& tri = *tris[s];
                 const float b1 = b1_[index], b2 = b2_[index];
                 Interpolate(tri, b1, b2, p[s], nrm[s]);
                 a[s] = InterpolateAttributes(tri, b1, b2);
