@@ -504,13 +504,10 @@ struct FrameShading {
 template <int kN>
 class BlockClassifier {
   public:
-    // lanes: whether the N = 2 lane code runs (OtwChannel::SetClassifyPixelByPixel).
-    BlockClassifier(const FrameGeometry& g, const FrameShading& f, int py0, BlockScratch& sc,
-                    bool lanes = true)
+    BlockClassifier(const FrameGeometry& g, const FrameShading& f, int py0, BlockScratch& sc)
         : g_(g),
           f_(f),
           sc_(sc),
-          lanes_(kN == 2 && lanes),
           y0_(py0 * g.n),
           primitive_(g.vis.primitive.data()),
           depth_(g.vis.depth.data()),
@@ -534,9 +531,8 @@ class BlockClassifier {
         if constexpr (kN == 2) {
             // Whole row segments of kLanes pixels, their decisions on lanes (QuadPixels); the
             // rest pixel by pixel below.
-            if (lanes_)
-                for (; px + int(simd::kLanes) <= pxEnd; px += int(simd::kLanes))
-                    QuadGroup(px, kRow, pixelRow);
+            for (; px + int(simd::kLanes) <= pxEnd; px += int(simd::kLanes))
+                QuadGroup(px, kRow, pixelRow);
         }
         const uint32_t* prim = primitive_;
         for (; px < pxEnd; ++px) {
@@ -666,6 +662,12 @@ class BlockClassifier {
         return tri;
     }
 
+    // The values of a pixel's samples (N = 2) from its two rows, sample (j, i) in lane 2j + i.
+    static F4 PixelSamples(const float* row0, const float* row1) {
+        return _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), reinterpret_cast<const __m64*>(row0)),
+                            reinterpret_cast<const __m64*>(row1));
+    }
+
     // Whether depths of the pixel's samples are within kMaxSeaPixelDepthRatio.
     bool DepthsClose(int x0) const {
         float dMin = std::numeric_limits<float>::infinity(), dMax = 0.0f;
@@ -730,15 +732,25 @@ class BlockClassifier {
         const float c0 = Dot3(tri.n0, toEye);
         const float d1 = Dot3(tri.n1, toEye) - c0, d2 = Dot3(tri.n2, toEye) - c0;
         float cMin = std::numeric_limits<float>::infinity(), cMax = -cMin;
-        for (int j = 0; j < n; ++j) {
-            for (int i = 0; i < n; ++i) {
-                const float c = c0 + b1[j][i] * d1 + b2[j][i] * d2;
-                cMin = std::min(cMin, c), cMax = std::max(cMax, c);
+        if constexpr (kN == 2) {
+            // The four samples' c on lanes (the same operations), then min and max in order.
+            const F4 c =
+                _mm_add_ps(_mm_add_ps(Set4(c0), _mm_mul_ps(PixelSamples(b1[0], b1[1]), Set4(d1))),
+                           _mm_mul_ps(PixelSamples(b2[0], b2[1]), Set4(d2)));
+            alignas(16) float cs[4];
+            _mm_store_ps(cs, c);
+            for (const float ci : cs) cMin = std::min(cMin, ci), cMax = std::max(cMax, ci);
+        } else {
+            for (int j = 0; j < n; ++j) {
+                for (int i = 0; i < n; ++i) {
+                    const float c = c0 + b1[j][i] * d1 + b2[j][i] * d2;
+                    cMin = std::min(cMin, c), cMax = std::max(cMax, c);
+                }
             }
         }
         if (!CosSpreadSmall(cMin, cMax, std::sqrt(Dot3(toEye, toEye)))) {
             if constexpr (kN == 2) {
-                if (lanes_ && !tri.shadowable) {
+                if (!tri.shadowable) {
                     SeaSamplesOnTriangle(tri, b1[0], b1[1], b2[0], b2[1], k);
                     return;
                 }
@@ -812,7 +824,7 @@ class BlockClassifier {
         if (!CosSpreadSmall(cMin, cMax, std::sqrt(Dot3(toEye, toEye)))) {
             // The samples one by one, from the values just interpolated.
             if constexpr (kN == 2) {
-                if (lanes_ && !shadowable) {
+                if (!shadowable) {
                     // Their components sample by sample on lanes: the same values, stored at once.
                     const auto Components = [](const F4* v, F4(&c)[3]) {
                         F4 r0 = v[0], r1 = v[1], r2 = v[2], r3 = v[3];
@@ -881,12 +893,7 @@ class BlockClassifier {
                                                              const float* b10, const float* b11,
                                                              const float* b20, const float* b21,
                                                              uint32_t k) {
-        const auto Rows = [](const float* row0, const float* row1) {
-            return _mm_loadh_pi(
-                _mm_loadl_pi(_mm_setzero_ps(), reinterpret_cast<const __m64*>(row0)),
-                reinterpret_cast<const __m64*>(row1));
-        };
-        const F4 w1 = Rows(b10, b11), w2 = Rows(b20, b21);
+        const F4 w1 = PixelSamples(b10, b11), w2 = PixelSamples(b20, b21);
         const F4 w0 = _mm_sub_ps(_mm_sub_ps(Set4(1.0f), w1), w2);
         // Component c of vertex attributes v0, v1, v2 interpolated.
         const auto Component = [&](const F4& v0, const F4& v1, const F4& v2, int c) {
@@ -965,7 +972,6 @@ class BlockClassifier {
     const FrameGeometry& g_;
     const FrameShading& f_;
     BlockScratch& sc_;
-    const bool lanes_;
     const int y0_;  // first sample row of the block
     // The visibility buffer's arrays and the frame count, read per sample: one load away here,
     // not three through g_.
@@ -1379,8 +1385,8 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
         const auto span = [&](int py) {
             return renderSpans_.empty() ? PixelSpan{0, cam.width} : renderSpans_[size_t(py)];
         };
-        if (n == 2) {
-            BlockClassifier<2> classify(g, f, py0, s, !classifyPixelByPixel_);
+        if (n == 2 && !classifyPixelByPixel_) {
+            BlockClassifier<2> classify(g, f, py0, s);
             for (int py = py0; py < py1; ++py) classify.Pixels(py, span(py).begin, span(py).end);
         } else {
             BlockClassifier<0> classify(g, f, py0, s);

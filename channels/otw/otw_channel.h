@@ -67,8 +67,9 @@ class OtwChannel {
     // oneTBB arena; bit-identical for any thread count.
     void Render(const scene::SceneState& state, Image& radiance);
 
-    // For tests: classify the shading pass's pixels one by one, as the lane code (N = 2:
-    // simd::kLanes pixels at a time, a pixel's four sea entries at once) must, bit for bit.
+    // For tests: classify the shading pass's pixels one by one in the code for any N, which
+    // the code for N = 2 (simd::kLanes pixels at a time, a pixel's samples on lanes) must
+    // equal bit for bit.
     void SetClassifyPixelByPixel(bool on) { classifyPixelByPixel_ = on; }
 
     const OtwFrameStats& Stats() const { return stats_; }
