@@ -791,6 +791,12 @@ class BlockClassifier {
         // looked up once for a run of samples on it.
         const CachedTriangle* tris[kMaxSamples];
         uint32_t lastPrim = kNoPrimitive;  // not a sea triangle
+        F4 w0s{}, w1s{}, w2s{};            // N = 2: the samples' barycentric weights, lane 2j + i
+        if constexpr (kN == 2) {
+            const size_t i0 = rowIndex_[0] + size_t(x0), i1 = rowIndex_[1] + size_t(x0);
+            w1s = PixelSamples(b1_ + i0, b1_ + i1), w2s = PixelSamples(b2_ + i0, b2_ + i1);
+            w0s = _mm_sub_ps(_mm_sub_ps(Set4(1.0f), w1s), w2s);
+        }
         for (int j = 0; j < n; ++j) {
             for (int i = 0; i < n; ++i) {
                 const uint32_t prim = primitive_[rowIndex_[j] + size_t(x0 + i)];
@@ -804,9 +810,17 @@ class BlockClassifier {
                 const size_t index = rowIndex_[j] + size_t(x0 + i);
                 const int s = j * n + i;
                 const CachedTriangle& tri = *tris[s];
-                const float b1 = b1_[index], b2 = b2_[index];
-                Interpolate(tri, b1, b2, p[s], nrm[s]);
-                a[s] = InterpolateAttributes(tri, b1, b2);
+                if constexpr (kN == 2) {
+                    // The weights of the four samples at once, broadcast from their lanes.
+                    const F4 w0 = Set4(w0s[s]), w1 = Set4(w1s[s]), w2 = Set4(w2s[s]);
+                    p[s] = Interpolate3(w0, w1, w2, tri.p0, tri.p1, tri.p2);
+                    nrm[s] = Interpolate3(w0, w1, w2, tri.n0, tri.n1, tri.n2);
+                    a[s] = Interpolate3(w0, w1, w2, tri.a0, tri.a1, tri.a2);
+                } else {
+                    const float b1 = b1_[index], b2 = b2_[index];
+                    Interpolate(tri, b1, b2, p[s], nrm[s]);
+                    a[s] = InterpolateAttributes(tri, b1, b2);
+                }
                 aSum = _mm_add_ps(aSum, a[s]);
                 sampleShadowable[s] = tri.shadowable;
                 shadowable |= tri.shadowable;
