@@ -15,6 +15,7 @@
 #include "channels/otw/celestial.h"
 #include "channels/otw/cloud_layer.h"
 #include "channels/otw/lightning_overlay.h"
+#include "channels/otw/quad_pixels.h"
 #include "channels/otw/sea_glint.h"
 #include "channels/otw/shore_shading.h"
 #include "channels/otw/spray_overlay.h"
@@ -361,8 +362,10 @@ struct BlockScratch {
     // pixel rows the same ones again (sea vertices are ~6 pixels apart), so each is gathered
     // about once per block. Entries of another frame or primitive are gathered anew; the
     // gathered values depend only on the frame and the primitive, so whatever the cache holds
-    // the shading is the same.
-    static constexpr uint32_t kTriangleCacheSize = 1024;
+    // the shading is the same. 2048 entries (360 kB) keep more of the previous block's
+    // triangles than 1024: otw-center at frames 120-121 gathered 32.3 k triangles, not 41.8 k
+    // (4096 entries: 30.1 k).
+    static constexpr uint32_t kTriangleCacheSize = 2048;
     std::vector<CachedTriangle> triangles = std::vector<CachedTriangle>(kTriangleCacheSize);
 
     // Empties the lists and makes the sky and sea lists hold at least n entries.
@@ -524,8 +527,15 @@ class BlockClassifier {
         }
         const glm::vec3 pixelRow = g_.RowBase(1.0 - 2.0 * (py * n + 0.5 * n) / g_.sampleHeight);
         const uint32_t kRow = uint32_t(size_t(py * n - y0_) * size_t(sw));
+        int px = pxBegin;
+        if constexpr (kN == 2) {
+            // Whole row segments of kLanes pixels, their decisions on lanes (QuadPixels); the
+            // rest pixel by pixel below.
+            for (; px + int(simd::kLanes) <= pxEnd; px += int(simd::kLanes))
+                QuadGroup(px, kRow, pixelRow);
+        }
         const uint32_t* prim = primitive_;
-        for (int px = pxBegin; px < pxEnd; ++px) {
+        for (; px < pxEnd; ++px) {
             const int x0 = px * n;
             const uint32_t prim0 = prim[rowIndex_[0] + size_t(x0)];
             bool same = true, allSea = true;
@@ -557,13 +567,73 @@ class BlockClassifier {
             } else if (allSea && (same ? SeaTrianglePixel(x0, k, prim0) : SeaPixel(x0, k))) {
                 continue;
             }
-            for (int j = 0; j < n; ++j)
-                for (int i = 0; i < n; ++i) Sample(x0 + i, j, k + uint32_t(j * sw + i));
+            Samples(x0, k);
         }
     }
 
   private:
     int N() const { return kN > 0 ? kN : g_.n; }
+
+    // Every sample of the pixel with top-left sample x0 (entry k) on its own.
+    void Samples(int x0, uint32_t k) {
+        for (int j = 0; j < N(); ++j)
+            for (int i = 0; i < N(); ++i) Sample(x0 + i, j, k + uint32_t(j * g_.sampleWidth + i));
+    }
+
+    // Pixels [px, px + kLanes) of the pixel row (N = 2) as Pixels classifies them one by one,
+    // their decisions made on lanes; a segment of sky pixels away from the sun is added at once.
+    void QuadGroup(int px, uint32_t kRow, const glm::vec3& pixelRow) {
+        using namespace simd;
+        const size_t i0 = rowIndex_[0] + size_t(2 * px), i1 = rowIndex_[1] + size_t(2 * px);
+        const QuadPixels q = ClassifyQuadPixels(primitive_ + i0, primitive_ + i1, depth_ + i0,
+                                                depth_ + i1, b1_ + i0, b1_ + i1, b2_ + i0, b2_ + i1,
+                                                g_.firstModelPrimitive, kMaxSeaPixelDepthRatio);
+        if (All(q.sky)) {
+            // The pixels' centre rays and NearSun as the scalar code computes them, lane by lane
+            // (glm::dot's (x + y) + z).
+            VI xs;
+            for (size_t l = 0; l < kLanes; ++l) xs[l] = int32_t(2 * l);
+            xs += 2 * px;                                         // the pixels' first samples
+            const VF u = __builtin_convertvector(xs, VF) + 1.0f;  // float(x0) + 0.5 · N
+            const VF dx = pixelRow.x + u * g_.colStep.x, dy = pixelRow.y + u * g_.colStep.y,
+                     dz = pixelRow.z + u * g_.colStep.z;
+            const VF c =
+                Dot(dx, dy, dz, Splat(f_.sunDir.x), Splat(f_.sunDir.y), Splat(f_.sunDir.z));
+            const VI near = (c > 0.0f) & (c * c >= (f_.cosNearSun * f_.cosNearSun) *
+                                                       Dot(dx, dy, dz, dx, dy, dz));
+            if (!Any(near)) {
+                const size_t e = sc_.skyCount;
+                sc_.skyCount += kLanes;
+                const VI keys = (xs + int32_t(kRow)) | int32_t(kPixelEntry);
+                std::memcpy(&sc_.skyK[e], &keys, sizeof keys);
+                Store(&sc_.skyX[e], dx), Store(&sc_.skyY[e], dy), Store(&sc_.skyZ[e], dz);
+                return;
+            }
+        }
+        const unsigned sky = LaneBits(q.sky), sea = LaneBits(q.allSea & q.depthsClose),
+                       same = LaneBits(q.same);
+        alignas(32) float b1Sum[kLanes], b2Sum[kLanes];
+        Store(b1Sum, q.b1Sum), Store(b2Sum, q.b2Sum);
+        for (size_t l = 0; l < kLanes; ++l) {
+            const unsigned bit = 1u << l;
+            const int x0 = 2 * px + int(2 * l);
+            const uint32_t k = kRow + uint32_t(x0);
+            if (sky & bit) {
+                const glm::vec3 d = pixelRow + (float(x0) + 0.5f * float(kN)) * g_.colStep;
+                if (!f_.NearSun(d)) {
+                    AddSky(k | kPixelEntry, d);
+                    continue;
+                }
+            } else if (sea & bit) {
+                if (same & bit)
+                    SeaTriangleClosePixel(x0, k, primitive_[i0 + 2 * l], b1Sum[l], b2Sum[l]);
+                else
+                    SeaClosePixel(x0, k);
+                continue;
+            }
+            Samples(x0, k);
+        }
+    }
 
     // The cached triangle prim. The hit, most calls, is inlined; the gathering is not.
     __attribute__((always_inline)) const CachedTriangle& Triangle(uint32_t prim) {
@@ -590,6 +660,12 @@ class BlockClassifier {
                 f_.casters.MayHit(0.5f * (l + h), 0.5f * (h - l) + (8e-6f * far + 2e-3f));
         }
         return tri;
+    }
+
+    // The values of a pixel's samples (N = 2) from its two rows, sample (j, i) in lane 2j + i.
+    static F4 PixelSamples(const float* row0, const float* row1) {
+        return _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), reinterpret_cast<const __m64*>(row0)),
+                            reinterpret_cast<const __m64*>(row1));
     }
 
     // Whether depths of the pixel's samples are within kMaxSeaPixelDepthRatio.
@@ -622,21 +698,31 @@ class BlockClassifier {
     // (then its samples are added one by one, as Sample adds them) or depth does (then returns
     // false, nothing added). On one triangle c is linear in the barycentrics.
     __attribute__((always_inline)) bool SeaTrianglePixel(int x0, uint32_t k, uint32_t prim) {
-        const int n = N(), count = n * n;
         if (!DepthsClose(x0)) return false;
+        float b1Sum = 0.0f, b2Sum = 0.0f;
+        for (int j = 0; j < N(); ++j) {
+            const size_t index = rowIndex_[j] + size_t(x0);
+            for (int i = 0; i < N(); ++i) {
+                b1Sum += b1_[index + size_t(i)];
+                b2Sum += b2_[index + size_t(i)];
+            }
+        }
+        SeaTriangleClosePixel(x0, k, prim, b1Sum, b2Sum);
+        return true;
+    }
+
+    // SeaTrianglePixel once the depths are close, with the sums of the samples' barycentrics.
+    __attribute__((always_inline)) void SeaTriangleClosePixel(int x0, uint32_t k, uint32_t prim,
+                                                              float b1Sum, float b2Sum) {
+        const int n = N(), count = n * n;
         const CachedTriangle& tri = Triangle(prim);
         // The samples' barycentrics are read in place, row by row (a local copy of them cost a
         // memmove call per row).
         const float *b1[kMaxSupersampling], *b2[kMaxSupersampling];
-        float b1Sum = 0.0f, b2Sum = 0.0f;
         for (int j = 0; j < n; ++j) {
             const size_t index = rowIndex_[j] + size_t(x0);
             b1[j] = b1_ + index;
             b2[j] = b2_ + index;
-            for (int i = 0; i < n; ++i) {
-                b1Sum += b1[j][i];
-                b2Sum += b2[j][i];
-            }
         }
         // The mean (a power-of-two scale for N = 1, 2, 4: exact).
         const float inv = 1.0f / float(count);
@@ -646,17 +732,33 @@ class BlockClassifier {
         const float c0 = Dot3(tri.n0, toEye);
         const float d1 = Dot3(tri.n1, toEye) - c0, d2 = Dot3(tri.n2, toEye) - c0;
         float cMin = std::numeric_limits<float>::infinity(), cMax = -cMin;
-        for (int j = 0; j < n; ++j) {
-            for (int i = 0; i < n; ++i) {
-                const float c = c0 + b1[j][i] * d1 + b2[j][i] * d2;
-                cMin = std::min(cMin, c), cMax = std::max(cMax, c);
+        if constexpr (kN == 2) {
+            // The four samples' c on lanes (the same operations), then min and max in order.
+            const F4 c =
+                _mm_add_ps(_mm_add_ps(Set4(c0), _mm_mul_ps(PixelSamples(b1[0], b1[1]), Set4(d1))),
+                           _mm_mul_ps(PixelSamples(b2[0], b2[1]), Set4(d2)));
+            alignas(16) float cs[4];
+            _mm_store_ps(cs, c);
+            for (const float ci : cs) cMin = std::min(cMin, ci), cMax = std::max(cMax, ci);
+        } else {
+            for (int j = 0; j < n; ++j) {
+                for (int i = 0; i < n; ++i) {
+                    const float c = c0 + b1[j][i] * d1 + b2[j][i] * d2;
+                    cMin = std::min(cMin, c), cMax = std::max(cMax, c);
+                }
             }
         }
         if (!CosSpreadSmall(cMin, cMax, std::sqrt(Dot3(toEye, toEye)))) {
+            if constexpr (kN == 2) {
+                if (!tri.shadowable) {
+                    SeaSamplesOnTriangle(tri, b1[0], b1[1], b2[0], b2[1], k);
+                    return;
+                }
+            }
             for (int j = 0; j < n; ++j)
                 for (int i = 0; i < n; ++i)
                     SeaSample(tri, b1[j][i], b2[j][i], k + uint32_t(j * g_.sampleWidth + i));
-            return true;
+            return;
         }
         const size_t e =
             AddSea(k | kPixelEntry, p, nSum, InterpolateAttributes(tri, b1Sum * inv, b2Sum * inv));
@@ -667,27 +769,58 @@ class BlockClassifier {
                     Interpolate(tri, b1[j][i], b2[j][i], samples[j * n + i], unused);
             SeaShadowRays(e, samples, count);
         }
-        return true;
     }
 
     // As SeaTrianglePixel, for a pixel whose sea samples lie on different triangles: the
     // samples' positions and normals are interpolated one by one and averaged.
     bool SeaPixel(int x0, uint32_t k) {
-        const int n = N(), count = n * n;
         if (!DepthsClose(x0)) return false;
+        SeaClosePixel(x0, k);
+        return true;
+    }
+
+    // SeaPixel once the depths are close.
+    void SeaClosePixel(int x0, uint32_t k) {
+        const int n = N(), count = n * n;
         constexpr int kMaxSamples = kMaxSupersampling * kMaxSupersampling;
         F4 p[kMaxSamples], nrm[kMaxSamples], a[kMaxSamples];
         bool sampleShadowable[kMaxSamples];
         F4 pSum = _mm_setzero_ps(), nSum = _mm_setzero_ps(), aSum = _mm_setzero_ps();
         bool shadowable = false;
+        // The samples' triangles first (a gathering call spills no interpolated value), each
+        // looked up once for a run of samples on it.
+        const CachedTriangle* tris[kMaxSamples];
+        uint32_t lastPrim = kNoPrimitive;  // not a sea triangle
+        F4 w0s{}, w1s{}, w2s{};            // N = 2: the samples' barycentric weights, lane 2j + i
+        if constexpr (kN == 2) {
+            const size_t i0 = rowIndex_[0] + size_t(x0), i1 = rowIndex_[1] + size_t(x0);
+            w1s = PixelSamples(b1_ + i0, b1_ + i1), w2s = PixelSamples(b2_ + i0, b2_ + i1);
+            w0s = _mm_sub_ps(_mm_sub_ps(Set4(1.0f), w1s), w2s);
+        }
+        for (int j = 0; j < n; ++j) {
+            for (int i = 0; i < n; ++i) {
+                const uint32_t prim = primitive_[rowIndex_[j] + size_t(x0 + i)];
+                const int s = j * n + i;
+                tris[s] = prim == lastPrim ? tris[s - 1] : &Triangle(prim);
+                lastPrim = prim;
+            }
+        }
         for (int j = 0; j < n; ++j) {
             for (int i = 0; i < n; ++i) {
                 const size_t index = rowIndex_[j] + size_t(x0 + i);
                 const int s = j * n + i;
-                const CachedTriangle& tri = Triangle(primitive_[index]);
-                const float b1 = b1_[index], b2 = b2_[index];
-                Interpolate(tri, b1, b2, p[s], nrm[s]);
-                a[s] = InterpolateAttributes(tri, b1, b2);
+                const CachedTriangle& tri = *tris[s];
+                if constexpr (kN == 2) {
+                    // The weights of the four samples at once, broadcast from their lanes.
+                    const F4 w0 = Set4(w0s[s]), w1 = Set4(w1s[s]), w2 = Set4(w2s[s]);
+                    p[s] = Interpolate3(w0, w1, w2, tri.p0, tri.p1, tri.p2);
+                    nrm[s] = Interpolate3(w0, w1, w2, tri.n0, tri.n1, tri.n2);
+                    a[s] = Interpolate3(w0, w1, w2, tri.a0, tri.a1, tri.a2);
+                } else {
+                    const float b1 = b1_[index], b2 = b2_[index];
+                    Interpolate(tri, b1, b2, p[s], nrm[s]);
+                    a[s] = InterpolateAttributes(tri, b1, b2);
+                }
                 aSum = _mm_add_ps(aSum, a[s]);
                 sampleShadowable[s] = tri.shadowable;
                 shadowable |= tri.shadowable;
@@ -704,6 +837,20 @@ class BlockClassifier {
         }
         if (!CosSpreadSmall(cMin, cMax, std::sqrt(Dot3(toEye, toEye)))) {
             // The samples one by one, from the values just interpolated.
+            if constexpr (kN == 2) {
+                if (!shadowable) {
+                    // Their components sample by sample on lanes: the same values, stored at once.
+                    const auto Components = [](const F4* v, F4(&c)[3]) {
+                        F4 r0 = v[0], r1 = v[1], r2 = v[2], r3 = v[3];
+                        _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+                        c[0] = r0, c[1] = r1, c[2] = r2;
+                    };
+                    F4 pc[3], nc[3], ac[3];
+                    Components(p, pc), Components(nrm, nc), Components(a, ac);
+                    AddSeaSamples(k, pc, nc, ac);
+                    return;
+                }
+            }
             for (int j = 0; j < n; ++j) {
                 for (int i = 0; i < n; ++i) {
                     const int s = j * n + i;
@@ -712,12 +859,11 @@ class BlockClassifier {
                     if (sampleShadowable[s]) SeaShadowRays(e, &p[s], 1);
                 }
             }
-            return true;
+            return;
         }
         const size_t e =
             AddSea(k | kPixelEntry, mean, nSum, _mm_mul_ps(aSum, Set4(1.0f / float(count))));
         if (shadowable) SeaShadowRays(e, p, count);
-        return true;
     }
 
     // A lit sea entry at position p with normal nSum (unnormalized: SeaShading::Shade normalizes
@@ -751,6 +897,48 @@ class BlockClassifier {
                 sc_.originOwner.push_back(kSeaOwner | uint32_t(e));
             }
         }
+    }
+
+    // The four samples of a pixel (N = 2, entry k) on unshadowable triangle tri as SeaSample
+    // adds them one by one, on four lanes (sample (j, i) in lane 2j + i, the barycentrics of
+    // row j from b1j, b2j): Interpolate's and InterpolateAttributes' operations per component
+    // in the same order, stored to the sea arrays at once.
+    __attribute__((always_inline)) void SeaSamplesOnTriangle(const CachedTriangle& tri,
+                                                             const float* b10, const float* b11,
+                                                             const float* b20, const float* b21,
+                                                             uint32_t k) {
+        const F4 w1 = PixelSamples(b10, b11), w2 = PixelSamples(b20, b21);
+        const F4 w0 = _mm_sub_ps(_mm_sub_ps(Set4(1.0f), w1), w2);
+        // Component c of vertex attributes v0, v1, v2 interpolated.
+        const auto Component = [&](const F4& v0, const F4& v1, const F4& v2, int c) {
+            return Interpolate3(w0, w1, w2, Set4(v0[c]), Set4(v1[c]), Set4(v2[c]));
+        };
+        F4 p[3], nrm[3], a[3];
+        for (int c = 0; c < 3; ++c) {
+            p[c] = Component(tri.p0, tri.p1, tri.p2, c);
+            nrm[c] = Component(tri.n0, tri.n1, tri.n2, c);
+            a[c] = Component(tri.a0, tri.a1, tri.a2, c);
+        }
+        AddSeaSamples(k, p, nrm, a);
+    }
+
+    // The four samples of a pixel (N = 2, entry k) as four lit sea entries, as AddSea adds
+    // them one by one: sample (j, i) in lane 2j + i of the positions', normals' and
+    // attributes' components (x, y, z).
+    __attribute__((always_inline)) void AddSeaSamples(uint32_t k, const F4 (&p)[3],
+                                                      const F4 (&nrm)[3], const F4 (&a)[3]) {
+        const size_t e = sc_.seaCount;
+        sc_.seaCount += 4;
+        _mm_storeu_ps(&sc_.seaPx[e], p[0]), _mm_storeu_ps(&sc_.seaPy[e], p[1]);
+        _mm_storeu_ps(&sc_.seaPz[e], p[2]);
+        _mm_storeu_ps(&sc_.seaNx[e], nrm[0]), _mm_storeu_ps(&sc_.seaNy[e], nrm[1]);
+        _mm_storeu_ps(&sc_.seaNz[e], nrm[2]);
+        _mm_storeu_ps(&sc_.seaDepth[e], a[0]), _mm_storeu_ps(&sc_.seaWet[e], a[1]);
+        _mm_storeu_ps(&sc_.seaFoam[e], a[2]);
+        const uint32_t sw = uint32_t(g_.sampleWidth);
+        const uint32_t keys[4] = {k, k + 1, k + sw, k + sw + 1};
+        std::memcpy(&sc_.seaK[e], keys, sizeof keys);
+        std::memset(&sc_.seaUnlit[e], 0, 4 * sizeof(uint16_t));
     }
 
     // Sea sample k at barycentrics (1 − b1 − b2, b1, b2) of triangle tri, shaded on its own.
@@ -1211,7 +1399,7 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
         const auto span = [&](int py) {
             return renderSpans_.empty() ? PixelSpan{0, cam.width} : renderSpans_[size_t(py)];
         };
-        if (n == 2) {
+        if (n == 2 && !classifyPixelByPixel_) {
             BlockClassifier<2> classify(g, f, py0, s);
             for (int py = py0; py < py1; ++py) classify.Pixels(py, span(py).begin, span(py).end);
         } else {

@@ -67,6 +67,11 @@ class OtwChannel {
     // oneTBB arena; bit-identical for any thread count.
     void Render(const scene::SceneState& state, Image& radiance);
 
+    // For tests: classify the shading pass's pixels one by one in the code for any N, which
+    // the code for N = 2 (simd::kLanes pixels at a time, a pixel's samples on lanes) must
+    // equal bit for bit.
+    void SetClassifyPixelByPixel(bool on) { classifyPixelByPixel_ = on; }
+
     const OtwFrameStats& Stats() const { return stats_; }
     const ChannelCamera& Camera() const { return geometry_.Camera(); }
     // The last frame's visibility buffer (supersampled grid): mesh 0 is the sea, mesh i ≥ 1
@@ -99,6 +104,7 @@ class OtwChannel {
     std::vector<uint8_t> overlayRows_;               // band basis: sample rows overlay_ drew on
     std::unique_ptr<BlackbodyGlowTable> basisGlow_;  // band basis: the flames' glow
     std::vector<PixelSpan> renderSpans_;             // per pixel row; empty: every pixel
+    bool classifyPixelByPixel_ = false;              // SetClassifyPixelByPixel
 };
 
 }  // namespace seasense::channels

@@ -85,6 +85,15 @@ inline VF Sqrt(VF v) {
 #endif
 }
 
+// Bit l set where lane l of a comparison's result is.
+inline unsigned LaneBits(VI mask) {
+#if defined(__AVX__)
+    return unsigned(_mm256_movemask_ps(reinterpret_cast<__m256>(mask)));
+#else
+    return unsigned(_mm_movemask_ps(reinterpret_cast<__m128>(mask)));
+#endif
+}
+
 // Whether any lane of a comparison's result is set.
 inline bool Any(VI mask) {
 #if defined(__AVX__)

@@ -465,5 +465,35 @@ TEST(OtwChannel, AFrameDoesNotDependOnEarlierFramesOrTheThreadCount) {
     EXPECT_FALSE(fresh.pixels == render(1, {40}).pixels);  // the frames do differ
 }
 
+// The shading pass's classification on lanes (2×2 supersampling: kLanes pixels at a time, a
+// pixel's four sea entries at once) gives the images of its pixel-by-pixel form bit for bit:
+// the five-channel demo's centre view early and late (sky, sea, boats, surf and exhaust), at
+// widths that leave a partial row segment.
+TEST(OtwChannel, ClassificationOnLanesEqualsPixelByPixel) {
+    scene::Scenario sc = scene::LoadScenario(std::filesystem::path(SEASENSE_SOURCE_DIR) /
+                                             "configs" / "five-channel.yaml");
+    scene::ChannelSettings ch = *sc.FindChannel("otw-center");
+    ASSERT_EQ(ch.supersampling, 2);
+    const scene::World world(sc);
+    for (const int width : {317, 160}) {
+        ch.width = width;
+        ch.height = width * 3 / 4;
+        for (const int64_t frame : {7, 130}) {
+            const auto render = [&](bool pixelByPixel) {
+                Image radiance;
+                tbb::task_arena(2).execute([&] {
+                    OtwChannel otw(world, ch);
+                    otw.SetClassifyPixelByPixel(pixelByPixel);
+                    otw.Render(world.State(frame), radiance);
+                });
+                return radiance;
+            };
+            const Image lanes = render(false), reference = render(true);
+            ASSERT_EQ(lanes.pixels.size(), reference.pixels.size());
+            EXPECT_TRUE(lanes.pixels == reference.pixels) << width << " " << frame;
+        }
+    }
+}
+
 }  // namespace
 }  // namespace seasense::channels
