@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstring>
 
+#include "channels/raster/rasterizer.h"
 #include "scene/core/simd_lanes.h"
 
 namespace seasense::channels {
@@ -16,7 +17,7 @@ namespace seasense::channels {
 struct QuadPixels {
     simd::VI same;         // all four primitive ids equal
     simd::VI allSea;       // all four ids below the first model primitive (sea, not sky)
-    simd::VI sky;          // all four ids kNoPrimitive (rasterizer.h)
+    simd::VI sky;          // all four ids kNoPrimitive
     simd::VI depthsClose;  // largest depth ≤ maxDepthRatio × smallest
     // The barycentrics summed sample by sample from 0 in sample order (row 0, then row 1).
     simd::VF b1Sum, b2Sum;
@@ -57,7 +58,7 @@ inline QuadPixels ClassifyQuadPixels(const uint32_t* prim0, const uint32_t* prim
     q.same = (a == b) & (a == c) & (a == d);
     q.allSea = (a < firstModelPrimitive) & (b < firstModelPrimitive) & (c < firstModelPrimitive) &
                (d < firstModelPrimitive);
-    q.sky = q.same & (a == 0xffffffffu);
+    q.sky = q.same & (a == kNoPrimitive);
     // std::min / std::max from +∞ and 0, sample by sample.
     VF s0, s1, s2, s3;
     EvenOdd(depth0, s0, s1);
