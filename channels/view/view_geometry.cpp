@@ -143,6 +143,11 @@ double SteepestViewDirectionZ(const ChannelCamera& cam) {
     return z;
 }
 
+namespace {
+// tan of the depression below the horizontal of a unit direction whose z is z < 0.
+double DepressionTan(double z) { return -z / std::sqrt(std::max(1.0 - z * z, 1e-18)); }
+}  // namespace
+
 double NearestVisibleSeaRange_m(const ChannelCamera& cam, double crestHeight_m,
                                 double horizontalReach_m) {
     const double h = cam.worldFromCamera.position_m.z - crestHeight_m;
@@ -151,7 +156,7 @@ double NearestVisibleSeaRange_m(const ChannelCamera& cam, double crestHeight_m,
     // slope = tan(depression) = −d_z / |d_xy| for unit d.
     const double z = SteepestViewDirectionZ(cam);
     if (z >= 0.0) return std::numeric_limits<double>::infinity();  // no ray looks down
-    const double slope = -z / std::sqrt(std::max(1.0 - z * z, 1e-18));
+    const double slope = DepressionTan(z);
     // A margin of 1e-6 for the rounding of the above; then allow for vertices that the waves
     // carry horizontally toward the eye. (Sampling the boundary at 33 directions per edge, as
     // this did before with a 20 % margin, missed the steepest ray near the nadir: a view 80°
@@ -205,10 +210,8 @@ scene::OceanMeshRequest SeaMeshRequest(const ChannelCamera& cam,
     // tangent rounded up to a step of 2^(1/8) (9 %), so that a view that pitches and rolls a
     // little (an eyepoint on a ship) keeps the same near rings, which would otherwise move.
     const double z = SteepestViewDirectionZ(cam);
-    if (z < 0.0) {
-        const double tan = -z / std::sqrt(std::max(1.0 - z * z, 1e-18));
-        req.maxDepressionTan = std::exp2(std::ceil(8.0 * std::log2(tan)) / 8.0);
-    }
+    if (z < 0.0)
+        req.maxDepressionTan = std::exp2(std::ceil(8.0 * std::log2(DepressionTan(z))) / 8.0);
     return req;
 }
 

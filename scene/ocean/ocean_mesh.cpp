@@ -57,11 +57,25 @@ double CurvatureDrop_m(double r) {
     return r * r / (R + std::sqrt(R * R - r * r));
 }
 
+namespace {
+
+// The eye's height above a typical trough (half the significant height), for foreshortening.
+double TroughDepth_m(double eyeHeight_m, double significantHeight_m) {
+    return std::max(eyeHeight_m, 0.05) + 0.5 * significantHeight_m;
+}
+
+// The ring step at range r for a surface H below the eye (see OceanMeshRadii), capped at 8× the
+// tangential spacing, hEff the trough's depth.
+double RingStep_m(double r, double H, double hEff, double dphi) {
+    return std::min(dphi * (r * r + H * H) / H, std::max(8.0 * r, hEff) * dphi);
+}
+
+}  // namespace
+
 std::vector<double> OceanMeshRadii(double eyeHeight_m, double significantHeight_m, double dphi,
                                    double maxRange_m) {
     CHECK(dphi > 0.0);
-    // Foreshortening uses the eye's height above a typical trough (half the significant height).
-    const double hEff = std::max(eyeHeight_m, 0.05) + 0.5 * significantHeight_m;
+    const double hEff = TroughDepth_m(eyeHeight_m, significantHeight_m);
     std::vector<double> radii{0.0};  // a centre vertex under the eye
     // A ring at range r is seen at the depression angle atan(h / r), which changes by
     // h dr / (r² + h²): steps of dphi (r² + h²) / h subtend the angular step from the nadir to the
@@ -70,9 +84,7 @@ std::vector<double> OceanMeshRadii(double eyeHeight_m, double significantHeight_
     double r = hEff * dphi;
     while (r < maxRange_m) {
         radii.push_back(r);
-        const double step =
-            std::min(dphi * (r * r + hEff * hEff) / hEff, std::max(8.0 * r, hEff) * dphi);
-        r += std::max(step, 1e-3);
+        r += std::max(RingStep_m(r, hEff, hEff, dphi), 1e-3);
     }
     radii.push_back(maxRange_m);
     return radii;
@@ -82,7 +94,7 @@ std::vector<double> ThinnedOceanMeshRadii(const std::vector<double>& radii, doub
                                           double significantHeight_m, double dphi,
                                           double maxDepressionTan) {
     CHECK(dphi > 0.0 && maxDepressionTan > 0.0);
-    const double hEff = std::max(eyeHeight_m, 0.05) + 0.5 * significantHeight_m;
+    const double hEff = TroughDepth_m(eyeHeight_m, significantHeight_m);
     std::vector<double> out;
     out.reserve(radii.size());
     for (size_t i = 0; i < radii.size();) {
@@ -94,8 +106,7 @@ std::vector<double> ThinnedOceanMeshRadii(const std::vector<double>& radii, doub
         const double H = std::min(hEff, r * maxDepressionTan);
         if (r > 0.0 && H < hEff) {
             // The step of OceanMeshRadii with H for h (a hair shorter, for its rounding).
-            const double step =
-                std::min(dphi * (r * r + H * H) / H, std::max(8.0 * r, hEff) * dphi);
+            const double step = RingStep_m(r, H, hEff, dphi);
             while (next + 1 < radii.size() && radii[next + 1] <= r + step * (1.0 - 1e-12)) ++next;
         }
         i = next;
@@ -163,7 +174,7 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
     // grows outward, so each coarse ring's columns are also the next ring's.
     std::vector<int> stride(size_t(rings), 1);
     if (req.widenByReach) {
-        const double hEff = std::max(req.eye_m.z, 0.05) + 0.5 * frame.SignificantHeight_m();
+        const double hEff = TroughDepth_m(req.eye_m.z, frame.SignificantHeight_m());
         for (int j = 0; j < rings; ++j) {
             const double r = radii[size_t(j)];
             const double allowed =

@@ -662,12 +662,11 @@ SurfWaves::Bound SurfWaves::BoundNear(double x, double y, double t, double radiu
     // No components, all dry, or all at or below the deepest fade (surf weights 0): Terms adds
     // none.
     if (n == 0 || !(maxDepth_m > 0.0) || minDepth_m >= fadeDeep_m_) return Bound{};
-    TermsOptions options;
-    options.velocity = false;
-    options.dominant = Dominant::kWhereBroken;
-    SurfPointInfo centre;
-    Terms(x, y, t, &centre, options);
-    if (!(centre.depth_m > 0.0) || centre.weights.AllDeep()) return Bound{kInf, kInf};
+    // The centre's depth and weights as Terms takes them (its sums are formed below in double).
+    const ShorePoint p = bathy_.Frame().ShoreFromWorld(x, y);
+    const double centreDepth_m = bathy_.Tide_m() - bathy_.SeabedZAtShore_m(p.s_m, p.u_m);
+    const SurfWeights centreWeights = Weights(centreDepth_m);
+    if (!(centreDepth_m > 0.0) || centreWeights.AllDeep()) return Bound{kInf, kInf};
     // Each component's weighted amplitude lies between its smallest table amplitude over the
     // disc's depths times the surf weight at the deepest (the weights fall with depth: Fade
     // grows) and its largest times the weight at the shallowest wet depth; Terms interpolates
@@ -682,7 +681,6 @@ SurfWaves::Bound SurfWaves::BoundNear(double x, double y, double t, double radiu
     // (|k_u| + max |k_s|) · radius; the cross-shore table's slopes are k_s at its samples, whose
     // profile depths are no shallower than at the disc's landward edge one sample further, and
     // k grows as the water shoals (seaward of the table, |k_s0| ≤ k0 ≤ k anywhere).
-    const ShorePoint p = bathy_.Frame().ShoreFromWorld(x, y);
     const double landward =
         std::max(bathy_.Tide_m() - bathy_.ProfileZ_m(p.s_m - radius_m - ds_m_), kMinDepth_m);
     double bound = 0.0;  // Re Σ a e^{iψ} at (x, y) (eRe below) plus the change across the disc
@@ -698,7 +696,7 @@ SurfWaves::Bound SurfWaves::BoundNear(double x, double y, double t, double radiu
     // E(c) and G keep the components' cancellation here and now, which the first bound gives
     // up for all but E(c): over a disc of a few metres, where |g| radius is well below 1, the
     // remainder is second order.
-    const double hc = std::max(centre.depth_m, kMinDepth_m);
+    const double hc = std::max(centreDepth_m, kMinDepth_m);
     const double cx = std::min(hc / dh_m_, double(depthSamples_ - 1));
     const size_t ci = std::min(size_t(cx), size_t(depthSamples_ - 2));
     const double cf = cx - double(ci);
@@ -749,9 +747,8 @@ SurfWaves::Bound SurfWaves::BoundNear(double x, double y, double t, double radiu
         spread += hi - lo;
 
         // The centre's weighted amplitude and phase as Terms forms them (in double).
-        const double a0 = depth_[ci * n + m].amplitude, a1 = depth_[(ci + 1) * n + m].amplitude;
-        const double ac = (a0 + cf * (a1 - a0)) *
-                          (spectral ? centre.weights.spectralSurf : centre.weights.gerstnerSurf);
+        const double ac = lerp(m, [](const DepthSample& d) { return d.amplitude; }) *
+                          (spectral ? centreWeights.spectralSurf : centreWeights.gerstnerSurf);
         const double* phase = lanePhase_.data() + m;
         const auto tablePhase = [&](int i) { return phase[size_t(i) * lanes_]; };
         double cross = tr.ks0 * p.s_m;
@@ -775,7 +772,8 @@ SurfWaves::Bound SurfWaves::BoundNear(double x, double y, double t, double radiu
         if (tHi > double(phaseSamples - 1)) sLo = std::min(sLo, 0.0), sHi = std::max(sHi, 0.0);
         const double gs = 0.5 * (sLo + sHi), sigma = 0.5 * (sHi - sLo);
         const double gLength = std::sqrt(gs * gs + tr.ku * tr.ku) * radius_m;
-        const double re = ac * std::cos(psi), im = ac * std::sin(psi);
+        const double sn = std::sin(psi), cs = std::cos(psi);
+        const double re = ac * cs, im = ac * sn;
         eRe += re, eIm += im;
         gsRe += re * gs, gsIm += im * gs;
         guRe += re * tr.ku, guIm += im * tr.ku;
@@ -787,7 +785,6 @@ SurfWaves::Bound SurfWaves::BoundNear(double x, double y, double t, double radiu
         const double hor = ac * lerp(m, [](const DepthSample& d) { return d.invTanh; });
         const double pS = hor * lerp(m, [](const DepthSample& d) { return d.kx; }) * invK;
         const double pU = hor * tr.ku * invK;
-        const double sn = std::sin(psi), cs = std::cos(psi);
         vS += pS * sn, vU += pU * sn;
         mSS += pS * cs * gs, mSU += pS * cs * tr.ku, mUS += pU * cs * gs, mUU += pU * cs * tr.ku;
         remainderH += std::sqrt(pS * pS + pU * pU) * taylor;
