@@ -174,6 +174,8 @@ FrameRecord ChannelPipeline::RenderAndWrite(int64_t frame) {
 }
 
 void ChannelPipeline::WarmUp(const scene::FrameState& frame) {
+    if (imager_) imager_->Restart();
+    if (intensifier_) intensifier_->Restart();
     Render(frame);
     if (imager_) imager_->Restart();
     if (intensifier_) intensifier_->Restart();

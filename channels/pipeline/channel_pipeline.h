@@ -62,8 +62,9 @@ class ChannelPipeline {
     // Renders frame once and forgets it: the one-off work of a pipeline's first frame (buffers
     // allocated and first touched, tables and acceleration structures built on first use) done
     // ahead of time, so that a frame-locked run's first frame costs what the others do. The
-    // sensor's history is restarted, so the frames rendered next are bit for bit those of a
-    // pipeline that never warmed up.
+    // sensor's history is restarted before and after, so frame may be any frame (also one
+    // earlier than those already rendered) and the frames rendered next are bit for bit those
+    // of a pipeline that never warmed up.
     void WarmUp(const scene::FrameState& frame);
     // The display image of the last rendered frame: 8-bit RGB, Width()×Height(), row 0 on top.
     const std::vector<uint8_t>& DisplayRgb8();
