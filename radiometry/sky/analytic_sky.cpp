@@ -25,23 +25,30 @@ using namespace simd4;
 constexpr int kTableSize = 128;
 constexpr int kHorizonSize = 512;
 
-// Writes the first count ≤ simd::kLanes of lanes' (r, g, b, ·) registers to r, g and b: four
-// lanes at a time transposed to (r r r r), (g g g g), (b b b b).
-__attribute__((always_inline)) inline void StoreTransposed(F4 (&lanes)[simd::kLanes], size_t count,
-                                                           float* r, float* g, float* b) {
-    static_assert(simd::kLanes % 4 == 0);
-    alignas(16) float tmp[3][simd::kLanes];
-    const bool full = count == simd::kLanes;
-    float* out[3] = {full ? r : tmp[0], full ? g : tmp[1], full ? b : tmp[2]};
-    for (size_t q = 0; q < simd::kLanes; q += 4) {
-        F4 c0 = lanes[q], c1 = lanes[q + 1], c2 = lanes[q + 2], c3 = lanes[q + 3];
-        _MM_TRANSPOSE4_PS(c0, c1, c2, c3);
-        _mm_storeu_ps(out[0] + q, c0);
-        _mm_storeu_ps(out[1] + q, c1);
-        _mm_storeu_ps(out[2] + q, c2);
-    }
-    if (full) return;
-    for (size_t l = 0; l < count; ++l) r[l] = tmp[0][l], g[l] = tmp[1][l], b[l] = tmp[2][l];
+// The (r, g, b) of the simd::kLanes texels at base + at[l] (16 bytes each: r, g, b, padding)
+// in lane l of r, g and b: four lanes at a time, their texels by 16-byte loads transposed on
+// registers (with AVX the second four in the upper halves), so that the lookups blend texels
+// on lanes with the scalar operations per component, without a broadcast per lane.
+__attribute__((always_inline)) inline void TexelLanes(const float* base, const uint32_t* at,
+                                                      simd::VF& r, simd::VF& g, simd::VF& b) {
+#if defined(__AVX__)
+    static_assert(simd::kLanes == 8);
+    __m256 m[4];
+    for (size_t q = 0; q < 4; ++q)
+        m[q] = _mm256_set_m128(_mm_loadu_ps(base + at[q + 4]), _mm_loadu_ps(base + at[q]));
+    // Per 128-bit half, as _MM_TRANSPOSE4_PS: (r0 r1 g0 g1), (b0 b1 · ·), (r2 r3 g2 g3), ...
+    const __m256 t0 = _mm256_unpacklo_ps(m[0], m[1]), t1 = _mm256_unpackhi_ps(m[0], m[1]);
+    const __m256 t2 = _mm256_unpacklo_ps(m[2], m[3]), t3 = _mm256_unpackhi_ps(m[2], m[3]);
+    r = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0));
+    g = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2));
+    b = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0));
+#else
+    static_assert(simd::kLanes == 4);
+    F4 c0 = _mm_loadu_ps(base + at[0]), c1 = _mm_loadu_ps(base + at[1]);
+    F4 c2 = _mm_loadu_ps(base + at[2]), c3 = _mm_loadu_ps(base + at[3]);
+    _MM_TRANSPOSE4_PS(c0, c1, c2, c3);
+    r = c0, g = c1, b = c2;
+#endif
 }
 
 // Position around the horizon in [0, 4) from a horizontal direction without trigonometry:
@@ -392,27 +399,28 @@ void AnalyticSky::LookUp(size_t n, const float* x, const float* y, const float* 
         VI i0 = __builtin_convertvector(tu, VI), j0 = __builtin_convertvector(tv, VI);
         i0 = i0 < hiIndex ? i0 : hiIndex;
         j0 = j0 < hiIndex ? j0 : hiIndex;
-        alignas(32) float fu[kLanes], fv[kLanes];
-        Store(fu, tu - __builtin_convertvector(i0, VF));
-        Store(fv, tv - __builtin_convertvector(j0, VF));
+        const VF fu = tu - __builtin_convertvector(i0, VF),
+                 fv = tv - __builtin_convertvector(j0, VF);
         // Float index of texel (i0, j0)'s red: 4 floats a texel, kTableSize texels a row.
-        alignas(32) int32_t t00[kLanes];
+        // Unsigned (≥ 0), so that a lane's offset needs no sign extension.
+        alignas(32) uint32_t t00[kLanes];
         const VI t00v = (i0 + (j0 << 7)) << 2;
         std::memcpy(t00, &t00v, sizeof t00);
-        // A lane's texels (r, g, b, 0) by 16-byte loads, blended on SSE registers with the
-        // scalar LookUp's operations per component, then transposed to the outputs.
-        F4 rgb[kLanes];
-        for (size_t l = 0; l < kLanes; ++l) {
-            const float* row0 = t + t00[l];
-            const float* row1 = row0 + 4 * kTableSize;
-            const F4 a00 = _mm_loadu_ps(row0), a01 = _mm_loadu_ps(row0 + 4);
-            const F4 a10 = _mm_loadu_ps(row1), a11 = _mm_loadu_ps(row1 + 4);
-            const F4 wu = Set4(fu[l]), wv = Set4(fv[l]);
-            const F4 a = _mm_add_ps(a00, _mm_mul_ps(_mm_sub_ps(a01, a00), wu));
-            const F4 c = _mm_add_ps(a10, _mm_mul_ps(_mm_sub_ps(a11, a10), wu));
-            rgb[l] = _mm_add_ps(a, _mm_mul_ps(_mm_sub_ps(c, a), wv));
-        }
-        StoreTransposed(rgb, count, r + k, g + k, b + k);
+        // The four texels' components on lanes, blended with the scalar LookUp's operations
+        // per component.
+        VF a00[3], a01[3], a10[3], a11[3];
+        TexelLanes(t, t00, a00[0], a00[1], a00[2]);
+        TexelLanes(t + 4, t00, a01[0], a01[1], a01[2]);
+        TexelLanes(t + 4 * kTableSize, t00, a10[0], a10[1], a10[2]);
+        TexelLanes(t + 4 * kTableSize + 4, t00, a11[0], a11[1], a11[2]);
+        const auto blend = [&](int c, float* out) __attribute__((always_inline)) {
+            const VF a = a00[c] + (a01[c] - a00[c]) * fu;
+            const VF e = a10[c] + (a11[c] - a10[c]) * fu;
+            Store(out, a + (e - a) * fv, count);
+        };
+        blend(0, r + k);
+        blend(1, g + k);
+        blend(2, b + k);
     }
 }
 
@@ -443,18 +451,17 @@ void AnalyticSky::HorizonLookUp(size_t n, const float* x, const float* y, float*
         VI i = __builtin_convertvector(tu, VI);
         i = i < hiIndex ? i : hiIndex;
         i = i > 0 ? i : VI{};
-        alignas(32) float f[kLanes];
-        Store(f, Min(Max(tu - __builtin_convertvector(i, VF), zero), one));
-        alignas(32) int32_t t0[kLanes];
+        const VF f = Min(Max(tu - __builtin_convertvector(i, VF), zero), one);
+        alignas(32) uint32_t t0[kLanes];
         const VI t0v = i << 2;  // float index of texel i's red
         std::memcpy(t0, &t0v, sizeof t0);
-        // As LookUp: a lane's two texels by 16-byte loads, blended on an SSE register.
-        F4 rgb[kLanes];
-        for (size_t l = 0; l < kLanes; ++l) {
-            const F4 a = _mm_loadu_ps(h + t0[l]), c = _mm_loadu_ps(h + t0[l] + 4);
-            rgb[l] = _mm_add_ps(a, _mm_mul_ps(_mm_sub_ps(c, a), Set4(f[l])));
-        }
-        StoreTransposed(rgb, count, r + k, g + k, b + k);
+        // As LookUp: the two texels' components on lanes, blended per component.
+        VF a[3], c[3];
+        TexelLanes(h, t0, a[0], a[1], a[2]);
+        TexelLanes(h + 4, t0, c[0], c[1], c[2]);
+        Store(r + k, a[0] + (c[0] - a[0]) * f, count);
+        Store(g + k, a[1] + (c[1] - a[1]) * f, count);
+        Store(b + k, a[2] + (c[2] - a[2]) * f, count);
     }
 }
 
