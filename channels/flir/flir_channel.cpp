@@ -172,25 +172,12 @@ UniformTable::UniformTable(std::vector<float> nodes, float xMax)
 }
 
 void UniformTable::operator()(size_t count, const float* x, float* out) const {
-    // operator() lane for lane: clamp(x·scale, 0, last) as std::clamp (min(max(u, 0), last)),
-    // the cell's two nodes by simd::GatherPair. The members are read into locals once: as far
-    // as the compiler knows, the stores to out could change them.
-    using simd::VF, simd::VI;
-    const float* nodes = nodes_.data();
-    const VF scale = simd::Splat(scale_), last = simd::Splat(last_),
-             lastCell = simd::Splat(float(nodes_.size() - 2));
-    const auto Lookup = [&](VF x) {
-        const VF u = simd::Min(simd::Max(x * scale, VF{}), last);
-        const VI cell = __builtin_convertvector(simd::Min(u, lastCell), VI);
-        VF a, b;
-        simd::GatherPair(nodes, cell, a, b);
-        return a + (b - a) * (u - __builtin_convertvector(cell, VF));
-    };
+    const Lanes lookup(*this);
     // Whole lane groups, then the rest padded with zeros.
     size_t i = 0;
     for (; i + simd::kLanes <= count; i += simd::kLanes)
-        simd::Store(out + i, Lookup(simd::Load(x + i)));
-    if (i < count) simd::Store(out + i, Lookup(simd::Load(x + i, count - i, 0.0f)), count - i);
+        simd::Store(out + i, lookup(simd::Load(x + i)));
+    if (i < count) simd::Store(out + i, lookup(simd::Load(x + i, count - i, 0.0f)), count - i);
 }
 
 FlirChannel::FlirChannel(const scene::World& world, const scene::ChannelSettings& settings)
@@ -367,12 +354,10 @@ struct FlirChannel::ShadeBlock {
     // Sky: sample index within the block, view direction's z and squared length.
     alignas(16) uint32_t skyK[kChunk];
     alignas(16) float skyZ[kChunk], skyLength[kChunk];
-    // Sea: per sample the records of position and (unnormalized) normal
-    // (x, y, z, 0, nx, ny, nz, 0) and of the sea-mesh attributes (depth, wet, foam, ·) as
-    // SeaGather writes them, turned to lanes by 4×4 transposes when shaded; and the runs of
-    // consecutive samples they came from (first sample index and length; a row's sea samples
-    // come in long runs, so they are written back a run at a time).
-    alignas(32) float seaPN[8 * kChunk], seaA[4 * kChunk];
+    // Sea: per sample position, (unnormalized) normal and sea-mesh attributes as SeaGather
+    // writes them; and the runs of consecutive samples they came from (first sample index and
+    // length; a row's sea samples come in long runs, so they are written back a run at a time).
+    SeaSamples<kChunk> sea;
     uint32_t seaRunK[kChunk], seaRunLength[kChunk];
     size_t seaRuns = 0;
     std::vector<uint32_t> modelK;
@@ -388,30 +373,6 @@ struct FlirChannel::ShadeScratch {
 };
 
 namespace {
-
-// Lanes x, y, z, w of simd::kLanes consecutive 16-byte aligned records of stride floats from
-// records (eight lanes: two 4×4 transposes side by side).
-void RecordLanes(const float* records, size_t stride, simd::VF& x, simd::VF& y, simd::VF& z,
-                 simd::VF& w) {
-#if defined(__AVX__)
-    const auto Pair = [&](size_t i) {
-        return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(records + i * stride)),
-                                    _mm_load_ps(records + (i + 4) * stride), 1);
-    };
-    const __m256 r0 = Pair(0), r1 = Pair(1), r2 = Pair(2), r3 = Pair(3);
-    const __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpackhi_ps(r0, r1);
-    const __m256 t2 = _mm256_unpacklo_ps(r2, r3), t3 = _mm256_unpackhi_ps(r2, r3);
-    x = simd::VF(_mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0)));
-    y = simd::VF(_mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2)));
-    z = simd::VF(_mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0)));
-    w = simd::VF(_mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2)));
-#else
-    F4 a = _mm_load_ps(records), b = _mm_load_ps(records + stride),
-       c = _mm_load_ps(records + 2 * stride), d = _mm_load_ps(records + 3 * stride);
-    _MM_TRANSPOSE4_PS(a, b, c, d);
-    x = simd::VF(a), y = simd::VF(b), z = simd::VF(c), w = simd::VF(d);
-#endif
-}
 
 // The end of the run of sky samples (kNoPrimitive) in prims[x, sw) that starts at x.
 int SkyRunEnd(const uint32_t* prims, int x, int sw) {
@@ -468,22 +429,23 @@ void FlirChannel::ShadeSea(const FrameShading& f, ShadeBlock& sc, size_t count, 
     // Emissivity at the local view angle (Masuda's wind average for the unresolved slopes), sky
     // reflected about the resolved normal (a ray reflected into the sea meets the next wave's
     // sky); sand where the sea lies on the beach and foam over both (SurfInfraredRadiance);
-    // through the path. The records past count (the last lane group's unused lanes) repeat the
+    // through the path. The entries past count (the last lane group's unused lanes) repeat the
     // last sample, so that those lanes compute finite values that are never stored.
     using simd::VF;
-    for (size_t i = count; i % simd::kLanes != 0; ++i) {
-        std::copy_n(sc.seaPN + 8 * (count - 1), 8, sc.seaPN + 8 * i);
-        std::copy_n(sc.seaA + 4 * (count - 1), 4, sc.seaA + 4 * i);
-    }
+    const auto Lanes = [&](SeaComponent k, size_t i) { return simd::Load(sc.sea.c[k] + i); };
+    for (float(&component)[kChunk + simd::kLanes] : sc.sea.c)
+        std::fill(component + count,
+                  component + (count + simd::kLanes - 1) / simd::kLanes * simd::kLanes,
+                  component[count - 1]);
     // The frame's constants in locals: the stores to sc could alias f's members, which would
     // be read again for every lane group.
     const VF eyeX = simd::Splat(f.eye.x), eyeY = simd::Splat(f.eye.y), eyeZ = simd::Splat(f.eye.z);
     const SurfInfrared surf = f.surf;
-    const VF airB = simd::Splat(f.airB);
+    const VF airB = simd::Splat(f.airB), seaB = simd::Splat(f.seaB);
+    const UniformTable::Lanes emissivity(seaEmissivity_), sky(skyTable_), path(pathTau_);
     for (size_t i = 0; i < count; i += simd::kLanes) {
-        VF nx, ny, nz, px, py, pz, unused;
-        RecordLanes(sc.seaPN + 8 * i + 4, 8, nx, ny, nz, unused);
-        RecordLanes(sc.seaPN + 8 * i, 8, px, py, pz, unused);
+        VF nx = Lanes(kSeaNx, i), ny = Lanes(kSeaNy, i), nz = Lanes(kSeaNz, i);
+        const VF px = Lanes(kSeaPx, i), py = Lanes(kSeaPy, i), pz = Lanes(kSeaPz, i);
         const VF invN = 1.0f / simd::Sqrt(simd::Dot(nx, ny, nz, nx, ny, nz));
         nx = nx * invN, ny = ny * invN, nz = nz * invN;
         const VF tx = eyeX - px, ty = eyeY - py, tz = eyeZ - pz;
@@ -491,20 +453,11 @@ void FlirChannel::ShadeSea(const FrameShading& f, ShadeBlock& sc, size_t count, 
         const VF invRange = 1.0f / range;
         const VF ndv = simd::Dot(nx, ny, nz, tx, ty, tz) * invRange;
         const VF rz = (2.0f * ndv) * nz - tz * invRange;
-        simd::Store(sc.a + i, simd::Max(ndv, VF{}));  // cos θ_view
-        simd::Store(sc.b + i, Abs(rz));               // reflected ray's cos θ_zenith
-        simd::Store(sc.c + i, simd::Sqrt(range));     // √range
-    }
-    seaEmissivity_(count, sc.a, sc.d);
-    skyTable_(count, sc.b, sc.e);
-    pathTau_(count, sc.c, sc.a);
-    const VF seaB = simd::Splat(f.seaB);
-    for (size_t i = 0; i < count; i += simd::kLanes) {
-        VF depth, wet, foam, unused;
-        RecordLanes(sc.seaA + 4 * i, 4, depth, wet, foam, unused);
-        const VF L = SurfInfraredRadiance(surf, simd::Load(sc.d + i), seaB, simd::Load(sc.e + i),
-                                          depth, wet, foam);
-        const VF tau = simd::Load(sc.a + i);
+        const VF epsWater = emissivity(simd::Max(ndv, VF{}));  // at cos θ_view
+        const VF skyR = sky(Abs(rz));                          // at the reflected cos θ_zenith
+        const VF tau = path(simd::Sqrt(range));
+        const VF L = SurfInfraredRadiance(surf, epsWater, seaB, skyR, Lanes(kSeaDepth, i),
+                                          Lanes(kSeaWet, i), Lanes(kSeaFoam, i));
         simd::Store(sc.b + i, tau * L + (1.0f - tau) * airB);
     }
     const float* L = sc.b;
@@ -540,7 +493,7 @@ uint64_t FlirChannel::ShadeRows(const FrameShading& f, int y0, int y1, float* ou
             const uint32_t k = kRow + uint32_t(x), prim = prims[x];
             if (sea.IsSea(prim)) {
                 const int x0 = x;
-                x = sea.Gather<kChunk>(prims, b1, b2, x, sw, sc.seaPN, sc.seaA, seaCount);
+                x = sea.Gather(prims, b1, b2, x, sw, sc.sea, seaCount);
                 sc.seaRunK[sc.seaRuns] = k;
                 sc.seaRunLength[sc.seaRuns++] = uint32_t(x - x0);
                 if (seaCount == kChunk) ShadeSea(f, sc, seaCount, out), seaCount = 0;

@@ -19,6 +19,7 @@
 #include "radiometry/planck/planck.h"
 #include "radiometry/sea/sea_emissivity.h"
 #include "scene/core/image.h"
+#include "scene/core/simd_lanes.h"
 #include "scene/world/world.h"
 
 namespace seasense::channels {
@@ -116,6 +117,28 @@ class UniformTable {
         const size_t i = std::min(size_t(u), nodes_.size() - 2);
         return nodes_[i] + (nodes_[i + 1] - nodes_[i]) * (u - float(i));
     }
+    // operator() lane for lane: clamp(x·scale, 0, last) as std::clamp (min(max(u, 0), last)),
+    // the cell's two nodes by simd::GatherPair. A copy of the table's constants, for loops
+    // whose stores the compiler must assume could change the table's members.
+    class Lanes {
+      public:
+        explicit Lanes(const UniformTable& t)
+            : nodes_(t.nodes_.data()),
+              scale_(simd::Splat(t.scale_)),
+              last_(simd::Splat(t.last_)),
+              lastCell_(simd::Splat(float(t.nodes_.size() - 2))) {}
+        simd::VF operator()(simd::VF x) const {
+            const simd::VF u = simd::Min(simd::Max(x * scale_, simd::VF{}), last_);
+            const simd::VI cell = __builtin_convertvector(simd::Min(u, lastCell_), simd::VI);
+            simd::VF a, b;
+            simd::GatherPair(nodes_, cell, a, b);
+            return a + (b - a) * (u - __builtin_convertvector(cell, simd::VF));
+        }
+
+      private:
+        const float* nodes_;
+        simd::VF scale_, last_, lastCell_;
+    };
     // operator() of each of count values (any count), lane for lane the same arithmetic.
     void operator()(size_t count, const float* x, float* out) const;
     float XMax() const { return last_ / scale_; }

@@ -4,11 +4,13 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstring>
 #include <glm/glm.hpp>
 #include <vector>
 
 #include "channels/raster/rasterizer.h"
 #include "scene/core/simd4.h"
+#include "scene/core/simd_lanes.h"
 
 namespace seasense::channels {
 
@@ -75,11 +77,34 @@ class TriangleCache {
     simd4::F4 p_[3] = {}, n_[3] = {};
 };
 
-// Sea-mesh samples of visibility-buffer rows gathered into records: per sample the
-// position and (unnormalized) normal as one record (x, y, z, 0, nx, ny, nz, 0) and the vertex
-// attributes (depth, wet, foam, ·), all interpolated with TriangleCache's sums, so the same
-// bits. Most samples of a row are sea, so this is the shading pass's inner loop: the sea mesh
-// is known (no search for the mesh) and the last triangle's vertices stay in registers.
+// The components of a sea sample that SeaGather writes, one array each: position, (unnormalized)
+// normal and the vertex attributes (depth, wet, foam) interpolated at the sample.
+enum SeaComponent {
+    kSeaPx,
+    kSeaPy,
+    kSeaPz,
+    kSeaNx,
+    kSeaNy,
+    kSeaNz,
+    kSeaDepth,
+    kSeaWet,
+    kSeaFoam,
+    kSeaComponents
+};
+
+// Up to kCapacity gathered sea samples, component by component (structure of arrays, as the
+// shading loops read them), with room past the last for the stores of a whole lane group.
+template <size_t kCapacity>
+struct SeaSamples {
+    alignas(32) float c[kSeaComponents][kCapacity + simd::kLanes];
+};
+
+// Sea-mesh samples of visibility-buffer rows gathered into SeaSamples: per sample each
+// component interpolated as TriangleCache's sums ((w0 a0 + w1 a1) + w2 a2, w0 = 1 − b1 − b2,
+// the attributes clamped to kMaxVertexAttribute first), so the same bits. Most samples of a
+// row are sea, in runs of a few samples per triangle, so this is the shading pass's inner
+// loop: the sea mesh is known (no search for the mesh) and a run's samples are interpolated a
+// lane group at a time from its triangle's vertex components, broadcast once per triangle.
 class SeaGather {
   public:
     // sea: mesh 0 of the visibility buffer, its primitives [seaBase, seaBase + seaPrimitives).
@@ -88,84 +113,88 @@ class SeaGather {
 
     bool IsSea(uint32_t prim) const { return prim - base_ < count_; }
 
-    // Gathers samples x, x + 1, … of a row (primitives prims, barycentrics b1 and b2) while
-    // they are sea, up to the row's end sw or until records holds kCapacity samples. Returns the
-    // first sample not gathered.
+    // Gathers samples x, x + 1, … of a row (primitives prims, barycentrics b1 and b2, sw
+    // samples) while they are sea, up to the row's end or until out holds kCapacity samples
+    // (records of them). Returns the first sample not gathered. Entries past the last
+    // record are overwritten with unspecified values.
     template <size_t kCapacity>
-    int Gather(const uint32_t* prims, const float* b1, const float* b2, int x, int sw, float* pn,
-               float* attributes, size_t& records) {
-        using namespace simd4;
+    int Gather(const uint32_t* prims, const float* b1, const float* b2, int x, int sw,
+               SeaSamples<kCapacity>& out, size_t& records) {
+        using simd::VF, simd::VI, simd::kLanes;
+        const VF top = simd::Broadcast(kMaxVertexAttribute);
+        // The triangle's state in locals: the record stores could alias the members.
+        uint32_t last = prim_;
+        const float* const* vertex = vertex_;
+        const float *p0 = vertex[0], *p1 = vertex[1], *p2 = vertex[2];
+        const float *n0 = vertex[3], *n1 = vertex[4], *n2 = vertex[5];
+        const float *a0 = vertex[6], *a1 = vertex[7], *a2 = vertex[8];
         size_t r = records;
-        // A run of samples on one triangle at a time, its vertices in locals (registers: the
-        // record stores could alias the members, which would be reloaded for every sample).
+        // A lane group of samples at a time: all lanes interpolated on the first sample's
+        // triangle and stored, its leading lanes on that triangle (up to the row's end or a full
+        // chunk) kept. The loads stay inside the row.
         while (x < sw && r < kCapacity) {
             const uint32_t prim = prims[x];
             if (!IsSea(prim)) break;
-            if (prim != prim_) Fetch(prim);
-            const int first = x, end = x + int(std::min(size_t(sw - x), kCapacity - r));
-            float* record = pn + 8 * r;
-            float* attribute = attributes + 4 * r;
+            if (prim != last) {
+                last = prim;
+                const uint32_t* i = sea_.indices + 3 * size_t(prim - base_);
+                p0 = &sea_.positions[i[0]].x, p1 = &sea_.positions[i[1]].x;
+                p2 = &sea_.positions[i[2]].x;
+                n0 = &sea_.normals[i[0]].x, n1 = &sea_.normals[i[1]].x;
+                n2 = &sea_.normals[i[2]].x;
+                if (sea_.attributes) {
+                    a0 = &sea_.attributes[i[0]].x, a1 = &sea_.attributes[i[1]].x;
+                    a2 = &sea_.attributes[i[2]].x;
+                }
+            }
+            const size_t inRow = std::min(kLanes, size_t(sw - x));
+            VI p;
+            VF u, v;
+            if (inRow == kLanes) {
+                std::memcpy(&p, prims + x, sizeof p);
+                u = simd::Load(b1 + x), v = simd::Load(b2 + x);
+            } else {
+                p = VI{};
+                for (size_t l = 0; l < inRow; ++l) p[l] = int32_t(prims[size_t(x) + l]);
+                u = simd::Load(b1 + x, inRow), v = simd::Load(b2 + x, inRow);
+            }
+            const unsigned on = simd::LaneBits(p == int32_t(prim));
+            const int run = std::min({__builtin_ctz(~on), sw - x, int(kCapacity - r)});
+            const VF w0 = 1.0f - u - v;
+            const auto Sum = [&](VF c0, VF c1, VF c2) { return (w0 * c0 + u * c1) + v * c2; };
+            const auto B = [](const float* c) { return simd::Broadcast(*c); };
+            // _mm_min_ps(a, top) as TriangleCache's clamp (top where a is NaN).
+            const auto Clamped = [&](const float* c) {
 #if defined(__AVX__)
-            const __m256 v0 = pn_[0], v1 = pn_[1], v2 = pn_[2];
+                return VF(_mm256_min_ps(B(c), top));
 #else
-            const F4 p[3] = {p_[0], p_[1], p_[2]}, n[3] = {n_[0], n_[1], n_[2]};
+                return VF(_mm_min_ps(B(c), top));
 #endif
-            const F4 a[3] = {a_[0], a_[1], a_[2]};
-            do {
-                const float u = b1[x], v = b2[x];
-#if defined(__AVX__)
-                const __m256 w0 = _mm256_set1_ps(1.0f - u - v), w1 = _mm256_set1_ps(u),
-                             w2 = _mm256_set1_ps(v);
-                _mm256_storeu_ps(record, _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(w0, v0),
-                                                                     _mm256_mul_ps(w1, v1)),
-                                                       _mm256_mul_ps(w2, v2)));
-                _mm_storeu_ps(attribute,
-                              Interpolate(_mm256_castps256_ps128(w0), _mm256_castps256_ps128(w1),
-                                          _mm256_castps256_ps128(w2), a));
-#else
-                const F4 w0 = Set4(1.0f - u - v), w1 = Set4(u), w2 = Set4(v);
-                _mm_storeu_ps(record, Interpolate(w0, w1, w2, p));
-                _mm_storeu_ps(record + 4, Interpolate(w0, w1, w2, n));
-                _mm_storeu_ps(attribute, Interpolate(w0, w1, w2, a));
-#endif
-                record += 8;
-                attribute += 4;
-            } while (++x < end && prims[x] == prim);
-            r += size_t(x - first);
+            };
+            for (int c = 0; c < 3; ++c) {
+                simd::Store(out.c[kSeaPx + c] + r, Sum(B(p0 + c), B(p1 + c), B(p2 + c)));
+                simd::Store(out.c[kSeaNx + c] + r, Sum(B(n0 + c), B(n1 + c), B(n2 + c)));
+                simd::Store(out.c[kSeaDepth + c] + r,
+                            Sum(Clamped(a0 + c), Clamped(a1 + c), Clamped(a2 + c)));
+            }
+            r += size_t(run);
+            x += run;
         }
+        prim_ = last;
+        const float* const now[9] = {p0, p1, p2, n0, n1, n2, a0, a1, a2};
+        std::copy_n(now, 9, vertex_);
         records = r;
         return x;
     }
 
   private:
-    void Fetch(uint32_t prim) {
-        using namespace simd4;
-        const uint32_t t = prim - base_;
-        const uint32_t i[3] = {sea_.indices[3 * t], sea_.indices[3 * t + 1],
-                               sea_.indices[3 * t + 2]};
-        prim_ = prim;
-        const F4 top = Set4(kMaxVertexAttribute);
-        for (int v = 0; v < 3; ++v) {
-#if defined(__AVX__)
-            pn_[v] = _mm256_set_m128(Load3(sea_.normals[i[v]]), Load3(sea_.positions[i[v]]));
-#else
-            p_[v] = Load3(sea_.positions[i[v]]);
-            n_[v] = Load3(sea_.normals[i[v]]);
-#endif
-            a_[v] = sea_.attributes ? _mm_min_ps(_mm_loadu_ps(&sea_.attributes[i[v]].x), top)
-                                    : _mm_setzero_ps();
-        }
-    }
-
     const MeshArrays& sea_;
     uint32_t base_, count_;
     uint32_t prim_ = kNoPrimitive;
-#if defined(__AVX__)
-    __m256 pn_[3] = {};  // (position, normal) of each vertex
-#else
-    simd4::F4 p_[3] = {}, n_[3] = {};
-#endif
-    simd4::F4 a_[3] = {};
+    // The last triangle's three vertices: positions, normals and attributes (each x, y, z);
+    // zeros for the attributes of a sea without them.
+    static constexpr float kNone[3] = {};
+    const float* vertex_[9] = {kNone, kNone, kNone, kNone, kNone, kNone, kNone, kNone, kNone};
 };
 
 }  // namespace seasense::channels

@@ -234,39 +234,41 @@ BandRadianceTable::BandRadianceTable(Band band, double minT_K, double maxT_K, do
     // Equal cells no wider than step_K that end exactly on maxT_K.
     const size_t cells = size_t(std::ceil((maxT_K - minT_K) / step_K - 1e-9));
     step_K_ = (maxT_K - minT_K) / double(cells);
-    nodes_.resize(cells + 1);
+    // ln L_B and d(ln L_B)/dT at the nodes, then each cell's polynomial: the cubic Hermite
+    // basis on [0, 1] with the node slopes scaled to the cell (step_K_).
     lnL_.resize(cells + 1);
+    std::vector<double> dlnLdT(cells + 1);
     for (size_t i = 0; i <= cells; ++i) {
         const double T = i == cells ? maxT_K : minT_K + double(i) * step_K_;
         const double L = BandRadiance(band_, T);
-        nodes_[i] = {std::log(L), BandRadianceDerivative(band_, T) / L};
-        lnL_[i] = nodes_[i].lnL;
+        lnL_[i] = std::log(L);
+        dlnLdT[i] = BandRadianceDerivative(band_, T) / L;
+    }
+    cells_.resize(cells);
+    for (size_t i = 0; i < cells; ++i) {
+        const double m0 = dlnLdT[i] * step_K_, m1 = dlnLdT[i + 1] * step_K_;
+        const double dy = lnL_[i + 1] - lnL_[i];
+        cells_[i] = {lnL_[i], m0, 3.0 * dy - 2.0 * m0 - m1, m0 + m1 - 2.0 * dy};
     }
 }
 
 double BandRadianceTable::Interpolate(size_t i, double t, double* dlnLdt) const {
-    // Cubic Hermite basis on [0, 1] with node slopes scaled to the cell (step_K_).
-    const Node& n0 = nodes_[i];
-    const Node& n1 = nodes_[i + 1];
-    const double m0 = n0.dlnLdT * step_K_, m1 = n1.dlnLdT * step_K_;
-    const double dy = n1.lnL - n0.lnL;
-    // p(t) = y0 + t(m0 + t(c2 + t c3)) with c2 = 3Δ − 2m0 − m1, c3 = m0 + m1 − 2Δ.
-    const double c2 = 3.0 * dy - 2.0 * m0 - m1, c3 = m0 + m1 - 2.0 * dy;
-    if (dlnLdt) *dlnLdt = m0 + t * (2.0 * c2 + 3.0 * t * c3);
-    return n0.lnL + t * (m0 + t * (c2 + t * c3));
+    const Cell& c = cells_[i];
+    if (dlnLdt) *dlnLdt = c.m0 + t * (2.0 * c.c2 + 3.0 * t * c.c3);
+    return c.lnL + t * (c.m0 + t * (c.c2 + t * c.c3));
 }
 
 double BandRadianceTable::Radiance(double T_K) const {
     if (!(T_K >= minT_K_ && T_K <= maxT_K_)) return BandRadiance(band_, T_K);
     const double u = (T_K - minT_K_) / step_K_;
-    const size_t i = std::min(size_t(u), nodes_.size() - 2);
+    const size_t i = std::min(size_t(u), cells_.size() - 1);
     return std::exp(Interpolate(i, u - double(i), nullptr));
 }
 
 double BandRadianceTable::RadianceDerivative(double T_K) const {
     if (!(T_K >= minT_K_ && T_K <= maxT_K_)) return BandRadianceDerivative(band_, T_K);
     const double u = (T_K - minT_K_) / step_K_;
-    const size_t i = std::min(size_t(u), nodes_.size() - 2);
+    const size_t i = std::min(size_t(u), cells_.size() - 1);
     double dlnLdt;
     const double lnL = Interpolate(i, u - double(i), &dlnLdt);
     return std::exp(lnL) * dlnLdt / step_K_;

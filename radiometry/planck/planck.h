@@ -73,17 +73,20 @@ class BandRadianceTable {
     double Temperature(double radiance_W_m2_sr) const;
 
   private:
-    struct Node {
-        double lnL;     // ln(L_B / (W·m⁻²·sr⁻¹))
-        double dlnLdT;  // d(ln L_B)/dT, K⁻¹
+    // The cubic Hermite polynomial of ln L_B over one cell in its local coordinate t ∈ [0, 1],
+    // p(t) = lnL + t(m0 + t(c2 + t c3)), its coefficients formed once from the nodes.
+    struct Cell {
+        double lnL;     // ln(L_B / (W·m⁻²·sr⁻¹)) at the cell's first node
+        double m0;      // d(ln L_B)/dT there, times the cell width
+        double c2, c3;  // 3Δ − 2m0 − m1 and m0 + m1 − 2Δ (Δ the rise of ln L_B over the cell)
     };
     // Cubic Hermite ln L_B at cell i, local coordinate t ∈ [0, 1]; slope in t if wanted.
     double Interpolate(size_t i, double t, double* dlnLdt) const;
 
     Band band_;
     double minT_K_, maxT_K_, step_K_;
-    std::vector<Node> nodes_;
-    std::vector<double> lnL_;  // nodes_[i].lnL again, contiguous for the inverse search
+    std::vector<Cell> cells_;
+    std::vector<double> lnL_;  // ln L_B at the nodes (cells_[i].lnL and the last node's)
 };
 
 }  // namespace seasense::radiometry

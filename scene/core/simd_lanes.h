@@ -21,6 +21,14 @@ using VF = float __attribute__((vector_size(kLanes * sizeof(float))));
 using VI = int32_t __attribute__((vector_size(kLanes * sizeof(int32_t))));
 
 inline VF Splat(float v) { return VF{} + v; }
+// v in every lane, bit for bit (Splat's 0 + v turns −0 into +0).
+inline VF Broadcast(float v) {
+#if defined(__AVX__)
+    return _mm256_set1_ps(v);
+#else
+    return _mm_set1_ps(v);
+#endif
+}
 
 // count ≤ kLanes lanes from p, the rest pad (a partial last group goes through the same code).
 inline VF Load(const float* p, size_t count = kLanes, float pad = 0.0f) {

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -248,6 +249,35 @@ TEST(BandRadianceTable, MatchesDirectIntegrationTo1e5) {
         // Nodes reproduce the direct values.
         EXPECT_NEAR(table.Radiance(150.0) / BandRadiance(band, 150.0), 1.0, 1e-13);
         EXPECT_NEAR(table.Radiance(2500.0) / BandRadiance(band, 2500.0), 1.0, 1e-13);
+    }
+}
+
+TEST(BandRadianceTable, EqualsTheCubicHermiteOfItsNodesBitForBit) {
+    // The interpolant written out from its definition: ln L_B and d(ln L_B)/dT at the two nodes
+    // around T (cells of 2 K from 150 K), the Hermite cubic in t with slopes scaled to the cell,
+    // formed for each call; the table must give these bits for the radiance and its derivative.
+    const Band band = Band::Lwir();
+    const BandRadianceTable table(band, 150.0, 2500.0, 2.0);
+    const double step = 2.0;
+    for (double T = 150.0; T <= 2500.0; T += 0.731) {
+        const double u = (T - 150.0) / step;
+        const size_t i = std::min(size_t(u), size_t(1174));
+        const double t = u - double(i);
+        const auto Node = [&](size_t k, double& lnL, double& dlnLdT) {
+            const double Tk = k == 1175 ? 2500.0 : 150.0 + double(k) * step;
+            const double L = BandRadiance(band, Tk);
+            lnL = std::log(L);
+            dlnLdT = BandRadianceDerivative(band, Tk) / L;
+        };
+        double y0, d0, y1, d1;
+        Node(i, y0, d0);
+        Node(i + 1, y1, d1);
+        const double m0 = d0 * step, m1 = d1 * step, dy = y1 - y0;
+        const double c2 = 3.0 * dy - 2.0 * m0 - m1, c3 = m0 + m1 - 2.0 * dy;
+        const double lnL = y0 + t * (m0 + t * (c2 + t * c3));
+        const double slope = m0 + t * (2.0 * c2 + 3.0 * t * c3);
+        ASSERT_EQ(table.Radiance(T), std::exp(lnL)) << T;
+        ASSERT_EQ(table.RadianceDerivative(T), std::exp(lnL) * slope / step) << T;
     }
 }
 
