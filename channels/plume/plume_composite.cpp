@@ -312,6 +312,8 @@ struct FrameBuffers {
     std::vector<CellRow> cellRows;
     std::vector<BandTrace> nodes;
     std::vector<float> nodeT;
+    std::vector<BandTrace> surfaceNodes;
+    std::vector<float> surfaceNodeRange, surfaceNodeT;
     std::vector<PlumeScreenBins::List> blocks;
     std::vector<PlumeScreenBins::RowSource> bandSources;
     bool busy = false;
@@ -638,8 +640,17 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     std::vector<float>& nodeT = lease.buffers->nodeT;
     nodes.resize(size_t(nodesX) * size_t(nodesY));
     nodeT.resize(nodes.size());
+    // The nodes' pixels' traces to their own surfaces, where a node's pixel lies in the image
+    // and its samples see surfaces with no depth edge (range: their nearest; else −1, none):
+    // the corners of the cells whose pixels all see such surfaces (pass 2, SurfacePixels).
+    std::vector<BandTrace>& surfaceNodes = lease.buffers->surfaceNodes;
+    std::vector<float>& surfaceNodeRange = lease.buffers->surfaceNodeRange;
+    std::vector<float>& surfaceNodeT = lease.buffers->surfaceNodeT;
+    surfaceNodes.resize(nodes.size());
+    surfaceNodeRange.resize(nodes.size());
+    surfaceNodeT.resize(nodes.size());
     std::vector<uint64_t> rowCovered(size_t(cellsY), 0), rowTraces(size_t(cellsY), 0),
-        rowTests(size_t(cellsY), 0);
+        rowTests(size_t(cellsY), 0), rowNodeBlended(size_t(cellsY), 0);
     // Pass 0, the puffs of each tile's block: the tile and the one pixel beyond its right and
     // bottom edges that its last cells reach, gathered from the tiles once. Every row of cells
     // of pass 1 lies inside its tiles' blocks, so it takes its puffs from the blocks' lists (the
@@ -731,6 +742,28 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
         },
         tbb::simple_partitioner());
 
+    // The ranges of the nearest and farthest surfaces that the samples of pixel (px, py) see
+    // (sky: kPlumeSkyRange_m), as pass 2 makes them from the visibility buffer.
+    const auto PixelRanges = [&](int px, int py, float& rMin, float& rMax) {
+        const glm::vec3 dir = PixelDirection(px, py);
+        // depth = near / w, w the distance along the optical axis.
+        const float rangeScale = nearM / std::max(glm::dot(dir, forward), 1e-6f);
+        rMin = kPlumeSkyRange_m, rMax = 0.0f;
+        for (int j = 0; j < N; ++j)
+            for (int i = 0; i < N; ++i) {
+                const size_t idx = vis.Index(px * N + i, py * N + j);
+                const float d = vis.depth[idx];
+                const bool sky = (vis.primitive[idx] == kNoPrimitive) | (d <= 0.0f);
+                const float r = sky ? kPlumeSkyRange_m : std::min(rangeScale / d, kPlumeSkyRange_m);
+                rMin = std::min(rMin, r), rMax = std::max(rMax, r);
+            }
+    };
+    // Whether a pixel with these ranges can be the corner of a cell of surfaces: its samples
+    // see surfaces (not the sky) with no depth edge between them.
+    const auto SurfaceCorner = [](float rMin, float rMax) {
+        return rMin < kPlumeSkyRange_m && !(rMax > rMin * kDepthEdgeRatio);
+    };
+
     // Pass 1b, the nodes traced to the sky: each node by the cell it is the near corner of (the
     // last column's and row's by the cells before them), when that cell has puffs and one of
     // the cells around the node with puffs is not skipped (the others never read it).
@@ -754,19 +787,38 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                     const size_t n = size_t(ny) * size_t(nodesX) + size_t(nx);
                     // No puff reaches the node's cell, so none reaches the node: a clear sky
                     // (the buffers are reused from frame to frame, so this is written).
-                    if (row.lists.count[size_t(cx)] == 0) {
-                        nodes[n] = BandTrace{};
-                        nodeT[n] = 1.0f;
-                        continue;
-                    }
+                    surfaceNodeRange[n] = -1.0f;
+                    const bool clear = row.lists.count[size_t(cx)] == 0;
+                    if (clear) nodes[n] = BandTrace{}, nodeT[n] = 1.0f;
                     if (!Used(nx - 1, ny - 1) && !Used(nx, ny - 1) && !Used(nx - 1, ny) &&
                         !Used(nx, ny))
                         continue;
+                    float rMin = kPlumeSkyRange_m, rMax = kPlumeSkyRange_m;
+                    if (nx * kCell < W && ny * kCell < H)
+                        PixelRanges(nx * kCell, ny * kCell, rMin, rMax);
+                    if (clear) {
+                        // Its pixel's surface trace is clear too, when it has one.
+                        if (SurfaceCorner(rMin, rMax)) {
+                            surfaceNodes[n] = BandTrace{};
+                            surfaceNodeRange[n] = rMin;
+                            surfaceNodeT[n] = 1.0f;
+                        }
+                        continue;
+                    }
                     row.lists.Take(size_t(cx), list);
-                    nodes[n] =
-                        bins.Trace(list, PixelDirection(nx * kCell, ny * kCell), kPlumeSkyRange_m);
+                    const glm::vec3 dir = PixelDirection(nx * kCell, ny * kCell);
+                    if (SurfaceCorner(rMin, rMax)) {
+                        // Both in one pass over the puffs (the sky trace the same bits as
+                        // alone).
+                        bins.Trace2(list, dir, rMin, kPlumeSkyRange_m, surfaceNodes[n], nodes[n]);
+                        surfaceNodeRange[n] = rMin;
+                        surfaceNodeT[n] = std::exp(-surfaceNodes[n].opticalDepth);
+                        traces += 2;
+                    } else {
+                        nodes[n] = bins.Trace(list, dir, kPlumeSkyRange_m);
+                        ++traces;
+                    }
                     nodeT[n] = std::exp(-nodes[n].opticalDepth);
-                    ++traces;
                     tests += list.size();
                 }
                 nodeRowTraces[size_t(ny)] = traces, nodeRowTests[size_t(ny)] = tests;
@@ -845,7 +897,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             depthRows.resize(size_t(rowSamples) * size_t(vis.width));
             for (size_t taken; (taken = nextRow.fetch_add(1)) < rowOrder.size();) {
                 const int cy = rowOrder[taken].second;
-                uint64_t covered = 0, traces = 0, tests = 0;
+                uint64_t covered = 0, traces = 0, tests = 0, nodeBlended = 0;
                 const CellRow& row = cellRows[size_t(cy)];
                 const int sy0 = cy * rowSamples;
                 ReadDepths(cy, row, depthRows.data(), local.depthRuns);
@@ -1006,34 +1058,78 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                         blendPx[blended] = px, blendPy[blended] = py;
                         ++blended;
                     };
+                    // The pixels of a whole cell blended from corners c: each with its source
+                    // function made on the blend's lanes (BlendedVisibleSources and
+                    // BlendedInfraredSources, the bits of Bilinear4 and the one-pixel source
+                    // functions), then composited as ApplyCell does; the centre pixel takes its
+                    // own trace instead where it has one (centre, else nullptr).
+                    const auto BlendCell = [&](const BandTrace* const c[4],
+                                               const BandTrace* centre) {
+                        float fx[kCellPixels], fy[kCellPixels], a[kCellPixels], b[kCellPixels];
+                        int px[kCellPixels], py[kCellPixels], n = 0;
+                        for (int ly = 0; ly < kCell; ++ly)
+                            for (int lx = 0; lx < kCell; ++lx) {
+                                if (centre && lx == kHalf && ly == kHalf) continue;
+                                fx[n] = float(lx) / kCell, fy[n] = float(ly) / kCell;
+                                px[n] = cx * kCell + lx, py[n] = cy * kCell + ly;
+                                a[n] = colA[size_t(px[n])], b[n] = rowB[size_t(py[n])];
+                                ++n;
+                            }
+                        float tau[kCellPixels];
+                        if (visible) {
+                            glm::vec3 S[kCellPixels];
+                            plume_detail::BlendedVisibleSources(c, fx, fy, a, b, n, worldFromCamera,
+                                                                light, tau, S);
+                            for (int l = 0; l < n; ++l) {
+                                if (!(tau[l] > 0.0f)) continue;
+                                const float Sl[3] = {S[l].x, S[l].y, S[l].z};
+                                CompositeAll(px[l], py[l], std::exp(-tau[l]), Sl);
+                            }
+                        } else {
+                            float S[kCellPixels];
+                            plume_detail::BlendedInfraredSources(c, fx, fy, n, light, tau, S);
+                            for (int l = 0; l < n; ++l) {
+                                if (!(tau[l] > 0.0f)) continue;
+                                const float Sl[3] = {S[l], 0.0f, 0.0f};
+                                CompositeAll(px[l], py[l], std::exp(-tau[l]), Sl);
+                            }
+                        }
+                        if (centre) {
+                            const int cpx = cx * kCell + kHalf, cpy = cy * kCell + kHalf;
+                            ApplyCell(centre, &cpx, &cpy, 1);
+                        }
+                    };
                     // The pixels with one trace to their nearest surface (inside the puffs'
                     // ranges, no depth edge), in the loop's order, made by SurfacePixels.
                     int surfaces = 0, surfPx[kPixels], surfPy[kPixels];
                     glm::vec3 surfDir[kPixels];
                     float surfRange[kPixels];
-                    // Where every pixel of the cell is such a pixel, no puff smaller than a cell
-                    // reaches it and its ranges have no edge (SmoothRanges), the traces at its four
-                    // corner pixels are blended for the others when the blend matches the own
-                    // traces of two inner pixels (1, 1) and (2, 2) (BlendMatches): the optical
-                    // depth to a smooth surface through puffs wider than the cell is as smooth
-                    // across it as the sky's. Else every pixel is traced.
+                    // Where every pixel of the cell is such a pixel and no puff smaller than a
+                    // cell reaches it, its corners' traces are blended for the others when its
+                    // ranges have no edge (SmoothRanges) and the blend matches the own traces of
+                    // inner pixels (BlendMatches): the optical depth to a smooth surface through
+                    // puffs wider than the cell is as smooth across it as the sky's. The corners
+                    // are first the grid nodes' pixels (surfaceNodes, traced once for the four
+                    // cells around each), checked at the centre pixel as sky cells are; where a
+                    // node's pixel has no surface trace or that test fails, the cell's own corner
+                    // pixels, checked at pixels (1, 1) and (2, 2). Else every pixel is traced.
                     const auto SurfacePixels = [&] {
                         BandTrace own[kPixels];
                         bool traced[kPixels] = {};
                         const auto TraceOwn = [&](int k) {
+                            if (traced[k]) return;
                             Count(1);
                             own[k] = bins.Trace(list, surfDir[k], surfRange[k]);
                             traced[k] = true;
                         };
                         constexpr int kLast = kCell - 1;
                         // No depth edge between the pixels: each range within kDepthEdgeRatio
-                        // of the blend of the corners' (a smooth surface, however oblique).
-                        const auto SmoothRanges = [&] {
-                            const float r[4] = {surfRange[0], surfRange[kLast],
-                                                surfRange[kLast * kCell], surfRange[kPixels - 1]};
+                        // of the blend of the corners' r at (x, y) / span (a smooth surface,
+                        // however oblique).
+                        const auto SmoothRanges = [&](const float r[4], float span) {
                             for (int k = 0; k < kPixels; ++k) {
-                                const float fx = float(k % kCell) / kLast,
-                                            fy = float(k / kCell) / kLast;
+                                const float fx = float(k % kCell) / span,
+                                            fy = float(k / kCell) / span;
                                 const float blend = (1.0f - fy) * ((1.0f - fx) * r[0] + fx * r[1]) +
                                                     fy * ((1.0f - fx) * r[2] + fx * r[3]);
                                 if (!(std::abs(surfRange[k] - blend) <=
@@ -1042,10 +1138,41 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                             }
                             return true;
                         };
+                        constexpr int kCentre = kHalf * kCell + kHalf;
+                        if (surfaces == kPixels && !fine) {
+                            const size_t n00 = size_t(cy) * size_t(nodesX) + size_t(cx);
+                            const size_t n[4] = {n00, n00 + 1, n00 + size_t(nodesX),
+                                                 n00 + size_t(nodesX) + 1};
+                            const float r[4] = {surfaceNodeRange[n[0]], surfaceNodeRange[n[1]],
+                                                surfaceNodeRange[n[2]], surfaceNodeRange[n[3]]};
+                            if (r[0] >= 0.0f && r[1] >= 0.0f && r[2] >= 0.0f && r[3] >= 0.0f &&
+                                SmoothRanges(r, float(kCell))) {
+                                const BandTrace* const c[4] = {
+                                    &surfaceNodes[n[0]], &surfaceNodes[n[1]], &surfaceNodes[n[2]],
+                                    &surfaceNodes[n[3]]};
+                                const float cT[4] = {surfaceNodeT[n[0]], surfaceNodeT[n[1]],
+                                                     surfaceNodeT[n[2]], surfaceNodeT[n[3]]};
+                                bool clear = false;
+                                if (Smooth(c, cT, fine, clear)) {
+                                    ++nodeBlended;
+                                    if (!clear) BlendCell(c, nullptr);
+                                    return;
+                                }
+                                TraceOwn(kCentre);
+                                if (BlendMatches(plume_detail::Bilinear(c, 0.5f, 0.5f),
+                                                 own[kCentre])) {
+                                    ++nodeBlended;
+                                    BlendCell(c, &own[kCentre]);
+                                    return;
+                                }
+                            }
+                        }
                         const BandTrace* const ends[4] = {&own[0], &own[kLast], &own[kLast * kCell],
                                                           &own[kLast * kCell + kLast]};
                         bool blend = false;
-                        if (surfaces == kPixels && !fine && SmoothRanges()) {
+                        const float r[4] = {surfRange[0], surfRange[kLast],
+                                            surfRange[kLast * kCell], surfRange[kPixels - 1]};
+                        if (surfaces == kPixels && !fine && SmoothRanges(r, float(kLast))) {
                             for (const int k :
                                  {0, kLast, kLast * kCell, kPixels - 1, kCell + 1, 2 * kCell + 2})
                                 TraceOwn(k);
@@ -1077,46 +1204,6 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                         DeferBlended(corner, blendFx, blendFy, blendPx, blendPy, blended);
                         ApplyCell(pendingTrace, pendingPx, pendingPy, pending);
                     };
-                    // The pixels of a whole sky cell that is smooth: each blended from the cell's
-                    // corners (but the centre pixel when the centre test traced it) with its
-                    // source function made on the blend's lanes (BlendedVisibleSources and
-                    // BlendedInfraredSources, the bits of Bilinear4 and the one-pixel source
-                    // functions), then composited as ApplyCell does.
-                    const auto BlendWholeSkyCell = [&] {
-                        float fx[kCellPixels], fy[kCellPixels], a[kCellPixels], b[kCellPixels];
-                        int px[kCellPixels], py[kCellPixels], n = 0;
-                        for (int ly = 0; ly < kCell; ++ly)
-                            for (int lx = 0; lx < kCell; ++lx) {
-                                if (centreTraced && lx == kHalf && ly == kHalf) continue;
-                                fx[n] = float(lx) / kCell, fy[n] = float(ly) / kCell;
-                                px[n] = cx * kCell + lx, py[n] = cy * kCell + ly;
-                                a[n] = colA[size_t(px[n])], b[n] = rowB[size_t(py[n])];
-                                ++n;
-                            }
-                        float tau[kCellPixels];
-                        if (visible) {
-                            glm::vec3 S[kCellPixels];
-                            plume_detail::BlendedVisibleSources(corner, fx, fy, a, b, n,
-                                                                worldFromCamera, light, tau, S);
-                            for (int l = 0; l < n; ++l) {
-                                if (!(tau[l] > 0.0f)) continue;
-                                const float Sl[3] = {S[l].x, S[l].y, S[l].z};
-                                CompositeAll(px[l], py[l], std::exp(-tau[l]), Sl);
-                            }
-                        } else {
-                            float S[kCellPixels];
-                            plume_detail::BlendedInfraredSources(corner, fx, fy, n, light, tau, S);
-                            for (int l = 0; l < n; ++l) {
-                                if (!(tau[l] > 0.0f)) continue;
-                                const float Sl[3] = {S[l], 0.0f, 0.0f};
-                                CompositeAll(px[l], py[l], std::exp(-tau[l]), Sl);
-                            }
-                        }
-                        if (centreTraced) {
-                            const int cpx = cx * kCell + kHalf, cpy = cy * kCell + kHalf;
-                            ApplyCell(&sub[1][1], &cpx, &cpy, 1);
-                        }
-                    };
                     // A whole cell whose every sample sees the sky, clear or smooth (after the
                     // centre test), takes what the loop below would give each of its pixels
                     // (nothing, or the blend of its corners; the centre pixel its own trace),
@@ -1128,7 +1215,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                         if (clearSky || smooth) {
                             covered += uint64_t(kCellPixels);
                             if (clearSky) continue;
-                            BlendWholeSkyCell();
+                            BlendCell(corner, centreTraced ? &sub[1][1] : nullptr);
                             continue;
                         }
                     }
@@ -1243,12 +1330,14 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                 }
                 rowCovered[size_t(cy)] = covered;
                 rowTraces[size_t(cy)] += traces, rowTests[size_t(cy)] += tests;
+                rowNodeBlended[size_t(cy)] = nodeBlended;
             }
         },
         tbb::simple_partitioner());
     for (int y = 0; y < cellsY; ++y) {
         stats.pixelsCovered += rowCovered[size_t(y)];
         stats.traces += rowTraces[size_t(y)];
+        stats.surfaceCellsFromNodes += rowNodeBlended[size_t(y)];
         stats.puffTests += rowTests[size_t(y)];
     }
     for (int y = 0; y < nodesY; ++y) {

@@ -406,18 +406,17 @@ TEST(PlumeComposite, CommittedPlumesWithinTheInterpolationToleranceOfTheExactInt
     EXPECT_LT(worst, 0.02);
 }
 
-// Committed plumes over a level sea seen from 400 m up, 1 km short of the fire, looking 20°
-// down: the sea under the plumes lies inside their ranges, so those pixels trace to their own
-// surfaces, and cells of a smooth sea blend the traces of their corner pixels. Every pixel's
-// transmittance is within the interpolation tolerance (0.02) of the exact line integrals through
-// all puffs (erf, in double) to its own surface (or the sky), with fewer rays than pixels.
-TEST(PlumeComposite, SurfacesInsideThePlumesWithinTheInterpolationToleranceOfTheExactIntegrals) {
+// CompositeAgainstExact of CommittedFourPlumes over a level sea (z = 0) seen from eye with a
+// camera of width × height pixels, hfov_deg wide, pitched pitch_deg; darkSea counts the sea
+// pixels whose exact transmittance is below 0.98.
+std::pair<PlumeCompositeStats, double> PlumesOverTheSea(const glm::dvec3& eye, int width,
+                                                        int height, double hfov_deg,
+                                                        double pitch_deg, int& darkSea) {
     const scene::PlumeField field = CommittedFourPlumes();
-    const glm::dvec3 eye{-150.0, 500.0, 400.0};
-    ChannelCamera cam = NorthCamera(eye, 240, 160, 1);
-    cam.hfov_rad = 20.0 * std::numbers::pi / 180.0;
+    ChannelCamera cam = NorthCamera(eye, width, height, 1);
+    cam.hfov_rad = hfov_deg * std::numbers::pi / 180.0;
     scene::Attitude attitude;
-    attitude.pitch_rad = -20.0 * std::numbers::pi / 180.0;
+    attitude.pitch_rad = pitch_deg * std::numbers::pi / 180.0;
     cam.worldFromCamera = scene::Pose{eye, scene::WorldFromBodyRotation(attitude)};
     const glm::dvec3 forward = cam.worldFromCamera.worldFromBody * glm::dvec3(0.0, 1.0, 0.0);
     VisibilityBuffer vis = SkyOnly(cam);
@@ -431,13 +430,40 @@ TEST(PlumeComposite, SurfacesInsideThePlumesWithinTheInterpolationToleranceOfThe
             vis.primitive[vis.Index(x, y)] = 0;
             vis.depth[vis.Index(x, y)] = float(cam.near_m / (s * glm::dot(d, forward)));
         }
-    int darkSea = 0;
-    const auto [stats, worst] = CompositeAgainstExact(
+    darkSea = 0;
+    return CompositeAgainstExact(
         field, cam, vis,
         [&](int x, int y) { return range_m[size_t(y) * size_t(cam.width) + size_t(x)]; },
         [&](double s, double T) { darkSea += s < kPlumeSkyRange_m && T < 0.98; });
+}
+
+// Committed plumes over a level sea seen from 400 m up, 1 km short of the fire, looking 20°
+// down: the sea under the plumes lies inside their ranges, so those pixels trace to their own
+// surfaces, and cells of a smooth sea blend the traces of their corners. Every pixel's
+// transmittance is within the interpolation tolerance (0.02) of the exact line integrals through
+// all puffs (erf, in double) to its own surface (or the sky), with fewer rays than pixels.
+TEST(PlumeComposite, SurfacesInsideThePlumesWithinTheInterpolationToleranceOfTheExactIntegrals) {
+    int darkSea = 0;
+    const auto [stats, worst] =
+        PlumesOverTheSea({-150.0, 500.0, 400.0}, 240, 160, 20.0, -20.0, darkSea);
     // Two thirds without blending the surfaces' corner traces.
     EXPECT_LT(double(stats.traces), 0.6 * double(stats.pixelsCovered));
+    EXPECT_GT(darkSea, 2000);
+    EXPECT_LT(worst, 0.02);
+}
+
+// Committed plumes over a level sea seen from 120 m up among the plumes, looking 30° down:
+// most cells of sea take the traces of the grid nodes' pixels to their own surfaces (pass 1b)
+// as corners (surfaceCellsFromNodes), and every pixel's transmittance is within the
+// interpolation tolerance (0.02) of the exact line integrals through all puffs (erf, in double)
+// to its own surface or the sky. (Blending the nodes' sky traces there instead errs by 0.3.)
+TEST(PlumeComposite, SeaCellsBlendedFromNodePixelsWithinTheInterpolationTolerance) {
+    int darkSea = 0;
+    const auto [stats, worst] =
+        PlumesOverTheSea({-150.0, 1300.0, 120.0}, 200, 150, 60.0, -30.0, darkSea);
+    // 1119 of the 1875 cells (and a third as many rays as pixels) when written.
+    EXPECT_GT(stats.surfaceCellsFromNodes, 800u);
+    EXPECT_LT(double(stats.traces), 0.4 * double(stats.pixelsCovered));
     EXPECT_GT(darkSea, 2000);
     EXPECT_LT(worst, 0.02);
 }
