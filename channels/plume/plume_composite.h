@@ -118,6 +118,7 @@ struct PlumeCompositeStats {
     uint64_t traces = 0;                 // rays traced (one per covered pixel, two at depth edges)
     uint64_t puffTests = 0;              // puffs looked at by those traces (their lists' lengths)
     uint64_t surfaceCellsFromNodes = 0;  // cells of surfaces blended from the nodes' pixels
+    uint64_t coarseSkyCells = 0;         // cells of sky blended from the coarse grid
     double ms = 0.0;                     // bounds, traces and compositing
 };
 
@@ -138,7 +139,12 @@ inline constexpr float kPlumeSkyRange_m = 1.0e6f;
 //    see absorbing puffs) within 10 K, or the corners' blend at the cell's centre pixel matches
 //    that pixel's own trace within 0.005 and 5 K (a linear variation across the cell); else
 //    refined on 2 × 2-pixel sub-cells by the same corner criteria, and traced through the pixel
-//    centre where those fail;
+//    centre where those fail. First, though, the whole cells of 2 × 2 cells (8 × 8 pixels,
+//    from even cell indices) whose every sample sees the sky beyond their puffs are blended
+//    from the traces at their corners (every other grid node) by the same criteria, with the
+//    sum over the four cells of the puffs smaller than 8 pixels as the fine puffs and the
+//    coarse cell's centre node (its own trace then) as the centre pixel; the nodes that only
+//    such cells read are not traced;
 //  - otherwise one ray through the pixel centre to the nearest surface and, when the ranges
 //    differ by more than 10 %, to the farthest in the same pass; each sample takes the trace
 //    whose end is nearer its own range. In a cell all of whose pixels take one such ray, with

@@ -401,6 +401,9 @@ TEST(PlumeComposite, CommittedPlumesWithinTheInterpolationToleranceOfTheExactInt
     const auto [stats, worst] = CompositeAgainstExact(
         field, cam, SkyOnly(cam), [](int, int) { return double(kPlumeSkyRange_m); },
         [&](double, double T) { dark += T < 0.9; });
+    // Coarse cells (2 × 2 cells) blended from every other node: 184 of 1285 cells when written
+    // (with those blended at a quarter of the coarse spacing instead, the worst error is 0.12).
+    EXPECT_GT(stats.coarseSkyCells, 100u);
     EXPECT_LT(double(stats.traces), 0.5 * double(stats.pixelsCovered));
     EXPECT_GT(dark, 1000);
     EXPECT_LT(worst, 0.02);
@@ -626,8 +629,8 @@ TEST(PlumeComposite, InterpolatedPixelsMatchTheirOwnTraces) {
 // A wall 50 m away (in front of every puff) over the right columns: its pixels are untouched,
 // the cells wholly behind it trace no grid nodes (fewer traces than with the sky alone), and
 // the sky pixels beside it, whose cells take their far corner nodes from the wall's cells'
-// lists, are the same bit for bit as without the wall and match the exact line integrals
-// within the interpolation bound.
+// lists, match the exact line integrals within the interpolation bound, those whose coarse
+// cells (2 × 2 cells) lie wholly left of the wall the same bit for bit as without it.
 TEST(PlumeComposite, CellsBehindANearSurfaceSkipTheirNodes) {
     const glm::dvec3 eye{0.0, 0.0, 10.0};
     const ChannelCamera cam = NorthCamera(eye, 162, 121, 1);
@@ -669,9 +672,11 @@ TEST(PlumeComposite, CellsBehindANearSurfaceSkipTheirNodes) {
                 darkBehindWall += skyImage.At(x, y)[0] < 0.9f;
                 continue;
             }
-            // A sky pixel depends only on its samples, its cell's puffs and the cell's corner
-            // nodes (sky traces): the same bits as with no wall.
-            EXPECT_EQ(std::memcmp(image.At(x, y), skyImage.At(x, y), 12), 0) << x << ", " << y;
+            // A sky pixel depends only on its samples, its coarse cell's (2 × 2 cells) puffs
+            // and samples and the corner nodes: the same bits as with no wall where the coarse
+            // cell lies wholly left of it.
+            if (x < kWallStart / 8 * 8)
+                EXPECT_EQ(std::memcmp(image.At(x, y), skyImage.At(x, y), 12), 0) << x << ", " << y;
             const glm::vec3 d(cam.SampleDirection(x, y));
             double tau = 0.0;
             for (const scene::Puff& p : puffs)
