@@ -158,11 +158,13 @@ inline constexpr float kPlumeSkyRange_m = 1.0e6f;
 //    keeps its own); else from the traces of the cell's corner pixels, when every range is
 //    within 10 % of the bilinear blend of theirs and the blend matches the own traces of
 //    pixels (1, 1) and (2, 2) within 0.005 and 5 K.
-// Samples whose traces have no optical depth are left bit for bit as they were. With
-// renderSpans (one per pixel row; empty: every pixel), a cell none of whose pixels lies in
-// them is skipped as a cell wholly behind surfaces is: the pixels in the spans come out bit
-// for bit as without them, the others of such cells are left alone (an NVG field stop passes
-// no light there). Runs in the caller's oneTBB arena; bit-identical for any thread count.
+// The pixels of whole cells blended from one set of corners take e^(−τ) from simd4::Exp4
+// (within 2e-7 relative), the others from std::exp. Samples whose traces have no optical depth are
+// left bit for bit as they were. With renderSpans (one per pixel row; empty: every pixel), a cell
+// none of whose pixels lies in them is skipped as a cell wholly behind surfaces is: the pixels in
+// the spans come out bit for bit as without them, the others of such cells are left alone (an NVG
+// field stop passes no light there). Runs in the caller's oneTBB arena; bit-identical for any
+// thread count.
 PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const ChannelCamera& camera,
                                     const VisibilityBuffer& vis, const PlumeLighting& light,
                                     Image& radiance, std::span<const PixelSpan> renderSpans = {});
