@@ -150,8 +150,10 @@ inline constexpr float kPlumeSkyRange_m = 1.0e6f;
 //    whose end is nearer its own range. In a cell all of whose pixels take one such ray, with
 //    no puff smaller than a cell, the rays are blended bilinearly instead: first from the
 //    traces of the cell's grid nodes' pixels to their own nearest surfaces (made with the
-//    nodes' sky traces, in the same pass, where a node's pixel lies in the image and its
-//    samples see surfaces within 10 % of each other), when there is no depth edge (every
+//    nodes' sky traces, in the same pass, where a node's pixel lies in the image, its
+//    samples see surfaces within 10 % of each other and its traces to 10 % before and beyond
+//    its surface match within 0.005 and 5 K: no surface inside the puffs that a step in
+//    range the 10 % admit would cut), when there is no depth edge (every
 //    range within 10 % of the bilinear blend of the nodes' pixels') and either those traces'
 //    transmittances agree within 0.02 and their temperatures within 10 K or their blend at the
 //    centre pixel matches that pixel's own trace within 0.005 and 5 K (the centre pixel then
