@@ -322,6 +322,7 @@ void PlumeScreenBins::Begin(List& out) {
     out.far_m = 0.0f;
     out.smallOpticalDepth = 0.0f;
     out.halfSmallOpticalDepth = 0.0f;
+    out.twiceSmallOpticalDepth = 0.0f;
 }
 
 // Where the footprint ellipse can reach pixels [x0, x1) × [y0, y1): their centres lie in the
@@ -374,6 +375,7 @@ inline void PlumeScreenBins::Add(uint32_t k, float smallPixels, List& out) const
     out.far_m = std::max(out.far_m, fp.far_m);
     if (fp.sigmaPixels < smallPixels) out.smallOpticalDepth += fp.tauMax;
     if (fp.sigmaPixels < 0.5f * smallPixels) out.halfSmallOpticalDepth += fp.tauMax;
+    if (fp.sigmaPixels < 2.0f * smallPixels) out.twiceSmallOpticalDepth += fp.tauMax;
 }
 
 inline void PlumeScreenBins::Take(uint32_t k, int x0, int y0, int x1, int y1, float rho,
@@ -454,7 +456,7 @@ void PlumeScreenBins::ListRow::Clear() {
     start.assign(1, 0);
     count.clear();
     near_m.clear(), far_m.clear();
-    smallOpticalDepth.clear(), halfSmallOpticalDepth.clear();
+    smallOpticalDepth.clear(), halfSmallOpticalDepth.clear(), twiceSmallOpticalDepth.clear();
 }
 
 void PlumeScreenBins::ListRow::Take(size_t c, List& out) const {
@@ -465,6 +467,7 @@ void PlumeScreenBins::ListRow::Take(size_t c, List& out) const {
     out.far_m = far_m[c];
     out.smallOpticalDepth = smallOpticalDepth[c];
     out.halfSmallOpticalDepth = halfSmallOpticalDepth[c];
+    out.twiceSmallOpticalDepth = twiceSmallOpticalDepth[c];
     out.copied = false;
 }
 
@@ -566,11 +569,12 @@ void PlumeScreenBins::GatherRow(const RowSource& from, int x0, int y0, int y1, i
         const int cb0 = b * cellsPerBlock, n = std::min(cellsPerBlock, cells - cb0);
         // The block's rectangles' ranges, sums and counts, kLanes rectangles a vector, as Begin
         // starts them.
-        VF nearV[kVectors], farV[kVectors], smallV[kVectors], halfSmallV[kVectors];
+        VF nearV[kVectors], farV[kVectors], smallV[kVectors], halfSmallV[kVectors],
+            twiceSmallV[kVectors];
         VI countV[kVectors];
         for (size_t v = 0; v < kVectors; ++v) {
             nearV[v] = simd::Splat(std::numeric_limits<float>::infinity());
-            farV[v] = smallV[v] = halfSmallV[v] = simd::Splat(0.0f);
+            farV[v] = smallV[v] = halfSmallV[v] = twiceSmallV[v] = simd::Splat(0.0f);
             countV[v] = VI{};
         }
         block.clear();
@@ -600,6 +604,7 @@ void PlumeScreenBins::GatherRow(const RowSource& from, int x0, int y0, int y1, i
             const VF nearK = simd::Splat(fp.near_m), farK = simd::Splat(fp.far_m);
             const bool small = fp.sigmaPixels < smallPixels;
             const bool halfSmall = fp.sigmaPixels < 0.5f * smallPixels;
+            const bool twiceSmall = fp.sigmaPixels < 2.0f * smallPixels;
             const VF tau = simd::Splat(fp.tauMax);
             const int hiBit = 31 - __builtin_clz(mask);
             for (size_t v = size_t(__builtin_ctz(mask)) / kLanes; v <= size_t(hiBit) / kLanes;
@@ -610,18 +615,22 @@ void PlumeScreenBins::GatherRow(const RowSource& from, int x0, int y0, int y1, i
                 countV[v] -= in;
                 if (small) smallV[v] = simd::Select(in, smallV[v] + tau, smallV[v]);
                 if (halfSmall) halfSmallV[v] = simd::Select(in, halfSmallV[v] + tau, halfSmallV[v]);
+                if (twiceSmall)
+                    twiceSmallV[v] = simd::Select(in, twiceSmallV[v] + tau, twiceSmallV[v]);
             }
         }
         // The block's lists, one after the other, each padded to a multiple of 4 with the
         // inert puff.
         alignas(32) float nearA[kVectors * kLanes], farA[kVectors * kLanes];
         alignas(32) float smallA[kVectors * kLanes], halfSmallA[kVectors * kLanes];
+        alignas(32) float twiceSmallA[kVectors * kLanes];
         alignas(32) int32_t countA[kVectors * kLanes];
         for (size_t v = 0; v < kVectors; ++v) {
             simd::Store(nearA + v * kLanes, nearV[v]);
             simd::Store(farA + v * kLanes, farV[v]);
             simd::Store(smallA + v * kLanes, smallV[v]);
             simd::Store(halfSmallA + v * kLanes, halfSmallV[v]);
+            simd::Store(twiceSmallA + v * kLanes, twiceSmallV[v]);
             std::memcpy(countA + v * kLanes, &countV[v], sizeof(VI));
         }
         size_t end = out.index.size();
@@ -644,6 +653,7 @@ void PlumeScreenBins::GatherRow(const RowSource& from, int x0, int y0, int y1, i
             out.far_m.push_back(farA[c]);
             out.smallOpticalDepth.push_back(smallA[c]);
             out.halfSmallOpticalDepth.push_back(halfSmallA[c]);
+            out.twiceSmallOpticalDepth.push_back(twiceSmallA[c]);
         }
         out.index.resize(end);
     }

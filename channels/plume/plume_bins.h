@@ -71,14 +71,15 @@ class PlumeScreenBins {
     // ellipsoid a ray through one of its pixels meets is there), in field order, padded with an
     // inert puff to a multiple of 4; with the nearest and farthest range (m) where they can matter
     // and the sum of the largest optical depths (through the centre along the longest axis) of
-    // those with σ under smallPixels pixels at their distance (and of those under half that). With
-    // copy, their data is also gathered into contiguous arrays (worth it when the list serves many
-    // rays).
+    // those with σ under smallPixels pixels at their distance (and of those under half and twice
+    // that). With copy, their data is also gathered into contiguous arrays (worth it when the
+    // list serves many rays).
     struct List {
         size_t count = 0;  // puffs (index and the arrays hold count rounded up to 4)
         float near_m = 0.0f, far_m = 0.0f;
         float smallOpticalDepth = 0.0f;
         float halfSmallOpticalDepth = 0.0f;
+        float twiceSmallOpticalDepth = 0.0f;
         bool copied = false;
         std::vector<uint32_t> index;  // kept positions
         std::vector<float> data[13];  // per field of Arrays, when copied
@@ -96,7 +97,8 @@ class PlumeScreenBins {
     // ranges and small-puff sums of a List.
     struct ListRow {
         std::vector<uint32_t> index, start{0}, count;
-        std::vector<float> near_m, far_m, smallOpticalDepth, halfSmallOpticalDepth;
+        std::vector<float> near_m, far_m, smallOpticalDepth, halfSmallOpticalDepth,
+            twiceSmallOpticalDepth;
         size_t size() const { return count.size(); }
         void Clear();
         // List c as Gather makes it (not copied).

@@ -23,6 +23,7 @@
 #include "radiometry/bands/builtin_bands.h"
 #include "radiometry/color/rec709.h"
 #include "scene/core/check.h"
+#include "scene/core/simd4.h"
 #include "scene/core/simd_lanes.h"
 
 namespace seasense::channels {
@@ -53,6 +54,10 @@ constexpr float kInterpolationTolerance_K = 10.0f;
 // interpolation tolerance (half in temperature) leaves room for the higher terms.
 constexpr float kCentreTolerance = 0.25f * kInterpolationTolerance;
 constexpr float kCentreTolerance_K = 0.5f * kInterpolationTolerance_K;
+// A coarse cell (2 × 2 cells) of sky whose corners are smooth by the cells' criteria: none
+// (its cells are tested one by one), clear (nothing to do), blended from its corners, or
+// blended but the centre node's pixel, which keeps its own trace.
+enum : uint8_t { kCoarseNone, kCoarseClear, kCoarseBlend, kCoarseCentre };
 // A pixel whose samples' surface ranges differ by more than this ratio traces a second ray.
 constexpr float kDepthEdgeRatio = 1.1f;
 
@@ -251,10 +256,13 @@ void BlendedVisibleSources(const BandTrace* const t[4], const float* fx, const f
         ScatteredSources(omega, blend.Asymmetry(), simd::Load(a + k, m), simd::Load(b + k, m),
                          worldFromCamera, light, Sc);
         simd::Store(tau + k, blend.depth, m);
-        if (light.glow) {
-            // The glow per lane (table look-ups) from the blended temperatures.
+        // The glow per lane (table look-ups) from the blended temperatures, skipped where no
+        // lane glows (VisibleGlow's test: each lane would add (1 − ω) · +0 to its S, S ≥ +0).
+        const VF temperature = blend.Temperature(), hotFraction = blend.HotFraction();
+        if (light.glow &&
+            simd::Any((hotFraction > 0.0f) | (temperature >= float(BlackbodyGlowTable::kMinT_K)))) {
             alignas(32) float f[4][kLanes];
-            simd::Store(f[0], blend.Temperature()), simd::Store(f[1], blend.HotFraction());
+            simd::Store(f[0], temperature), simd::Store(f[1], hotFraction);
             simd::Store(f[2], blend.HotTemperature()), simd::Store(f[3], 1.0f - omega);
             for (size_t l = 0; l < m; ++l) {
                 BandTrace one;
@@ -302,6 +310,9 @@ struct CellRow {
     PlumeScreenBins::ListRow lists;
     // Whether every surface of the cell lies in front of its puffs (the cell is skipped).
     std::vector<uint8_t> inFront;
+    // Whether the cell lies wholly in the image and every sample of it sees the sky (made for
+    // the cells with puffs not in front of them).
+    std::vector<uint8_t> skyOnly;
 };
 
 // A frame's buffers, kept by the calling thread from one frame to the next: allocating and
@@ -312,6 +323,9 @@ struct FrameBuffers {
     std::vector<CellRow> cellRows;
     std::vector<BandTrace> nodes;
     std::vector<float> nodeT;
+    std::vector<BandTrace> surfaceNodes;
+    std::vector<float> surfaceNodeRange, surfaceNodeT;
+    std::vector<uint8_t> coarse, nodeDone;
     std::vector<PlumeScreenBins::List> blocks;
     std::vector<PlumeScreenBins::RowSource> bandSources;
     bool busy = false;
@@ -610,6 +624,29 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
         }
         return true;
     };
+    // Whether cell (cx, cy) lies wholly in the image and every sample of it sees the sky, four
+    // samples at a time (SSE2, the visibility buffer's sky test per lane).
+    const auto SkyOnly = [&](int cx, int cy) {
+        if ((cx + 1) * kCell > W || (cy + 1) * kCell > H) return false;
+        const int rowSamples = kCell * N;
+        const __m128 zero = _mm_setzero_ps();
+        const __m128i none = _mm_set1_epi32(int32_t(kNoPrimitive));
+        __m128 sky = _mm_castsi128_ps(_mm_set1_epi32(-1));
+        bool rest = true;
+        for (int j = 0; j < rowSamples; ++j) {
+            const size_t idx0 = vis.Index(cx * rowSamples, cy * rowSamples + j);
+            const float* depth = vis.depth.data() + idx0;
+            const uint32_t* primitive = vis.primitive.data() + idx0;
+            int i = 0;
+            for (; i + 4 <= rowSamples; i += 4) {
+                const __m128i p = _mm_loadu_si128(reinterpret_cast<const __m128i*>(primitive + i));
+                sky = _mm_and_ps(sky, _mm_or_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(p, none)),
+                                                _mm_cmple_ps(_mm_loadu_ps(depth + i), zero)));
+            }
+            for (; i < rowSamples; ++i) rest &= (primitive[i] == kNoPrimitive) | (depth[i] <= 0.0f);
+        }
+        return rest && _mm_movemask_ps(sky) == 0xf;
+    };
     // A depth beyond which a sample's surface is nearer than dNear anywhere in cell (cx, cy), so
     // that its pixel is skipped without its direction: range r = near / (cos θ · depth), θ the
     // angle from the optical axis, and cos θ = 1 / |(a, 1, b)| ≥ cosMin over the cell's pixels,
@@ -638,8 +675,19 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     std::vector<float>& nodeT = lease.buffers->nodeT;
     nodes.resize(size_t(nodesX) * size_t(nodesY));
     nodeT.resize(nodes.size());
+    // The nodes' pixels' traces to their own surfaces, where a node's pixel lies in the image,
+    // its samples see surfaces with no depth edge and the trace hardly depends on where the
+    // surface lies within the depth-edge ratio (range: their nearest; else −1, none): the
+    // corners of the cells whose pixels all see such surfaces (pass 2, SurfacePixels).
+    std::vector<BandTrace>& surfaceNodes = lease.buffers->surfaceNodes;
+    std::vector<float>& surfaceNodeRange = lease.buffers->surfaceNodeRange;
+    std::vector<float>& surfaceNodeT = lease.buffers->surfaceNodeT;
+    surfaceNodes.resize(nodes.size());
+    surfaceNodeRange.resize(nodes.size());
+    surfaceNodeT.resize(nodes.size());
     std::vector<uint64_t> rowCovered(size_t(cellsY), 0), rowTraces(size_t(cellsY), 0),
-        rowTests(size_t(cellsY), 0);
+        rowTests(size_t(cellsY), 0), rowNodeBlended(size_t(cellsY), 0),
+        rowCoarse(size_t(cellsY), 0);
     // Pass 0, the puffs of each tile's block: the tile and the one pixel beyond its right and
     // bottom edges that its last cells reach, gathered from the tiles once. Every row of cells
     // of pass 1 lies inside its tiles' blocks, so it takes its puffs from the blocks' lists (the
@@ -721,58 +769,40 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                 // Cells with no pixel in the render spans are skipped the same way (their
                 // lists stay: a node they are the near corner of is traced from theirs).
                 row.inFront.assign(size_t(cellsX), 0);
+                row.skyOnly.assign(size_t(cellsX), 0);
                 for (int cx = 0; cx < cellsX; ++cx)
-                    if (row.lists.count[size_t(cx)] != 0)
+                    if (row.lists.count[size_t(cx)] != 0) {
                         row.inFront[size_t(cx)] =
                             !CellInSpans(cx, cy) ||
                             AllDepthsAtLeast(cx, cy,
                                              DepthInFront(cx, cy, row.lists.near_m[size_t(cx)]));
+                        if (!row.inFront[size_t(cx)]) row.skyOnly[size_t(cx)] = SkyOnly(cx, cy);
+                    }
             }
         },
         tbb::simple_partitioner());
 
-    // Pass 1b, the nodes traced to the sky: each node by the cell it is the near corner of (the
-    // last column's and row's by the cells before them), when that cell has puffs and one of
-    // the cells around the node with puffs is not skipped (the others never read it).
-    std::vector<uint64_t> nodeRowTraces(size_t(nodesY), 0), nodeRowTests(size_t(nodesY), 0);
-    const auto Used = [&](int cx, int cy) {
-        if (cx < 0 || cy < 0 || cx >= cellsX || cy >= cellsY) return false;
-        const CellRow& row = cellRows[size_t(cy)];
-        return row.lists.count[size_t(cx)] != 0 && !row.inFront[size_t(cx)];
-    };
-    tbb::parallel_for(
-        tbb::blocked_range<int>(0, nodesY, 1),
-        [&](const tbb::blocked_range<int>& r) {
-            PlumeScreenBins::List& list = LocalScratch().list;
-            for (int ny = r.begin(); ny != r.end(); ++ny) {
-                // The row's counts, kept in registers (the rows' slots share cache lines).
-                uint64_t traces = 0, tests = 0;
-                const int cy = std::min(ny, cellsY - 1);
-                const CellRow& row = cellRows[size_t(cy)];
-                for (int nx = 0; nx < nodesX; ++nx) {
-                    const int cx = std::min(nx, cellsX - 1);
-                    const size_t n = size_t(ny) * size_t(nodesX) + size_t(nx);
-                    // No puff reaches the node's cell, so none reaches the node: a clear sky
-                    // (the buffers are reused from frame to frame, so this is written).
-                    if (row.lists.count[size_t(cx)] == 0) {
-                        nodes[n] = BandTrace{};
-                        nodeT[n] = 1.0f;
-                        continue;
-                    }
-                    if (!Used(nx - 1, ny - 1) && !Used(nx, ny - 1) && !Used(nx - 1, ny) &&
-                        !Used(nx, ny))
-                        continue;
-                    row.lists.Take(size_t(cx), list);
-                    nodes[n] =
-                        bins.Trace(list, PixelDirection(nx * kCell, ny * kCell), kPlumeSkyRange_m);
-                    nodeT[n] = std::exp(-nodes[n].opticalDepth);
-                    ++traces;
-                    tests += list.size();
-                }
-                nodeRowTraces[size_t(ny)] = traces, nodeRowTests[size_t(ny)] = tests;
+    // The ranges of the nearest and farthest surfaces that the samples of pixel (px, py) see
+    // (sky: kPlumeSkyRange_m), as pass 2 makes them from the visibility buffer.
+    const auto PixelRanges = [&](int px, int py, float& rMin, float& rMax) {
+        const glm::vec3 dir = PixelDirection(px, py);
+        // depth = near / w, w the distance along the optical axis.
+        const float rangeScale = nearM / std::max(glm::dot(dir, forward), 1e-6f);
+        rMin = kPlumeSkyRange_m, rMax = 0.0f;
+        for (int j = 0; j < N; ++j)
+            for (int i = 0; i < N; ++i) {
+                const size_t idx = vis.Index(px * N + i, py * N + j);
+                const float d = vis.depth[idx];
+                const bool sky = (vis.primitive[idx] == kNoPrimitive) | (d <= 0.0f);
+                const float r = sky ? kPlumeSkyRange_m : std::min(rangeScale / d, kPlumeSkyRange_m);
+                rMin = std::min(rMin, r), rMax = std::max(rMax, r);
             }
-        },
-        tbb::simple_partitioner());
+    };
+    // Whether a pixel with these ranges can be the corner of a cell of surfaces: its samples
+    // see surfaces (not the sky) with no depth edge between them.
+    const auto SurfaceCorner = [](float rMin, float rMax) {
+        return rMin < kPlumeSkyRange_m && !(rMax > rMin * kDepthEdgeRatio);
+    };
 
     // Whether the sky traces at the four corners of a cell (00, 10, 01, 11) may be blended:
     // their transmittances agree within kInterpolationTolerance, their temperatures (of the
@@ -811,6 +841,156 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
         return std::abs(tBlend - tOwn) <= kCentreTolerance_K;
     };
 
+    // Pass 1b, the nodes traced to the sky: each node by the cell it is the near corner of (the
+    // last column's and row's by the cells before them), when that cell has puffs and one of
+    // the cells around the node that reads it has puffs and is not skipped (the others never
+    // read it). First the nodes of the coarse grid (every other node in x and y, kCoarse
+    // pixels apart), then the coarse cells (2 × 2 cells) tested as cells are, then the other
+    // nodes that a cell outside the smooth coarse cells reads.
+    std::vector<uint64_t> nodeRowTraces(size_t(nodesY), 0), nodeRowTests(size_t(nodesY), 0);
+    const auto Used = [&](int cx, int cy) {
+        if (cx < 0 || cy < 0 || cx >= cellsX || cy >= cellsY) return false;
+        const CellRow& row = cellRows[size_t(cy)];
+        return row.lists.count[size_t(cx)] != 0 && !row.inFront[size_t(cx)];
+    };
+    // The coarse cells: (sx, sy) holds cells 2sx, 2sx + 1 × 2sy, 2sy + 1 (whole ones only), its
+    // corners the nodes (2sx, 2sy) … (2sx + 2, 2sy + 2).
+    const int coarseX = cellsX / 2, coarseY = cellsY / 2;
+    std::vector<uint8_t>& coarse = lease.buffers->coarse;
+    coarse.assign(size_t(coarseX) * size_t(coarseY), kCoarseNone);
+    // Whether cell (cx, cy) takes its pixels from its coarse cell's corners (it reads none of
+    // its own nodes then).
+    const auto InSmoothCoarse = [&](int cx, int cy) {
+        const int sx = cx / 2, sy = cy / 2;
+        return sx < coarseX && sy < coarseY &&
+               coarse[size_t(sy) * size_t(coarseX) + size_t(sx)] != kCoarseNone;
+    };
+    const auto Reads = [&](int cx, int cy) { return Used(cx, cy) && !InSmoothCoarse(cx, cy); };
+    std::vector<uint8_t>& nodeDone = lease.buffers->nodeDone;
+    nodeDone.assign(nodes.size(), 0);
+    // Traces node (nx, ny) (and its pixel's surface trace) with list as scratch.
+    const auto TraceNode = [&](int nx, int ny, PlumeScreenBins::List& list, uint64_t& traces,
+                               uint64_t& tests) {
+        const int cx = std::min(nx, cellsX - 1), cy = std::min(ny, cellsY - 1);
+        const CellRow& row = cellRows[size_t(cy)];
+        const size_t n = size_t(ny) * size_t(nodesX) + size_t(nx);
+        nodeDone[n] = 1;
+        float rMin = kPlumeSkyRange_m, rMax = kPlumeSkyRange_m;
+        if (nx * kCell < W && ny * kCell < H) PixelRanges(nx * kCell, ny * kCell, rMin, rMax);
+        if (row.lists.count[size_t(cx)] == 0) {
+            // Its pixel's surface trace is clear too, when it has one.
+            if (SurfaceCorner(rMin, rMax)) {
+                surfaceNodes[n] = BandTrace{};
+                surfaceNodeRange[n] = rMin;
+                surfaceNodeT[n] = 1.0f;
+            }
+            return;
+        }
+        row.lists.Take(size_t(cx), list);
+        const glm::vec3 dir = PixelDirection(nx * kCell, ny * kCell);
+        if (SurfaceCorner(rMin, rMax)) {
+            // Both in one pass over the puffs (the sky trace the same bits as alone).
+            bins.Trace2(list, dir, rMin, kPlumeSkyRange_m, surfaceNodes[n], nodes[n]);
+            surfaceNodeT[n] = std::exp(-surfaceNodes[n].opticalDepth);
+            // The cells that blend this trace admit pixels whose ranges differ from the blend
+            // of their nodes' by up to the depth-edge ratio, so it serves them only where the
+            // traces to that ratio before and beyond the surface match (BlendMatches): a
+            // surface inside puffs (a hull across a boat's exhaust) cuts them, and a step in
+            // it of well under 10 % of the range changes the optical depth within a pixel,
+            // which the nodes' agreement cannot show (FLIR frame 128 of five-channel.yaml: a
+            // step of 0.6 m at 278 m across 1500 K exhaust, 0.007 in T and 19 K in the image).
+            BandTrace nearer, farther;
+            bins.Trace2(list, dir, rMin / kDepthEdgeRatio, rMin * kDepthEdgeRatio, nearer, farther);
+            if (BlendMatches(nearer, farther)) surfaceNodeRange[n] = rMin;
+            traces += 4;
+            tests += list.size();
+        } else {
+            nodes[n] = bins.Trace(list, dir, kPlumeSkyRange_m);
+            ++traces;
+        }
+        nodeT[n] = std::exp(-nodes[n].opticalDepth);
+        tests += list.size();
+    };
+    // The nodes of one phase: those with coarse (both indices even) equal to `even`, read by one
+    // of the cells around them (used: Used or Reads).
+    const auto TraceNodes = [&](bool even, const auto& used) {
+        tbb::parallel_for(
+            tbb::blocked_range<int>(0, nodesY, 1),
+            [&](const tbb::blocked_range<int>& r) {
+                PlumeScreenBins::List& list = LocalScratch().list;
+                for (int ny = r.begin(); ny != r.end(); ++ny) {
+                    // The row's counts, kept in registers (the rows' slots share cache lines).
+                    uint64_t traces = 0, tests = 0;
+                    const CellRow& row = cellRows[size_t(std::min(ny, cellsY - 1))];
+                    for (int nx = 0; nx < nodesX; ++nx) {
+                        if ((nx % 2 == 0 && ny % 2 == 0) != even) continue;
+                        const size_t n = size_t(ny) * size_t(nodesX) + size_t(nx);
+                        if (nodeDone[n]) continue;
+                        // No puff reaches the node's cell, so none reaches the node: a clear
+                        // sky (the buffers are reused from frame to frame, so this is written).
+                        if (row.lists.count[size_t(std::min(nx, cellsX - 1))] == 0)
+                            nodes[n] = BandTrace{}, nodeT[n] = 1.0f;
+                        if (!used(nx - 1, ny - 1) && !used(nx, ny - 1) && !used(nx - 1, ny) &&
+                            !used(nx, ny))
+                            continue;
+                        TraceNode(nx, ny, list, traces, tests);
+                    }
+                    nodeRowTraces[size_t(ny)] += traces, nodeRowTests[size_t(ny)] += tests;
+                }
+            },
+            tbb::simple_partitioner());
+    };
+    std::fill(surfaceNodeRange.begin(), surfaceNodeRange.end(), -1.0f);
+    TraceNodes(true, Used);
+    // The coarse cells whose four cells all see only the sky through puffs that can matter
+    // there, with no puff smaller than a coarse cell adding more than kInterpolationTolerance
+    // (the sum of the cells' sums, an upper bound), and whose corners are Smooth or match the
+    // coarse centre node's own trace (BlendMatches; the node is traced then, for its pixel).
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, coarseY, 1),
+        [&](const tbb::blocked_range<int>& r) {
+            PlumeScreenBins::List& list = LocalScratch().list;
+            for (int sy = r.begin(); sy != r.end(); ++sy) {
+                uint64_t traces = 0, tests = 0;
+                for (int sx = 0; sx < coarseX; ++sx) {
+                    float small = 0.0f;
+                    bool sky = true;
+                    for (int k = 0; k < 4 && sky; ++k) {
+                        const int cx = 2 * sx + k % 2, cy = 2 * sy + k / 2;
+                        const CellRow& row = cellRows[size_t(cy)];
+                        sky = Used(cx, cy) && row.skyOnly[size_t(cx)] &&
+                              kPlumeSkyRange_m > row.lists.near_m[size_t(cx)] &&
+                              kPlumeSkyRange_m >= row.lists.far_m[size_t(cx)];
+                        if (sky) small += row.lists.twiceSmallOpticalDepth[size_t(cx)];
+                    }
+                    if (!sky || small > kInterpolationTolerance) continue;
+                    const BandTrace* c[4];
+                    float cT[4];
+                    for (int k = 0; k < 4; ++k) {
+                        const size_t n = size_t(2 * sy + k / 2 * 2) * size_t(nodesX) +
+                                         size_t(2 * sx + k % 2 * 2);
+                        c[k] = &nodes[n], cT[k] = nodeT[n];
+                    }
+                    uint8_t& state = coarse[size_t(sy) * size_t(coarseX) + size_t(sx)];
+                    bool clear = false;
+                    if (Smooth(c, cT, false, clear)) {
+                        state = clear ? kCoarseClear : kCoarseBlend;
+                        continue;
+                    }
+                    const int nx = 2 * sx + 1, ny = 2 * sy + 1;
+                    TraceNode(nx, ny, list, traces, tests);
+                    const size_t n = size_t(ny) * size_t(nodesX) + size_t(nx);
+                    if (BlendMatches(plume_detail::Bilinear(c, 0.5f, 0.5f), nodes[n]))
+                        state = kCoarseCentre;
+                }
+                // The centre nodes' rows are odd: each written by its own coarse row only.
+                nodeRowTraces[size_t(2 * sy + 1)] += traces;
+                nodeRowTests[size_t(2 * sy + 1)] += tests;
+            }
+        },
+        tbb::simple_partitioner());
+    TraceNodes(false, Reads);
+
     // Pass 2, cells in parallel (a row of cells each); each pixel depends only on its own rays
     // and the cell's corner nodes. The rows' costs differ by orders of magnitude, so they are
     // handed out costliest first (by the puff entries of their cells that are not skipped,
@@ -843,9 +1023,60 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             const __m128 skyRange = _mm_set1_ps(kPlumeSkyRange_m), minusOne = _mm_set1_ps(-1.0f);
             std::vector<float>& depthRows = local.depthRows;
             depthRows.resize(size_t(rowSamples) * size_t(vis.width));
+            // The pixels of whole cell (cx, cy) blended from corners c span pixels apart, the
+            // cell's pixel (lx, ly) at ((ox + lx) / span, (oy + ly) / span): each with its source
+            // function made on the blend's lanes (BlendedVisibleSources and
+            // BlendedInfraredSources, the bits of Bilinear4 and the one-pixel source functions),
+            // then composited as ApplyCell does; pixel (centreX, centreY) takes its own trace
+            // instead where it has one (centre, else nullptr).
+            const auto BlendCell = [&](int cx, int cy, const BandTrace* const c[4],
+                                       const BandTrace* centre, int centreX, int centreY, int ox,
+                                       int oy, float span) {
+                float fx[kCellPixels], fy[kCellPixels], a[kCellPixels], b[kCellPixels];
+                int px[kCellPixels], py[kCellPixels], n = 0;
+                for (int ly = 0; ly < kCell; ++ly)
+                    for (int lx = 0; lx < kCell; ++lx) {
+                        if (centre && lx == centreX && ly == centreY) continue;
+                        fx[n] = float(ox + lx) / span, fy[n] = float(oy + ly) / span;
+                        px[n] = cx * kCell + lx, py[n] = cy * kCell + ly;
+                        a[n] = colA[size_t(px[n])], b[n] = rowB[size_t(py[n])];
+                        ++n;
+                    }
+                alignas(16) float tau[kCellPixels] = {}, T[kCellPixels];
+                // e^(−τ) four pixels at a time (simd4::Exp4, within 2e-7 relative of std::exp).
+                const auto Transmittances = [&] {
+                    for (int l = 0; l < n; l += 4)
+                        _mm_store_ps(
+                            T + l, simd4::Exp4(_mm_sub_ps(_mm_setzero_ps(), _mm_load_ps(tau + l))));
+                };
+                if (visible) {
+                    glm::vec3 S[kCellPixels];
+                    plume_detail::BlendedVisibleSources(c, fx, fy, a, b, n, worldFromCamera, light,
+                                                        tau, S);
+                    Transmittances();
+                    for (int l = 0; l < n; ++l) {
+                        if (!(tau[l] > 0.0f)) continue;
+                        const float Sl[3] = {S[l].x, S[l].y, S[l].z};
+                        CompositeAll(px[l], py[l], T[l], Sl);
+                    }
+                } else {
+                    float S[kCellPixels];
+                    plume_detail::BlendedInfraredSources(c, fx, fy, n, light, tau, S);
+                    Transmittances();
+                    for (int l = 0; l < n; ++l) {
+                        if (!(tau[l] > 0.0f)) continue;
+                        const float Sl[3] = {S[l], 0.0f, 0.0f};
+                        CompositeAll(px[l], py[l], T[l], Sl);
+                    }
+                }
+                if (centre) {
+                    const int cpx = cx * kCell + centreX, cpy = cy * kCell + centreY;
+                    ApplyCell(centre, &cpx, &cpy, 1);
+                }
+            };
             for (size_t taken; (taken = nextRow.fetch_add(1)) < rowOrder.size();) {
                 const int cy = rowOrder[taken].second;
-                uint64_t covered = 0, traces = 0, tests = 0;
+                uint64_t covered = 0, traces = 0, tests = 0, nodeBlended = 0, coarseCells = 0;
                 const CellRow& row = cellRows[size_t(cy)];
                 const int sy0 = cy * rowSamples;
                 ReadDepths(cy, row, depthRows.data(), local.depthRuns);
@@ -874,6 +1105,28 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                     if (row.inFront[size_t(cx)]) {
                         covered += uint64_t(std::min(W, (cx + 1) * kCell) - cx * kCell) *
                                    uint64_t(std::min(H, (cy + 1) * kCell) - cy * kCell);
+                        continue;
+                    }
+                    // A cell of a smooth coarse cell: its pixels blended from the coarse
+                    // corners (the coarse centre node's pixel, this cell's first when it is the
+                    // coarse cell's last, its own trace where the centre test traced it).
+                    if (InSmoothCoarse(cx, cy)) {
+                        covered += uint64_t(kCellPixels);
+                        const int sx = cx / 2, sy = cy / 2;
+                        const uint8_t state = coarse[size_t(sy) * size_t(coarseX) + size_t(sx)];
+                        ++coarseCells;
+                        if (state == kCoarseClear) continue;
+                        const BandTrace* c[4];
+                        for (int k = 0; k < 4; ++k)
+                            c[k] = &nodes[size_t(2 * sy + k / 2 * 2) * size_t(nodesX) +
+                                          size_t(2 * sx + k % 2 * 2)];
+                        const bool last = cx % 2 == 1 && cy % 2 == 1;
+                        const BandTrace* centre =
+                            state == kCoarseCentre && last
+                                ? &nodes[size_t(cy) * size_t(nodesX) + size_t(cx)]
+                                : nullptr;
+                        BlendCell(cx, cy, c, centre, 0, 0, cx % 2 * kCell, cy % 2 * kCell,
+                                  float(2 * kCell));
                         continue;
                     }
                     // The next cell's radiance, fetched while this one is worked on (its
@@ -1011,29 +1264,32 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                     int surfaces = 0, surfPx[kPixels], surfPy[kPixels];
                     glm::vec3 surfDir[kPixels];
                     float surfRange[kPixels];
-                    // Where every pixel of the cell is such a pixel, no puff smaller than a cell
-                    // reaches it and its ranges have no edge (SmoothRanges), the traces at its four
-                    // corner pixels are blended for the others when the blend matches the own
-                    // traces of two inner pixels (1, 1) and (2, 2) (BlendMatches): the optical
-                    // depth to a smooth surface through puffs wider than the cell is as smooth
-                    // across it as the sky's. Else every pixel is traced.
+                    // Where every pixel of the cell is such a pixel and no puff smaller than a
+                    // cell reaches it, its corners' traces are blended for the others when its
+                    // ranges have no edge (SmoothRanges) and the blend matches the own traces of
+                    // inner pixels (BlendMatches): the optical depth to a smooth surface through
+                    // puffs wider than the cell is as smooth across it as the sky's. The corners
+                    // are first the grid nodes' pixels (surfaceNodes, traced once for the four
+                    // cells around each), checked at the centre pixel as sky cells are; where a
+                    // node's pixel has no surface trace or that test fails, the cell's own corner
+                    // pixels, checked at pixels (1, 1) and (2, 2). Else every pixel is traced.
                     const auto SurfacePixels = [&] {
                         BandTrace own[kPixels];
                         bool traced[kPixels] = {};
                         const auto TraceOwn = [&](int k) {
+                            if (traced[k]) return;
                             Count(1);
                             own[k] = bins.Trace(list, surfDir[k], surfRange[k]);
                             traced[k] = true;
                         };
                         constexpr int kLast = kCell - 1;
                         // No depth edge between the pixels: each range within kDepthEdgeRatio
-                        // of the blend of the corners' (a smooth surface, however oblique).
-                        const auto SmoothRanges = [&] {
-                            const float r[4] = {surfRange[0], surfRange[kLast],
-                                                surfRange[kLast * kCell], surfRange[kPixels - 1]};
+                        // of the blend of the corners' r at (x, y) / span (a smooth surface,
+                        // however oblique).
+                        const auto SmoothRanges = [&](const float r[4], float span) {
                             for (int k = 0; k < kPixels; ++k) {
-                                const float fx = float(k % kCell) / kLast,
-                                            fy = float(k / kCell) / kLast;
+                                const float fx = float(k % kCell) / span,
+                                            fy = float(k / kCell) / span;
                                 const float blend = (1.0f - fy) * ((1.0f - fx) * r[0] + fx * r[1]) +
                                                     fy * ((1.0f - fx) * r[2] + fx * r[3]);
                                 if (!(std::abs(surfRange[k] - blend) <=
@@ -1042,10 +1298,43 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                             }
                             return true;
                         };
+                        constexpr int kCentre = kHalf * kCell + kHalf;
+                        if (surfaces == kPixels && !fine) {
+                            const size_t n00 = size_t(cy) * size_t(nodesX) + size_t(cx);
+                            const size_t n[4] = {n00, n00 + 1, n00 + size_t(nodesX),
+                                                 n00 + size_t(nodesX) + 1};
+                            const float r[4] = {surfaceNodeRange[n[0]], surfaceNodeRange[n[1]],
+                                                surfaceNodeRange[n[2]], surfaceNodeRange[n[3]]};
+                            if (r[0] >= 0.0f && r[1] >= 0.0f && r[2] >= 0.0f && r[3] >= 0.0f &&
+                                SmoothRanges(r, float(kCell))) {
+                                const BandTrace* const c[4] = {
+                                    &surfaceNodes[n[0]], &surfaceNodes[n[1]], &surfaceNodes[n[2]],
+                                    &surfaceNodes[n[3]]};
+                                const float cT[4] = {surfaceNodeT[n[0]], surfaceNodeT[n[1]],
+                                                     surfaceNodeT[n[2]], surfaceNodeT[n[3]]};
+                                bool clear = false;
+                                if (Smooth(c, cT, fine, clear)) {
+                                    ++nodeBlended;
+                                    if (!clear)
+                                        BlendCell(cx, cy, c, nullptr, 0, 0, 0, 0, float(kCell));
+                                    return;
+                                }
+                                TraceOwn(kCentre);
+                                if (BlendMatches(plume_detail::Bilinear(c, 0.5f, 0.5f),
+                                                 own[kCentre])) {
+                                    ++nodeBlended;
+                                    BlendCell(cx, cy, c, &own[kCentre], kHalf, kHalf, 0, 0,
+                                              float(kCell));
+                                    return;
+                                }
+                            }
+                        }
                         const BandTrace* const ends[4] = {&own[0], &own[kLast], &own[kLast * kCell],
                                                           &own[kLast * kCell + kLast]};
                         bool blend = false;
-                        if (surfaces == kPixels && !fine && SmoothRanges()) {
+                        const float r[4] = {surfRange[0], surfRange[kLast],
+                                            surfRange[kLast * kCell], surfRange[kPixels - 1]};
+                        if (surfaces == kPixels && !fine && SmoothRanges(r, float(kLast))) {
                             for (const int k :
                                  {0, kLast, kLast * kCell, kPixels - 1, kCell + 1, 2 * kCell + 2})
                                 TraceOwn(k);
@@ -1077,46 +1366,6 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                         DeferBlended(corner, blendFx, blendFy, blendPx, blendPy, blended);
                         ApplyCell(pendingTrace, pendingPx, pendingPy, pending);
                     };
-                    // The pixels of a whole sky cell that is smooth: each blended from the cell's
-                    // corners (but the centre pixel when the centre test traced it) with its
-                    // source function made on the blend's lanes (BlendedVisibleSources and
-                    // BlendedInfraredSources, the bits of Bilinear4 and the one-pixel source
-                    // functions), then composited as ApplyCell does.
-                    const auto BlendWholeSkyCell = [&] {
-                        float fx[kCellPixels], fy[kCellPixels], a[kCellPixels], b[kCellPixels];
-                        int px[kCellPixels], py[kCellPixels], n = 0;
-                        for (int ly = 0; ly < kCell; ++ly)
-                            for (int lx = 0; lx < kCell; ++lx) {
-                                if (centreTraced && lx == kHalf && ly == kHalf) continue;
-                                fx[n] = float(lx) / kCell, fy[n] = float(ly) / kCell;
-                                px[n] = cx * kCell + lx, py[n] = cy * kCell + ly;
-                                a[n] = colA[size_t(px[n])], b[n] = rowB[size_t(py[n])];
-                                ++n;
-                            }
-                        float tau[kCellPixels];
-                        if (visible) {
-                            glm::vec3 S[kCellPixels];
-                            plume_detail::BlendedVisibleSources(corner, fx, fy, a, b, n,
-                                                                worldFromCamera, light, tau, S);
-                            for (int l = 0; l < n; ++l) {
-                                if (!(tau[l] > 0.0f)) continue;
-                                const float Sl[3] = {S[l].x, S[l].y, S[l].z};
-                                CompositeAll(px[l], py[l], std::exp(-tau[l]), Sl);
-                            }
-                        } else {
-                            float S[kCellPixels];
-                            plume_detail::BlendedInfraredSources(corner, fx, fy, n, light, tau, S);
-                            for (int l = 0; l < n; ++l) {
-                                if (!(tau[l] > 0.0f)) continue;
-                                const float Sl[3] = {S[l], 0.0f, 0.0f};
-                                CompositeAll(px[l], py[l], std::exp(-tau[l]), Sl);
-                            }
-                        }
-                        if (centreTraced) {
-                            const int cpx = cx * kCell + kHalf, cpy = cy * kCell + kHalf;
-                            ApplyCell(&sub[1][1], &cpx, &cpy, 1);
-                        }
-                    };
                     // A whole cell whose every sample sees the sky, clear or smooth (after the
                     // centre test), takes what the loop below would give each of its pixels
                     // (nothing, or the blend of its corners; the centre pixel its own trace),
@@ -1128,7 +1377,8 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                         if (clearSky || smooth) {
                             covered += uint64_t(kCellPixels);
                             if (clearSky) continue;
-                            BlendWholeSkyCell();
+                            BlendCell(cx, cy, corner, centreTraced ? &sub[1][1] : nullptr, kHalf,
+                                      kHalf, 0, 0, float(kCell));
                             continue;
                         }
                     }
@@ -1243,12 +1493,16 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                 }
                 rowCovered[size_t(cy)] = covered;
                 rowTraces[size_t(cy)] += traces, rowTests[size_t(cy)] += tests;
+                rowNodeBlended[size_t(cy)] = nodeBlended;
+                rowCoarse[size_t(cy)] = coarseCells;
             }
         },
         tbb::simple_partitioner());
     for (int y = 0; y < cellsY; ++y) {
         stats.pixelsCovered += rowCovered[size_t(y)];
         stats.traces += rowTraces[size_t(y)];
+        stats.surfaceCellsFromNodes += rowNodeBlended[size_t(y)];
+        stats.coarseSkyCells += rowCoarse[size_t(y)];
         stats.puffTests += rowTests[size_t(y)];
     }
     for (int y = 0; y < nodesY; ++y) {

@@ -114,10 +114,12 @@ void BlendedInfraredSources(const BandTrace* const t[4], const float* fx, const 
 }  // namespace plume_detail
 
 struct PlumeCompositeStats {
-    uint64_t pixelsCovered = 0;  // output pixels inside some plume's screen bounds
-    uint64_t traces = 0;         // rays traced (one per covered pixel, two at depth edges)
-    uint64_t puffTests = 0;      // puffs looked at by those traces (their lists' lengths)
-    double ms = 0.0;             // bounds, traces and compositing
+    uint64_t pixelsCovered = 0;          // output pixels inside some plume's screen bounds
+    uint64_t traces = 0;                 // rays traced (one per covered pixel, two at depth edges)
+    uint64_t puffTests = 0;              // puffs looked at by those traces (their lists' lengths)
+    uint64_t surfaceCellsFromNodes = 0;  // cells of surfaces blended from the nodes' pixels
+    uint64_t coarseSkyCells = 0;         // cells of sky blended from the coarse grid
+    double ms = 0.0;                     // bounds, traces and compositing
 };
 
 // Rays to the sky are traced this far (m).
@@ -137,18 +139,34 @@ inline constexpr float kPlumeSkyRange_m = 1.0e6f;
 //    see absorbing puffs) within 10 K, or the corners' blend at the cell's centre pixel matches
 //    that pixel's own trace within 0.005 and 5 K (a linear variation across the cell); else
 //    refined on 2 × 2-pixel sub-cells by the same corner criteria, and traced through the pixel
-//    centre where those fail;
+//    centre where those fail. First, though, the whole cells of 2 × 2 cells (8 × 8 pixels,
+//    from even cell indices) whose every sample sees the sky beyond their puffs are blended
+//    from the traces at their corners (every other grid node) by the same criteria, with the
+//    sum over the four cells of the puffs smaller than 8 pixels as the fine puffs and the
+//    coarse cell's centre node (its own trace then) as the centre pixel; the nodes that only
+//    such cells read are not traced;
 //  - otherwise one ray through the pixel centre to the nearest surface and, when the ranges
 //    differ by more than 10 %, to the farthest in the same pass; each sample takes the trace
 //    whose end is nearer its own range. In a cell all of whose pixels take one such ray, with
-//    no puff smaller than a cell and no depth edge (every range within 10 % of the bilinear
-//    blend of the corner pixels'), the corner pixels' traces are blended for the others when
-//    the blend matches the own traces of pixels (1, 1) and (2, 2) within 0.005 and 5 K.
-// Samples whose traces have no optical depth are left bit for bit as they were. With
-// renderSpans (one per pixel row; empty: every pixel), a cell none of whose pixels lies in
-// them is skipped as a cell wholly behind surfaces is: the pixels in the spans come out bit
-// for bit as without them, the others of such cells are left alone (an NVG field stop passes
-// no light there). Runs in the caller's oneTBB arena; bit-identical for any thread count.
+//    no puff smaller than a cell, the rays are blended bilinearly instead: first from the
+//    traces of the cell's grid nodes' pixels to their own nearest surfaces (made with the
+//    nodes' sky traces, in the same pass, where a node's pixel lies in the image, its
+//    samples see surfaces within 10 % of each other and its traces to 10 % before and beyond
+//    its surface match within 0.005 and 5 K: no surface inside the puffs that a step in
+//    range the 10 % admit would cut), when there is no depth edge (every
+//    range within 10 % of the bilinear blend of the nodes' pixels') and either those traces'
+//    transmittances agree within 0.02 and their temperatures within 10 K or their blend at the
+//    centre pixel matches that pixel's own trace within 0.005 and 5 K (the centre pixel then
+//    keeps its own); else from the traces of the cell's corner pixels, when every range is
+//    within 10 % of the bilinear blend of theirs and the blend matches the own traces of
+//    pixels (1, 1) and (2, 2) within 0.005 and 5 K.
+// The pixels of whole cells blended from one set of corners take e^(−τ) from simd4::Exp4
+// (within 2e-7 relative), the others from std::exp. Samples whose traces have no optical depth are
+// left bit for bit as they were. With renderSpans (one per pixel row; empty: every pixel), a cell
+// none of whose pixels lies in them is skipped as a cell wholly behind surfaces is: the pixels in
+// the spans come out bit for bit as without them, the others of such cells are left alone (an NVG
+// field stop passes no light there). Runs in the caller's oneTBB arena; bit-identical for any
+// thread count.
 PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const ChannelCamera& camera,
                                     const VisibilityBuffer& vis, const PlumeLighting& light,
                                     Image& radiance, std::span<const PixelSpan> renderSpans = {});

@@ -34,6 +34,7 @@ void ExpectSameList(const PlumeScreenBins::List& a, const PlumeScreenBins::List&
     EXPECT_EQ(std::memcmp(&a.far_m, &b.far_m, 4), 0) << where;
     EXPECT_EQ(std::memcmp(&a.smallOpticalDepth, &b.smallOpticalDepth, 4), 0) << where;
     EXPECT_EQ(std::memcmp(&a.halfSmallOpticalDepth, &b.halfSmallOpticalDepth, 4), 0) << where;
+    EXPECT_EQ(std::memcmp(&a.twiceSmallOpticalDepth, &b.twiceSmallOpticalDepth, 4), 0) << where;
 }
 
 using scene::ObscurantBand;
