@@ -763,8 +763,9 @@ TEST(PlumeComposite, CellsBehindANearSurfaceSkipTheirNodes) {
             // A sky pixel depends only on its samples, its coarse cell's (2 × 2 cells) puffs
             // and samples and the corner nodes: the same bits as with no wall where the coarse
             // cell lies wholly left of it.
-            if (x < kWallStart / 8 * 8)
+            if (x < kWallStart / 8 * 8) {
                 EXPECT_EQ(std::memcmp(image.At(x, y), skyImage.At(x, y), 12), 0) << x << ", " << y;
+            }
             const glm::vec3 d(cam.SampleDirection(x, y));
             double tau = 0.0;
             for (const scene::Puff& p : puffs)
