@@ -30,15 +30,17 @@ uint32_t* Raw(FutexWord& w) {
     return reinterpret_cast<uint32_t*>(static_cast<std::atomic<uint32_t>*>(&w));
 }
 
-// Counts the caller among the word's sleepers for its lifetime. The fence after the increment
-// pairs with the one in WakeAll (Dekker's pattern): either the waker's load of `sleepers` sees
-// this increment and it wakes, or every read of the word, status and counters this waiter
-// makes after the fence sees the waker's change, so a skipped wake-up is never needed.
+// Counts the caller among the word's sleepers for its lifetime. The increment is an acquire
+// read-modify-write that pairs with WakeAll's release one on the same counter (Dekker's pattern
+// without fences, which ThreadSanitizer does not model): the two are ordered in the counter's
+// modification order, so either the waker's reads this increment and it wakes, or this one
+// reads the waker's (or a later decrement in its release sequence) and every read of the word,
+// status and counters this waiter makes after it sees the waker's change, so a skipped wake-up
+// is never needed.
 class SleeperGuard {
   public:
     explicit SleeperGuard(FutexWord& w) : w_(w) {
-        w_.sleepers.fetch_add(1, std::memory_order_relaxed);
-        std::atomic_thread_fence(std::memory_order_seq_cst);
+        w_.sleepers.fetch_add(1, std::memory_order_acq_rel);
     }
     ~SleeperGuard() { w_.sleepers.fetch_sub(1, std::memory_order_relaxed); }
     SleeperGuard(const SleeperGuard&) = delete;
@@ -94,10 +96,10 @@ const char* ToString(WaitResult r) {
 }
 
 void WakeAll(FutexWord& word) {
-    // Orders the caller's change of the word (or of the status) before the read of the
-    // sleeper count; see SleeperGuard.
-    std::atomic_thread_fence(std::memory_order_seq_cst);
-    if (word.sleepers.load(std::memory_order_relaxed) == 0) return;
+    // Reads the sleeper count with a release read-modify-write (adding 0), which publishes the
+    // caller's change of the word (or of the status) to a sleeper whose increment comes after
+    // it; see SleeperGuard.
+    if (word.sleepers.fetch_add(0, std::memory_order_acq_rel) == 0) return;
     ::syscall(SYS_futex, Raw(word), FUTEX_WAKE, INT_MAX, nullptr, nullptr, 0);
 }
 
