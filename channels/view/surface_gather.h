@@ -104,7 +104,7 @@ struct SeaSamples {
 // the attributes clamped to kMaxVertexAttribute first), so the same bits. Most samples of a
 // row are sea, in runs of a few samples per triangle, so this is the shading pass's inner
 // loop: the sea mesh is known (no search for the mesh) and a run's samples are interpolated a
-// lane group at a time from its triangle's vertex components, broadcast once per triangle.
+// lane group at a time from its triangle's vertex components (each broadcast to the lanes).
 class SeaGather {
   public:
     // sea: mesh 0 of the visibility buffer, its primitives [seaBase, seaBase + seaPrimitives).
@@ -163,14 +163,8 @@ class SeaGather {
             const VF w0 = 1.0f - u - v;
             const auto Sum = [&](VF c0, VF c1, VF c2) { return (w0 * c0 + u * c1) + v * c2; };
             const auto B = [](const float* c) { return simd::Broadcast(*c); };
-            // _mm_min_ps(a, top) as TriangleCache's clamp (top where a is NaN).
-            const auto Clamped = [&](const float* c) {
-#if defined(__AVX__)
-                return VF(_mm256_min_ps(B(c), top));
-#else
-                return VF(_mm_min_ps(B(c), top));
-#endif
-            };
+            // min(a, top) as TriangleCache's _mm_min_ps(a, top): top where a is NaN.
+            const auto Clamped = [&](const float* c) { return simd::Min(top, B(c)); };
             for (int c = 0; c < 3; ++c) {
                 simd::Store(out.c[kSeaPx + c] + r, Sum(B(p0 + c), B(p1 + c), B(p2 + c)));
                 simd::Store(out.c[kSeaNx + c] + r, Sum(B(n0 + c), B(n1 + c), B(n2 + c)));
