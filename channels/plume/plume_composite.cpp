@@ -61,6 +61,17 @@ enum : uint8_t { kCoarseNone, kCoarseClear, kCoarseBlend, kCoarseCentre };
 // A pixel whose samples' surface ranges differ by more than this ratio traces a second ray.
 constexpr float kDepthEdgeRatio = 1.1f;
 
+// Whether a visibility-buffer sample sees the sky: no primitive, or no depth in front.
+inline bool SkySample(uint32_t primitive, float depth) {
+    return (primitive == kNoPrimitive) | (depth <= 0.0f);
+}
+// SkySample of the four samples at primitive[0 … 3], depth[0 … 3], as an SSE2 lane mask.
+inline __m128 SkySamples4(const uint32_t* primitive, const float* depth) {
+    const __m128i p = _mm_loadu_si128(reinterpret_cast<const __m128i*>(primitive));
+    return _mm_or_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(p, _mm_set1_epi32(int32_t(kNoPrimitive)))),
+                     _mm_cmple_ps(_mm_loadu_ps(depth), _mm_setzero_ps()));
+}
+
 // Absorption-weighted emission of the trace's puffs in band b: the hot (flame) part and the
 // rest each at their own mean temperature. emit(T) is the band's blackbody radiance.
 template <class Emission>
@@ -566,8 +577,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             else
                 runs.emplace_back(sx0, sx1);
         }
-        const __m128 zero = _mm_setzero_ps(), skyDepth = _mm_set1_ps(-1.0f);
-        const __m128i none = _mm_set1_epi32(int32_t(kNoPrimitive));
+        const __m128 skyDepth = _mm_set1_ps(-1.0f);
         for (int j = 0; j < std::min(rowSamples, vis.height - sy0); ++j) {
             const size_t idx0 = vis.Index(0, sy0 + j);
             const float* depth = vis.depth.data() + idx0;
@@ -577,17 +587,12 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                 int sx = sx0;
                 for (; sx + 4 <= sx1; sx += 4) {
                     const __m128 d = _mm_loadu_ps(depth + sx);
-                    const __m128i p =
-                        _mm_loadu_si128(reinterpret_cast<const __m128i*>(primitive + sx));
-                    const __m128 sky = _mm_or_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(p, none)),
-                                                 _mm_cmple_ps(d, zero));
+                    const __m128 sky = SkySamples4(primitive + sx, depth + sx);
                     _mm_storeu_ps(o + sx,
                                   _mm_or_ps(_mm_and_ps(sky, skyDepth), _mm_andnot_ps(sky, d)));
                 }
                 for (; sx < sx1; ++sx) {
-                    const float d = depth[sx];
-                    const bool sky = (primitive[sx] == kNoPrimitive) | (d <= 0.0f);
-                    o[sx] = sky ? -1.0f : d;
+                    o[sx] = SkySample(primitive[sx], depth[sx]) ? -1.0f : depth[sx];
                 }
             }
         }
@@ -598,9 +603,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
         const int rowSamples = kCell * N, sy0 = cy * rowSamples, sx0 = cx * rowSamples;
         const int sx1 = std::min(sx0 + rowSamples, vis.width);
         // Four samples at a time (SSE2), the same test per lane, one branch per row.
-        const __m128 leastV = _mm_set1_ps(least), zero = _mm_setzero_ps();
-        const __m128 skyDepth = _mm_set1_ps(-1.0f);
-        const __m128i none = _mm_set1_epi32(int32_t(kNoPrimitive));
+        const __m128 leastV = _mm_set1_ps(least), skyDepth = _mm_set1_ps(-1.0f);
         for (int j = 0; j < std::min(rowSamples, vis.height - sy0); ++j) {
             const size_t idx0 = vis.Index(0, sy0 + j);
             const float* depth = vis.depth.data() + idx0;
@@ -609,17 +612,14 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             __m128 ok = _mm_castsi128_ps(_mm_set1_epi32(-1));
             for (; sx + 4 <= sx1; sx += 4) {
                 const __m128 d = _mm_loadu_ps(depth + sx);
-                const __m128i p = _mm_loadu_si128(reinterpret_cast<const __m128i*>(primitive + sx));
-                const __m128 sky =
-                    _mm_or_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(p, none)), _mm_cmple_ps(d, zero));
+                const __m128 sky = SkySamples4(primitive + sx, depth + sx);
                 const __m128 v = _mm_or_ps(_mm_and_ps(sky, skyDepth), _mm_andnot_ps(sky, d));
                 ok = _mm_and_ps(ok, _mm_cmpge_ps(v, leastV));
             }
             if (_mm_movemask_ps(ok) != 0xf) return false;
             for (; sx < sx1; ++sx) {
-                const float d = depth[sx];
-                const bool sky = (primitive[sx] == kNoPrimitive) | (d <= 0.0f);
-                if (!((sky ? -1.0f : d) >= least)) return false;
+                if (!((SkySample(primitive[sx], depth[sx]) ? -1.0f : depth[sx]) >= least))
+                    return false;
             }
         }
         return true;
@@ -629,8 +629,6 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     const auto SkyOnly = [&](int cx, int cy) {
         if ((cx + 1) * kCell > W || (cy + 1) * kCell > H) return false;
         const int rowSamples = kCell * N;
-        const __m128 zero = _mm_setzero_ps();
-        const __m128i none = _mm_set1_epi32(int32_t(kNoPrimitive));
         __m128 sky = _mm_castsi128_ps(_mm_set1_epi32(-1));
         bool rest = true;
         for (int j = 0; j < rowSamples; ++j) {
@@ -638,12 +636,9 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             const float* depth = vis.depth.data() + idx0;
             const uint32_t* primitive = vis.primitive.data() + idx0;
             int i = 0;
-            for (; i + 4 <= rowSamples; i += 4) {
-                const __m128i p = _mm_loadu_si128(reinterpret_cast<const __m128i*>(primitive + i));
-                sky = _mm_and_ps(sky, _mm_or_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(p, none)),
-                                                _mm_cmple_ps(_mm_loadu_ps(depth + i), zero)));
-            }
-            for (; i < rowSamples; ++i) rest &= (primitive[i] == kNoPrimitive) | (depth[i] <= 0.0f);
+            for (; i + 4 <= rowSamples; i += 4)
+                sky = _mm_and_ps(sky, SkySamples4(primitive + i, depth + i));
+            for (; i < rowSamples; ++i) rest &= SkySample(primitive[i], depth[i]);
         }
         return rest && _mm_movemask_ps(sky) == 0xf;
     };
@@ -793,7 +788,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             for (int i = 0; i < N; ++i) {
                 const size_t idx = vis.Index(px * N + i, py * N + j);
                 const float d = vis.depth[idx];
-                const bool sky = (vis.primitive[idx] == kNoPrimitive) | (d <= 0.0f);
+                const bool sky = SkySample(vis.primitive[idx], d);
                 const float r = sky ? kPlumeSkyRange_m : std::min(rangeScale / d, kPlumeSkyRange_m);
                 rMin = std::min(rMin, r), rMax = std::max(rMax, r);
             }
