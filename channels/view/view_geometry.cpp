@@ -165,7 +165,7 @@ double NearestVisibleSeaRange_m(const ChannelCamera& cam, double crestHeight_m,
 }
 
 double NearestVisibleSeaRange_m(const ChannelCamera& cam, const scene::OceanSurfaceFrame& sea,
-                                const glm::dvec3& eye_m) {
+                                const glm::dvec3& eye_m, double meshAngularStep_rad) {
     // A radius r is a safe nearest range when the range found from the bounds over the disc of
     // radius r is at least r (every rest position within r is then drawn below the view), and so
     // is that range when it is at most r (the disc holds it). The range from the bounds over a
@@ -175,7 +175,13 @@ double NearestVisibleSeaRange_m(const ChannelCamera& cam, const scene::OceanSurf
     // there, which puts the range of a 2 m eye several metres further out than the whole sea's
     // highest crest does (configs/five-channel.yaml's flir: 1.3 m → 5–7 m).
     const auto rangeFrom = [&](double radius_m) {
-        const scene::SurfaceBounds b = sea.LocalBoundsNear(eye_m.x, eye_m.y, radius_m);
+        const double maxFootprint_m =
+            std::isfinite(meshAngularStep_rad)
+                ? scene::OceanMeshFootprintBound_m(radius_m, eye_m.z, sea.SignificantHeight_m(),
+                                                   meshAngularStep_rad)
+                : std::numeric_limits<double>::infinity();
+        const scene::SurfaceBounds b =
+            sea.LocalBoundsNear(eye_m.x, eye_m.y, radius_m, maxFootprint_m);
         return NearestVisibleSeaRange_m(cam, b.height_m, b.horizontal_m);
     };
     const double r0 = rangeFrom(0.0);
@@ -205,7 +211,7 @@ scene::OceanMeshRequest SeaMeshRequest(const ChannelCamera& cam,
     else
         SpansAzimuthSector(cam, renderSpans, req.azimuthMin_rad, req.azimuthMax_rad);
     req.widenByReach = true;
-    req.minRange_m = NearestVisibleSeaRange_m(cam, sea, req.eye_m);
+    req.minRange_m = NearestVisibleSeaRange_m(cam, sea, req.eye_m, req.angularStep_rad);
     // The rings near the eye are seen no steeper than the lowest view ray: its depression's
     // tangent rounded up to a step of 2^(1/8) (9 %), so that a view that pitches and rolls a
     // little (an eyepoint on a ship) keeps the same near rings, which would otherwise move.

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <span>
 #include <vector>
@@ -103,9 +104,12 @@ double SteepestViewDirectionZ(const ChannelCamera& camera);
 double NearestVisibleSeaRange_m(const ChannelCamera& camera, double crestHeight_m,
                                 double horizontalReach_m);
 // The same for the sea of a frame seen from eye_m: the crest and reach bounds taken over the
-// disc of sea near the eye (OceanSurfaceFrame::BoundsNear) rather than the whole surface.
-double NearestVisibleSeaRange_m(const ChannelCamera& camera, const scene::OceanSurfaceFrame& sea,
-                                const glm::dvec3& eye_m);
+// disc of sea near the eye (OceanSurfaceFrame::LocalBoundsNear) rather than the whole surface.
+// With the sea mesh's angular step, for the rings of that mesh (their footprints bounded by
+// scene::OceanMeshFootprintBound_m), which bounds the Gerstner waves signed (their troughs).
+double NearestVisibleSeaRange_m(
+    const ChannelCamera& camera, const scene::OceanSurfaceFrame& sea, const glm::dvec3& eye_m,
+    double meshAngularStep_rad = std::numeric_limits<double>::infinity());
 
 // The sea mesh a channel asks for (ViewGeometry, and the mesh benchmarks): vertices 6 pixels
 // apart on screen, the camera's own azimuth sector (that of renderSpans when given, one per

@@ -3,6 +3,7 @@
 #include "scene/ocean/gerstner.h"
 
 #include <cmath>
+#include <limits>
 
 #include "scene/core/check.h"
 
@@ -144,7 +145,15 @@ SurfaceTerms GerstnerOcean::Terms(double x0, double y0, double t, double footpri
 }
 
 double GerstnerOcean::MaxElevationNear_m(double x, double y, double radius_m, double t) const {
-    CHECK(radius_m >= 0.0);
+    return ElevationBoundNear_m(x, y, radius_m, t, std::numeric_limits<double>::infinity());
+}
+
+double GerstnerOcean::ElevationBoundNear_m(double x, double y, double radius_m, double t,
+                                           double maxFootprint_m) const {
+    CHECK(radius_m >= 0.0 && maxFootprint_m >= 0.0);
+    // The mesh forms its weights in float (LocalFrame::FootprintWeights): a margin far above
+    // their rounding.
+    constexpr double kWeightMargin = 1e-5;
     double bound = 0.0;
     for (size_t i = 0; i < k_.size(); ++i) {
         // The rest positions within the disc have phases within k r of the centre's (|d| = 1).
@@ -156,7 +165,15 @@ double GerstnerOcean::MaxElevationNear_m(double x, double y, double radius_m, do
         // positive part.
         const double c =
             std::abs(centre) <= half ? 1.0 : std::cos(std::max(std::abs(centre) - half, 0.0));
-        bound += amplitude_[i] * std::max(c, 0.0);
+        if (c >= 0.0) {
+            bound += amplitude_[i] * c;
+        } else if (std::isfinite(maxFootprint_m)) {
+            // The weight falls as the footprint grows; 1 for a footprint of 0.
+            const double w = maxFootprint_m > 0.0
+                                 ? GerstnerFootprintWeight(k_[i], maxFootprint_m) - kWeightMargin
+                                 : 1.0 - kWeightMargin;
+            if (w > 0.0) bound += w * amplitude_[i] * c;
+        }
     }
     return std::min(bound, maxAmplitude_m_);
 }

@@ -95,6 +95,12 @@ class GerstnerOcean {
     // phase interval θ_i(centre) ± (k_i radius + kPhaseMargin_rad) that the disc spans. Never
     // above MaxAmplitude_m().
     double MaxElevationNear_m(double x, double y, double radius_m, double t_s) const;
+    // The same for footprint weights of at least GerstnerFootprintWeight(k_i, maxFootprint_m)
+    // (the weights of a mesh whose rings there have footprints ≤ maxFootprint_m; ∞: any), and
+    // signed: a wave whose largest cos θ_i over the interval is negative adds its smallest
+    // weight times A_i cos θ_i. Below 0 where the waves' troughs cover the disc.
+    double ElevationBoundNear_m(double x, double y, double radius_m, double t_s,
+                                double maxFootprint_m) const;
     // Phase slack of MaxElevationNear_m: far above the float rounding of LocalFrame's phases
     // (~1e-4 rad, see LocalFrame), so that the bound also holds for the float mesh path.
     static constexpr double kPhaseMargin_rad = 1e-2;

@@ -90,6 +90,14 @@ std::vector<double> OceanMeshRadii(double eyeHeight_m, double significantHeight_
     return radii;
 }
 
+double OceanMeshFootprintBound_m(double radius_m, double eyeHeight_m, double significantHeight_m,
+                                 double angularStep_rad) {
+    // (+ 1 mm: OceanMeshRadii's smallest step.)
+    return std::max(8.0 * radius_m, TroughDepth_m(eyeHeight_m, significantHeight_m)) *
+               angularStep_rad +
+           1e-3;
+}
+
 std::vector<double> ThinnedOceanMeshRadii(const std::vector<double>& radii, double eyeHeight_m,
                                           double significantHeight_m, double dphi,
                                           double maxDepressionTan) {
@@ -196,9 +204,16 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
         std::vector<double> discR, discReach;
         for (double R = 1.0; R < 5000.0; R *= 2.0) {
             discR.push_back(R);
+            // (The rings within R have footprints of at most OceanMeshFootprintBound_m: the
+            // cascades' bound then takes only the mip levels those read.)
             discReach.push_back(
-                R <= 64.0 ? frame.LocalBoundsNear(req.eye_m.x, req.eye_m.y, R).horizontal_m
-                          : frame.BoundsNear(req.eye_m.x, req.eye_m.y, R).horizontal_m);
+                R <= 64.0
+                    ? frame
+                          .LocalBoundsNear(req.eye_m.x, req.eye_m.y, R,
+                                           OceanMeshFootprintBound_m(
+                                               R, req.eye_m.z, frame.SignificantHeight_m(), dphi))
+                          .horizontal_m
+                    : frame.BoundsNear(req.eye_m.x, req.eye_m.y, R).horizontal_m);
         }
         discR.push_back(std::numeric_limits<double>::infinity());
         discReach.push_back(frame.MaxHorizontal_m());

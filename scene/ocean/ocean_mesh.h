@@ -112,6 +112,14 @@ std::vector<double> ThinnedOceanMeshRadii(const std::vector<double>& radii, doub
                                           double significantHeight_m, double dphi,
                                           double maxDepressionTan);
 
+// An upper bound (m) of the footprint (OceanMesh::footprint_m) of every ring within radius_m of
+// the eye, for an eye height, the waves' significant height and an angular step: a ring's
+// footprint is its tangential spacing r·dphi or a radial spacing to a neighbour, which
+// OceanMeshRadii caps at max(8 r, trough depth)·dphi (thinning keeps that cap), dphi ≤ the step.
+// For OceanSurfaceFrame::LocalBoundsNear over discs about the eye.
+double OceanMeshFootprintBound_m(double radius_m, double eyeHeight_m, double significantHeight_m,
+                                 double angularStep_rad);
+
 // Builds the mesh for one view from a surface frame (see ocean_mesh.cpp for the choice of a
 // polar grid). Parallel over rings with oneTBB; bit-identical for any thread count.
 void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& request,

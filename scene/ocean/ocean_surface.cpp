@@ -540,11 +540,29 @@ SurfaceBounds OceanSurfaceFrame::BoundsNear(double x, double y, double radius_m)
     return {std::max({tide + b.height_m, zBed, 0.0}), b.horizontal_m};
 }
 
-SurfWaves::Bound OceanSurfaceFrame::CascadeBoundNear(size_t c, double x, double y,
-                                                     double radius_m) const {
+void OceanSurfaceFrame::FilterLevels(size_t c, double minFootprint_m, double maxFootprint_m,
+                                     int& first, int& last) const {
     const CascadeTexture& t = textures_[c];
+    // Filter's level(f) is the whole part of its float level of detail, which grows with f: the
+    // range's ends taken 0.1 % further out (for log2f's rounding), and level(max) + 1.
+    const int top = int(t.levels.size()) - 1;
+    const auto levelOf = [&](double footprint_m) {
+        const float f = float(footprint_m);
+        const float lod = f > float(t.texel_m) ? std::log2(f / float(t.texel_m)) : 0.0f;
+        return int(std::min(lod, float(top)));
+    };
+    first = levelOf(minFootprint_m / 1.001);
+    last = std::isfinite(maxFootprint_m) ? std::min(levelOf(maxFootprint_m * 1.001) + 1, top) : top;
+}
+
+SurfWaves::Bound OceanSurfaceFrame::CascadeBoundNear(size_t c, double x, double y, double radius_m,
+                                                     double minFootprint_m,
+                                                     double maxFootprint_m) const {
+    const CascadeTexture& t = textures_[c];
+    int first = 0, last = 0;
+    FilterLevels(c, minFootprint_m, maxFootprint_m, first, last);
     SurfWaves::Bound b;
-    for (size_t level = 0; level < t.levels.size(); ++level) {
+    for (size_t level = size_t(first); level <= size_t(last); ++level) {
         // AddBilinear at rest position x0 reads texels floor(u) and floor(u) + 1 of the level,
         // u = ((x0 + Δ/2) / Δ) 2^−l − ½, which grows with x0: the disc's bounding box reads
         // those from its low edge to its high edge, one more on each side for rounding.
@@ -581,13 +599,16 @@ SurfWaves::Bound OceanSurfaceFrame::CascadeBoundNear(size_t c, double x, double 
     return b;
 }
 
-SurfaceBounds OceanSurfaceFrame::LocalBoundsNear(double x, double y, double radius_m) const {
-    CHECK(radius_m >= 0.0);
+SurfaceBounds OceanSurfaceFrame::LocalBoundsNear(double x, double y, double radius_m,
+                                                 double maxFootprint_m,
+                                                 double minFootprint_m) const {
+    CHECK(radius_m >= 0.0 && minFootprint_m >= 0.0 && maxFootprint_m >= minFootprint_m);
     const SurfaceBounds global = BoundsNear(x, y, radius_m);
     std::vector<SurfWaves::Bound> cascades(textures_.size());
-    for (size_t c = 0; c < textures_.size(); ++c) cascades[c] = CascadeBoundNear(c, x, y, radius_m);
+    for (size_t c = 0; c < textures_.size(); ++c)
+        cascades[c] = CascadeBoundNear(c, x, y, radius_m, minFootprint_m, maxFootprint_m);
     SurfWaves::Bound gerstner = GerstnerBound();
-    gerstner.height_m = gerstner_.MaxElevationNear_m(x, y, radius_m, t_s_);
+    gerstner.height_m = gerstner_.ElevationBoundNear_m(x, y, radius_m, t_s_, maxFootprint_m);
     SurfaceBounds local;
     if (!surf_) {
         local.height_m = gerstner.height_m, local.horizontal_m = gerstner.horizontal_m;

@@ -166,11 +166,22 @@ class OceanSurfaceFrame {
     // surface: each FFT cascade bounded by the highest texel (and the longest horizontal
     // displacement) that a lookup within the disc can read at any mip level, the Gerstner
     // waves' elevation by GerstnerOcean::MaxElevationNear_m; the surf zone and the seabed as in
-    // BoundsNear. Never above BoundsNear; the height includes kLocalBoundMargin_m.
-    SurfaceBounds LocalBoundsNear(double x, double y, double radius_m) const;
+    // BoundsNear. Never above BoundsNear; the height includes kLocalBoundMargin_m. With
+    // maxFootprint_m, for the points of a mesh whose rings there have footprints of at most
+    // maxFootprint_m: the Gerstner waves' footprint weights are then bounded from below, and
+    // their elevation signed (GerstnerOcean::ElevationBoundNear_m), following their troughs.
+    // With minFootprint_m too, the FFT cascades are bounded over the mip levels such footprints
+    // read (see Filter) rather than all.
+    SurfaceBounds LocalBoundsNear(double x, double y, double radius_m,
+                                  double maxFootprint_m = std::numeric_limits<double>::infinity(),
+                                  double minFootprint_m = 0.0) const;
     // Added to LocalBoundsNear's height and reach: the float rounding of the mesh's sums (a few
     // ulp of metres) far below it.
     static constexpr double kLocalBoundMargin_m = 1e-3;
+    // The mip levels [first, last] of cascade c that Filter's lookups read for every footprint
+    // in [minFootprint_m, maxFootprint_m] (each reads level[c] and level[c] + 1).
+    void FilterLevels(size_t c, double minFootprint_m, double maxFootprint_m, int& first,
+                      int& last) const;
     // Significant wave height of the sea (time-independent; for mesh spacing choices), m.
     double SignificantHeight_m() const { return significantHeight_m_; }
 
@@ -188,8 +199,10 @@ class OceanSurfaceFrame {
         std::vector<std::vector<Texel>> levels;
     };
     void BuildTextures();
-    // Cascade c's bound over the lookups at rest positions within radius_m of (x, y).
-    SurfWaves::Bound CascadeBoundNear(size_t c, double x, double y, double radius_m) const;
+    // Cascade c's bound over the lookups at rest positions within radius_m of (x, y) by
+    // footprints in [minFootprint_m, maxFootprint_m] (the levels FilterLevels gives).
+    SurfWaves::Bound CascadeBoundNear(size_t c, double x, double y, double radius_m,
+                                      double minFootprint_m, double maxFootprint_m) const;
     SurfWaves::Bound GerstnerBound() const;
     // OpenSeaFrom_m for the frame's bounds (surfBounds_ made).
     double OpenSeaFrom(const SurfWaves& surf) const;

@@ -589,6 +589,7 @@ SurfWaves::IntervalParts SurfWaves::Parts(int i, double surfDepth_m) const {
     const SurfWeights wDeep = Weights(h1), wSurf = Weights(surfDepth_m);
     IntervalParts parts;
     parts.deep = wDeep;
+    parts.gerstnerShallow = wSurf.gerstner;
     double amplitude = 0.0, orbit = 0.0, longest = 0.0;
     for (size_t m = 0; m < n; ++m) {
         const DepthSample& s0 = depth_[size_t(i) * n + m];
@@ -624,7 +625,8 @@ SurfWaves::Bound SurfWaves::IntervalBound(int i, double surfDepth_m,
     }
     const IntervalParts& parts = *p;
     Bound b;
-    b.height_m = parts.deep.gerstner * gerstner.height_m;
+    b.height_m =
+        (gerstner.height_m < 0.0 ? parts.gerstnerShallow : parts.deep.gerstner) * gerstner.height_m;
     b.horizontal_m = parts.deep.gerstner * gerstner.horizontal_m;
     for (size_t c = 0; c < cascades.size(); ++c) {
         const double w = cascades_.empty() ? 1.0 : parts.deep.cascade[c];
@@ -644,8 +646,16 @@ SurfWaves::Bound SurfWaves::BoundAtDepths(double minDepth_m, const std::vector<B
     // A point at depth h in interval i (h0 ≤ h ≤ h1) has deep weights at most interval i's (at
     // h1) and surf weights at most those at max(h0, minDepth): every interval the depths
     // [minDepth, maxDepth] meet, and the deep sea where they reach the deepest fade.
+    // (A signed Gerstner bound can make every interval's height negative: their maximum then
+    // starts from −∞ rather than 0.)
     Bound out = maxDepth_m >= fadeDeep_m_ ? DeepBound(cascades, gerstner) : Bound{};
-    for (int i = 0; i + 1 < depthSamples_; ++i) {
+    if (gerstner.height_m < 0.0 && maxDepth_m < fadeDeep_m_)
+        out.height_m = -std::numeric_limits<double>::infinity();
+    // From a little before the first interval with h1 ≥ minDepth (the loop skips the rest).
+    int first = 0;
+    if (minDepth_m > 0.0)
+        first = int(std::clamp(std::floor(minDepth_m / dh_m_) - 2.0, 0.0, double(depthSamples_)));
+    for (int i = first; i + 1 < depthSamples_; ++i) {
         const double h0 = i * dh_m_, h1 = (i + 1) * dh_m_;
         if (h1 < minDepth_m) continue;
         if (h0 >= fadeDeep_m_ || h0 > maxDepth_m) break;

@@ -173,7 +173,9 @@ class SurfWaves {
     // surfCap, when given, caps the surf components' height and horizontal excursion in every
     // interval (e.g. BoundNear's bounds for the points in question), and maxDepth_m bounds the
     // depths from above (no interval deeper, and the deep sea's own bound only if it reaches
-    // FadeDeep_m).
+    // FadeDeep_m). The Gerstner height may be negative (a signed bound, as from
+    // GerstnerOcean::ElevationBoundNear_m): an interval then weights it with the smallest deep
+    // weight its depths have (the weight at its shallow end), not the largest.
     Bound BoundAtDepths(double minDepth_m, const std::vector<Bound>& cascades,
                         const Bound& gerstner, const Bound& surfCap = kNoCap,
                         double maxDepth_m = std::numeric_limits<double>::infinity()) const;
@@ -261,6 +263,8 @@ class SurfWaves {
     // height and horizontal excursion, and the swash's maximum where it reaches (else 0).
     struct IntervalParts {
         SurfWeights deep;
+        // The Gerstner waves' deep weight at the interval's surf depth: the smallest on it.
+        double gerstnerShallow = 0.0;
         double surfHeight_m = 0.0, swash_m = 0.0, surfHorizontal_m = 0.0;
     };
     IntervalParts Parts(int i, double surfDepth_m) const;

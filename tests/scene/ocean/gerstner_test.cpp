@@ -21,6 +21,18 @@ OceanSettings OneWave(double wavelength, double amplitude, double steepness, dou
     return s;
 }
 
+// s with a second, shorter wave crossing it (23 m, 0.2 m).
+OceanSettings WithShortWave(OceanSettings s) {
+    GerstnerWaveSettings w;
+    w.direction_rad = 2.0;
+    w.wavelength_m = 23.0;
+    w.amplitude_m = 0.2;
+    w.steepness = 0.3;
+    w.phase_rad = 0.7;
+    s.waves.push_back(w);
+    return s;
+}
+
 // Position of the crest nearest x_guess along a wave travelling east (+x), by golden-section
 // search on the drawn height.
 double CrestX(const GerstnerOcean& o, double xGuess, double halfWidth, double t) {
@@ -41,14 +53,7 @@ double CrestX(const GerstnerOcean& o, double xGuess, double halfWidth, double t)
 // below the amplitude where no crest lies in the disc.
 TEST(Gerstner, ElevationNearADiscBoundsEveryPointInIt) {
     const OceanSettings one = OneWave(60.0, 0.5, 0.6, 30.0, 20.0);
-    OceanSettings two = one;
-    GerstnerWaveSettings w;
-    w.direction_rad = 2.0;
-    w.wavelength_m = 23.0;
-    w.amplitude_m = 0.2;
-    w.steepness = 0.3;
-    w.phase_rad = 0.7;
-    two.waves.push_back(w);
+    const OceanSettings two = WithShortWave(one);
     for (const OceanSettings& s : {one, two}) {
         const GerstnerOcean o(s);
         int below = 0;
@@ -75,6 +80,49 @@ TEST(Gerstner, ElevationNearADiscBoundsEveryPointInIt) {
         }
         if (s.waves.size() == 1) {
             EXPECT_GT(below, 20);
+        }
+    }
+}
+
+// The signed bound for a mesh's footprints holds at every rest position sampled in the disc for
+// every footprint up to the largest (Terms' footprint weights), and follows the troughs: with
+// one wave it is the sampled maximum (but for the phase margin) also where that is negative, and
+// negative where the disc lies in a trough. With no footprint given it is MaxElevationNear_m.
+TEST(Gerstner, SignedElevationBoundHoldsForEveryFootprintUpToTheLargest) {
+    const OceanSettings one = OneWave(60.0, 0.5, 0.6, 30.0, 20.0);
+    const OceanSettings two = WithShortWave(one);
+    for (const OceanSettings& s : {one, two}) {
+        const GerstnerOcean o(s);
+        int negative = 0;
+        for (int f = 0; f < 40; ++f) {
+            const double t = 0.91 * f, cx = 13.0 * f - 200.0, cy = 7.0 * f;
+            for (const double r : {0.0, 0.5, 2.0, 8.0}) {
+                EXPECT_EQ(o.ElevationBoundNear_m(cx, cy, r, t, INFINITY),
+                          o.MaxElevationNear_m(cx, cy, r, t));
+                // 8 m footprints weight the 23 m wave by 3.14 / (k 8) − 1 ≈ 0.44.
+                for (const double maxFootprint : {0.0, 2.0, 8.0}) {
+                    const double bound = o.ElevationBoundNear_m(cx, cy, r, t, maxFootprint);
+                    EXPECT_LE(bound, o.MaxElevationNear_m(cx, cy, r, t));
+                    double highest = -1.0;
+                    for (int i = 0; i <= 20; ++i)
+                        for (int j = 0; j < (i == 0 ? 1 : 72); ++j) {
+                            const double rho = r * i / 20.0, a = 2.0 * M_PI * j / 72.0;
+                            const double x = cx + rho * std::cos(a), y = cy + rho * std::sin(a);
+                            for (const double fp : {0.0, 0.5 * maxFootprint, maxFootprint}) {
+                                const double z = o.Terms(x, y, t, fp).displacement.z;
+                                highest = std::max(highest, z);
+                                EXPECT_LE(z, bound + 1e-12) << f << " " << r << " " << fp;
+                            }
+                        }
+                    if (s.waves.size() == 1) {
+                        EXPECT_LE(bound, highest + 0.006) << f << " " << r;
+                        if (bound < -0.1) ++negative;
+                    }
+                }
+            }
+        }
+        if (s.waves.size() == 1) {
+            EXPECT_GT(negative, 40);
         }
     }
 }

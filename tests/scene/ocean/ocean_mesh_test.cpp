@@ -408,6 +408,72 @@ TEST(OceanMesh, LocalBoundsHoldAtEveryVertexDrawnFromTheDisc) {
     }
 }
 
+// Rest position of mesh vertex v on ring j.
+glm::dvec2 RestPosition(const OceanMesh& m, const glm::dvec3& eye, int j, uint32_t v) {
+    const int64_t column = m.ringFirstColumn[size_t(j)] +
+                           int64_t(v - m.ringStart[size_t(j)]) * m.ringStride[size_t(j)];
+    const double az = 2.0 * kPi * double(column) / m.circleSegments, r = m.radii_m[size_t(j)];
+    return {eye.x + r * std::sin(az), eye.y + r * std::cos(az)};
+}
+
+// The bounds over small discs for the footprints of the rings there (signed Gerstner waves,
+// the cascades' levels those footprints read) hold at every vertex of those rings drawn from
+// the disc, and follow the troughs: well below the bounds for any footprint on many discs.
+TEST(OceanMesh, FootprintBoundsHoldAtEveryVertexOfTheirRings) {
+    for (const bool surf : {false, true}) {
+        const OceanSurface sea(surf ? WithSurf(Beaufort5()) : Beaufort5());
+        int vertices = 0, discs = 0, lower = 0;
+        for (int f = 0; f < 8; ++f) {
+            const auto frame = sea.At(1.37 * f);
+            for (const double cx : {60.0, 120.0, 260.0}) {
+                const glm::dvec3 eye(cx, 40.0 * f, 2.0);
+                OceanMeshRequest req = View(eye, 0.0, kPi);
+                req.angularStep_rad = 0.02;
+                OceanMesh m;
+                BuildOceanMesh(*frame, req, m);
+                for (int jc = 1; jc < m.rings && m.radii_m[size_t(jc)] < 40.0; jc += 11) {
+                    for (uint32_t vc = m.ringStart[size_t(jc)]; vc < m.ringStart[size_t(jc) + 1];
+                         vc += 17) {
+                        const glm::dvec2 c = RestPosition(m, eye, jc, vc);
+                        for (const double rho : {0.3, 1.2}) {
+                            const double rc = glm::length(c - glm::dvec2(eye));
+                            float minFp = INFINITY, maxFp = 0.0f;
+                            for (int j = 0; j < m.rings; ++j)
+                                if (std::abs(m.radii_m[size_t(j)] - rc) <= rho) {
+                                    minFp = std::min(minFp, m.footprint_m[size_t(j)]);
+                                    maxFp = std::max(maxFp, m.footprint_m[size_t(j)]);
+                                }
+                            const SurfaceBounds b =
+                                frame->LocalBoundsNear(c.x, c.y, rho, maxFp, minFp);
+                            const SurfaceBounds any = frame->LocalBoundsNear(c.x, c.y, rho);
+                            EXPECT_LE(b.height_m, any.height_m);
+                            EXPECT_LE(b.horizontal_m, any.horizontal_m);
+                            ++discs;
+                            if (b.height_m < any.height_m - 0.1) ++lower;
+                            for (int j = 0; j < m.rings; ++j) {
+                                if (std::abs(m.radii_m[size_t(j)] - rc) > rho) continue;
+                                const double drop = CurvatureDrop_m(m.radii_m[size_t(j)]);
+                                for (uint32_t v = m.ringStart[size_t(j)];
+                                     v < m.ringStart[size_t(j) + 1]; ++v) {
+                                    const glm::dvec2 x0 = RestPosition(m, eye, j, v);
+                                    if (glm::length(x0 - c) > rho) continue;
+                                    const glm::dvec3 p(m.positions[v]);
+                                    EXPECT_LE(p.z + drop, b.height_m) << surf << " " << f;
+                                    EXPECT_LE(std::hypot(p.x - x0.x, p.y - x0.y), b.horizontal_m)
+                                        << surf << " " << f;
+                                    ++vertices;
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        EXPECT_GT(vertices, 20000);
+        EXPECT_GT(lower, discs / 10) << discs;
+    }
+}
+
 TEST(OceanMesh, DryLandShortcutIsTheFullEvaluationBitForBit) {
     // Where OceanSurfaceFrame::DryLandSums claims dry land, the mesh skips the surf terms, the
     // faded deep sea and the clamp test (and on the level land behind the beach the seabed's
@@ -608,6 +674,34 @@ TEST(OceanMesh, ShortcutsAreTheWholePathBitForBit) {
     EXPECT_GT(surfPath, 200000u);
     EXPECT_GT(noGerstner, 1000u);  // rings
     EXPECT_GT(gerstner, 1000u);
+}
+
+// Every ring's footprint lies within OceanMeshFootprintBound_m of its radius (so of any radius
+// beyond), for eye heights from 0.3 to 300 m, calm to rough seas, fine and coarse steps, with
+// and without the view's thinning; and the bound is not loose by more than the 8× cap allows.
+TEST(OceanMesh, RingFootprintsStayWithinTheirBound) {
+    int rings = 0, near = 0;
+    for (const double eyeZ : {0.3, 2.0, 15.0, 300.0})
+        for (const double hs : {0.0, 1.5, 6.0})
+            for (const double step : {0.001, 0.005, 0.02})
+                for (const double tan : {double(INFINITY), 0.02, 0.15, 1.0}) {
+                    std::vector<double> radii = OceanMeshRadii(eyeZ, hs, step, 20000.0);
+                    if (std::isfinite(tan))
+                        radii = ThinnedOceanMeshRadii(radii, eyeZ, hs, step, tan);
+                    // BuildOceanMesh's footprints: the tangential spacing or the radial spacing
+                    // to either neighbour, the last ring (the far range) aside.
+                    for (size_t a = 0; a + 1 < radii.size(); ++a) {
+                        const double inner = a > 0 ? radii[a] - radii[a - 1] : 0.0;
+                        const double outer = radii[a + 1] - radii[a];
+                        const float footprint = float(std::max({radii[a] * step, inner, outer}));
+                        const double bound = OceanMeshFootprintBound_m(radii[a], eyeZ, hs, step);
+                        ASSERT_LE(footprint, bound) << eyeZ << " " << hs << " " << step << " " << a;
+                        ++rings;
+                        if (footprint > 0.25 * bound) ++near;
+                    }
+                }
+    EXPECT_GT(rings, 100000);
+    EXPECT_GT(near, rings / 4);
 }
 
 TEST(OceanMesh, SurfMeshAndFrameBitIdenticalForAnyThreadCount) {

@@ -329,6 +329,36 @@ TEST(OceanSurface, FilteredLookupIsTheFieldAtFineFootprintsAndLosesVarianceAsItG
     EXPECT_LT(previous, 1e-6);
 }
 
+// FilterLevels holds every level the filter of any footprint in the range reads (level[c], and
+// level[c] + 1 where it blends it in), starts at the smallest footprint's and ends at most one
+// past the largest's.
+TEST(OceanSurface, FilterLevelsHoldEveryLevelTheFootprintsRead) {
+    const OceanSurface sea(Beaufort5(5, 64, false));
+    const auto frame = sea.At(9.0);
+    const size_t cascades = frame->Fft()->CascadeCount();
+    int ranges = 0, blended = 0;
+    for (int a = 0; a < 60; ++a)
+        for (const double ratio : {1.0, 1.3, 3.0, 40.0}) {
+            const double lo = 0.01 * std::pow(1.17, a), hi = lo * ratio;
+            for (size_t c = 0; c < cascades; ++c) {
+                int first = -1, last = -1;
+                frame->FilterLevels(c, lo, hi, first, last);
+                EXPECT_EQ(first, frame->Filter(float(lo)).level[c]) << lo;
+                EXPECT_LE(last, frame->Filter(float(hi)).level[c] + 1) << hi;
+                for (int k = 0; k <= 50; ++k) {
+                    const float f = float(lo * std::pow(ratio, k / 50.0));
+                    const FftFilter filter = frame->Filter(f);
+                    EXPECT_GE(filter.level[c], first) << f;
+                    EXPECT_LE(filter.level[c] + (filter.frac[c] > 0.0f ? 1 : 0), last) << f;
+                    if (filter.frac[c] > 0.0f) ++blended;
+                }
+                ++ranges;
+            }
+        }
+    EXPECT_GT(ranges, 400);
+    EXPECT_GT(blended, ranges * 15);
+}
+
 TEST(OceanSurface, LookupsFourAtATimeAreTheLookupsOneByOneBitForBit) {
     // AccumulateFft computes the lookups' texel coordinates, wraps and weights four at a time:
     // the same sums as one lookup at a time, bit for bit, at footprints from below the finest

@@ -237,6 +237,36 @@ TEST(SurfWaves, BoundTableEqualsTheIntervalLoop) {
     }
 }
 
+// A negative (signed) Gerstner bound is weighted in each depth range by the smallest Gerstner
+// weight of its depths (the deep weights grow with depth): the bound holds at every depth of
+// [minDepth, maxDepth], and equals −w(minDepth) where no swash reaches.
+TEST(SurfWaves, SignedGerstnerBoundTakesTheSmallestWeightOfItsDepths) {
+    const OceanSurface sea(SpectralBeach(true));
+    const SurfWaves& surf = *sea.Surf();
+    const std::vector<SurfWaves::Bound> cascades(sea.Fft()->Cascades().size(),
+                                                 SurfWaves::Bound{0.0, 0.0});
+    const SurfWaves::Bound gerstner{-1.0, 0.0};
+    const double fade = surf.FadeDeep_m(), swashDeep = 2.0 * surf.Swash().runup2_m;
+    int checked = 0;
+    for (int k = 1; k <= 300; ++k) {
+        const double minDepth = 1.05 * fade * k / 300.0;
+        for (const double width : {0.003, 0.2, 2.0}) {
+            const double maxDepth = minDepth + width;
+            const SurfWaves::Bound b = surf.BoundAtDepths(minDepth, cascades, gerstner,
+                                                          SurfWaves::Bound{0.0, 0.0}, maxDepth);
+            for (int i = 0; i <= 40; ++i) {
+                const double h = minDepth + width * i / 40.0;
+                ASSERT_GE(b.height_m, -surf.Weights(h).gerstner) << minDepth << " " << h;
+                ++checked;
+            }
+            if (minDepth > swashDeep + 0.1 && minDepth < fade) {
+                EXPECT_EQ(b.height_m, -surf.Weights(minDepth).gerstner) << minDepth;
+            }
+        }
+    }
+    EXPECT_GT(checked, 30000);
+}
+
 // The surf components' bounds over a disc (BoundNear) hold at every wet rest position in it —
 // the height, Terms' vertical displacement less the swash (cap · Re Σ a e^{iψ}), and the reach,
 // the length of its horizontal displacement — over the fade zone, the bar and the beach, at many
