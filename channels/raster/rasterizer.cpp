@@ -342,7 +342,8 @@ struct TileRect {
 // parallel algorithm for polygon rasterization", SIGGRAPH 1988): exact int64 edge functions,
 // stepped incrementally from row to row and from sample to sample.
 template <bool kCount, bool kClipped>
-void RasterTriangle(const TriSetup& s, const double* attrs, const TileRect& r, const Targets& t) {
+[[gnu::always_inline]] inline void RasterTriangle(const TriSetup& s, const double* attrs,
+                                                  const TileRect& r, const Targets& t) {
     const int x0 = std::max<int>(s.bx0, r.x0), x1 = std::min<int>(s.bx1, r.x1);
     const int y0 = std::max<int>(s.by0, r.y0), y1 = std::min<int>(s.by1, r.y1);
     if (x0 > x1 || y0 > y1) return;
