@@ -2,9 +2,7 @@
 // binning into tiles over triangle chunks, then per-tile half-space rasterization.
 #include "channels/raster/rasterizer.h"
 
-#if defined(__AVX__)
-#include <immintrin.h>
-#elif defined(__SSE2__)
+#if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
 
@@ -16,11 +14,13 @@
 #include <bit>
 #include <cmath>
 #include <cstddef>
+#include <cstring>
 #include <limits>
 #include <sstream>
 
 #include "scene/core/check.h"
 #include "scene/core/error.h"
+#include "scene/core/simd_lanes.h"
 
 namespace seasense::channels {
 namespace {
@@ -476,32 +476,20 @@ void RasterTile(int tile, const Context& ctx, const std::vector<Chunk>& chunks, 
             float* __restrict b2 = t.b2 + b;
             // The compiler turned the plain loop into four memset calls per tile row (~77 k
             // calls per 1280×960 frame). Stores of values it cannot see to be constant (the
-            // empty asm statement hides them) stay stores: four samples at a time with SSE2.
+            // empty asm statement hides them) stay stores: simd::kLanes samples at a time (32-byte
+            // stores with AVX, 16-byte ones with SSE2).
             float zero = 0.0f;
             uint32_t empty = kNoPrimitive;
             asm("" : "+r"(zero), "+r"(empty));
+            const simd::VF zeros = simd::Splat(zero);
+            const simd::VI empties = simd::VI{} + int32_t(empty);
             size_t i = 0;
-#if defined(__AVX__)
-            // Eight samples a store where AVX has 32-byte stores.
-            const __m256 zero8 = _mm256_set1_ps(zero);
-            const __m256i empty8 = _mm256_set1_epi32(int32_t(empty));
-            for (; i + 8 <= n; i += 8) {
-                _mm256_storeu_ps(depth + i, zero8);
-                _mm256_storeu_si256(reinterpret_cast<__m256i*>(primitive + i), empty8);
-                _mm256_storeu_ps(b1 + i, zero8);
-                _mm256_storeu_ps(b2 + i, zero8);
+            for (; i + simd::kLanes <= n; i += simd::kLanes) {
+                std::memcpy(depth + i, &zeros, sizeof zeros);
+                std::memcpy(primitive + i, &empties, sizeof empties);
+                std::memcpy(b1 + i, &zeros, sizeof zeros);
+                std::memcpy(b2 + i, &zeros, sizeof zeros);
             }
-#endif
-#if defined(__SSE2__)
-            const __m128 zero4 = _mm_set1_ps(zero);
-            const __m128i empty4 = _mm_set1_epi32(int32_t(empty));
-            for (; i + 4 <= n; i += 4) {
-                _mm_storeu_ps(depth + i, zero4);
-                _mm_storeu_si128(reinterpret_cast<__m128i*>(primitive + i), empty4);
-                _mm_storeu_ps(b1 + i, zero4);
-                _mm_storeu_ps(b2 + i, zero4);
-            }
-#endif
             for (; i < n; ++i) {
                 depth[i] = zero;
                 primitive[i] = empty;
