@@ -14,11 +14,13 @@
 #include <bit>
 #include <cmath>
 #include <cstddef>
+#include <cstring>
 #include <limits>
 #include <sstream>
 
 #include "scene/core/check.h"
 #include "scene/core/error.h"
+#include "scene/core/simd_lanes.h"
 
 namespace seasense::channels {
 namespace {
@@ -342,7 +344,8 @@ struct TileRect {
 // parallel algorithm for polygon rasterization", SIGGRAPH 1988): exact int64 edge functions,
 // stepped incrementally from row to row and from sample to sample.
 template <bool kCount, bool kClipped>
-void RasterTriangle(const TriSetup& s, const double* attrs, const TileRect& r, const Targets& t) {
+[[gnu::always_inline]] inline void RasterTriangle(const TriSetup& s, const double* attrs,
+                                                  const TileRect& r, const Targets& t) {
     const int x0 = std::max<int>(s.bx0, r.x0), x1 = std::min<int>(s.bx1, r.x1);
     const int y0 = std::max<int>(s.by0, r.y0), y1 = std::min<int>(s.by1, r.y1);
     if (x0 > x1 || y0 > y1) return;
@@ -374,21 +377,27 @@ void RasterTriangle(const TriSetup& s, const double* attrs, const TileRect& r, c
     const int64_t u1 = unbias[1], u2 = unbias[2];
     // E_0 + E_1 + E_2 = |2·area| exactly, so depth = Σ E_k c_k = k0 + E_1 Δc_1 + E_2 Δc_2
     // needs two conversions per sample instead of three.
-    const double absArea2 = double(positive ? area2 : -area2);
+    const int64_t absArea2 = positive ? area2 : -area2;
     const double c1 = s.c[1], c2 = s.c[2];
-    const double k0 = absArea2 * s.c[0], dc1 = c1 - s.c[0], dc2 = c2 - s.c[0];
+    const double k0 = double(absArea2) * s.c[0], dc1 = c1 - s.c[0], dc2 = c2 - s.c[0];
     double g0 = 0.0, g1 = 0.0, g2 = 0.0, h0 = 0.0, h1 = 0.0, h2 = 0.0;
     if constexpr (kClipped) {
         const double* g = attrs + s.attr;
-        g0 = absArea2 * g[0];
+        g0 = double(absArea2) * g[0];
         g1 = g[1] - g[0];
         g2 = g[2] - g[0];
-        h0 = absArea2 * g[3];
+        h0 = double(absArea2) * g[3];
         h1 = g[4] - g[3];
         h2 = g[5] - g[3];
     }
+    // Inside the triangle every E_k lies in [0, |2·area|]: below 2^53 the samples' E_1, E_2
+    // are exact in doubles, and so are their sums, so the span steps them in doubles, the
+    // same values as converting each sample's integer.
+    const bool exactInDoubles = absArea2 <= (int64_t(1) << 53);
+    const double step1 = double(stepX[1]), step2 = double(stepX[2]);
 
-    for (int y = y0; y <= y1; ++y) {
+    size_t rowBase = size_t(y0) * size_t(t.width);
+    for (int y = y0; y <= y1; ++y, rowBase += size_t(t.width)) {
         // The covered samples of a row form one span: each edge bounds it from one side,
         // found by exact integer division rather than by testing every sample of the box.
         int64_t lo = x0, hi = x1;
@@ -402,43 +411,47 @@ void RasterTriangle(const TriSetup& s, const double* attrs, const TileRect& r, c
                 hi = -1;
             }
         }
-        if (lo <= hi) {
-            const size_t rowBase = size_t(y) * size_t(t.width);
-            int64_t e1 = row[1] + (lo - x0) * stepX[1] + u1;
-            int64_t e2 = row[2] + (lo - x0) * stepX[2] + u2;
-            if constexpr (kCount) {
-                uint32_t* __restrict hitsRow = t.hits + rowBase;
-                for (int64_t x = lo; x <= hi; ++x) ++hitsRow[x];
-            } else {
-                float* __restrict depthRow = t.depth + rowBase;
-                uint32_t* __restrict primRow = t.primitive + rowBase;
-                float* __restrict b1Row = t.b1 + rowBase;
-                float* __restrict b2Row = t.b2 + rowBase;
-                for (int64_t x = lo; x <= hi; ++x) {
-                    const double f1 = double(e1), f2 = double(e2);
-                    e1 += stepX[1];
-                    e2 += stepX[2];
-                    const double d = k0 + f1 * dc1 + f2 * dc2;
-                    const float depth = float(d);
-                    const float old = depthRow[x];
-                    if (depth > 0.0f && (depth > old || (depth == old && prim < primRow[x]))) {
-                        depthRow[x] = depth;
-                        primRow[x] = prim;
-                        const double inv = 1.0 / d;
-                        if constexpr (kClipped) {
-                            b1Row[x] = float((g0 + f1 * g1 + f2 * g2) * inv);
-                            b2Row[x] = float((h0 + f1 * h1 + f2 * h2) * inv);
-                        } else {
-                            b1Row[x] = float(f1 * c1 * inv);
-                            b2Row[x] = float(f2 * c2 * inv);
-                        }
-                    }
-                }
-            }
-        }
+        const int64_t r1 = row[1], r2 = row[2];
         row[0] += stepY[0];
         row[1] += stepY[1];
         row[2] += stepY[2];
+        if (lo > hi) continue;
+        int64_t e1 = r1 + (lo - x0) * stepX[1] + u1;
+        int64_t e2 = r2 + (lo - x0) * stepX[2] + u2;
+        if constexpr (kCount) {
+            uint32_t* __restrict hitsRow = t.hits + rowBase;
+            for (int64_t x = lo; x <= hi; ++x) ++hitsRow[x];
+        } else {
+            float* __restrict depthRow = t.depth + rowBase;
+            uint32_t* __restrict primRow = t.primitive + rowBase;
+            float* __restrict b1Row = t.b1 + rowBase;
+            float* __restrict b2Row = t.b2 + rowBase;
+            const auto sample = [&](int64_t x, double f1, double f2)
+                __attribute__((always_inline)) {
+                const double d = k0 + f1 * dc1 + f2 * dc2;
+                const float depth = float(d);
+                const float old = depthRow[x];
+                if (depth > 0.0f && (depth > old || (depth == old && prim < primRow[x]))) {
+                    depthRow[x] = depth;
+                    primRow[x] = prim;
+                    const double inv = 1.0 / d;
+                    if constexpr (kClipped) {
+                        b1Row[x] = float((g0 + f1 * g1 + f2 * g2) * inv);
+                        b2Row[x] = float((h0 + f1 * h1 + f2 * h2) * inv);
+                    } else {
+                        b1Row[x] = float(f1 * c1 * inv);
+                        b2Row[x] = float(f2 * c2 * inv);
+                    }
+                }
+            };
+            if (exactInDoubles) [[likely]] {
+                double f1 = double(e1), f2 = double(e2);
+                for (int64_t x = lo; x <= hi; ++x, f1 += step1, f2 += step2) sample(x, f1, f2);
+            } else {
+                for (int64_t x = lo; x <= hi; ++x, e1 += stepX[1], e2 += stepX[2])
+                    sample(x, double(e1), double(e2));
+            }
+        }
     }
 }
 
@@ -463,21 +476,20 @@ void RasterTile(int tile, const Context& ctx, const std::vector<Chunk>& chunks, 
             float* __restrict b2 = t.b2 + b;
             // The compiler turned the plain loop into four memset calls per tile row (~77 k
             // calls per 1280×960 frame). Stores of values it cannot see to be constant (the
-            // empty asm statement hides them) stay stores: four samples at a time with SSE2.
+            // empty asm statement hides them) stay stores: simd::kLanes samples at a time (32-byte
+            // stores with AVX, 16-byte ones with SSE2).
             float zero = 0.0f;
             uint32_t empty = kNoPrimitive;
             asm("" : "+r"(zero), "+r"(empty));
+            const simd::VF zeros = simd::Splat(zero);
+            const simd::VI empties = simd::VI{} + int32_t(empty);
             size_t i = 0;
-#if defined(__SSE2__)
-            const __m128 zero4 = _mm_set1_ps(zero);
-            const __m128i empty4 = _mm_set1_epi32(int32_t(empty));
-            for (; i + 4 <= n; i += 4) {
-                _mm_storeu_ps(depth + i, zero4);
-                _mm_storeu_si128(reinterpret_cast<__m128i*>(primitive + i), empty4);
-                _mm_storeu_ps(b1 + i, zero4);
-                _mm_storeu_ps(b2 + i, zero4);
+            for (; i + simd::kLanes <= n; i += simd::kLanes) {
+                std::memcpy(depth + i, &zeros, sizeof zeros);
+                std::memcpy(primitive + i, &empties, sizeof empties);
+                std::memcpy(b1 + i, &zeros, sizeof zeros);
+                std::memcpy(b2 + i, &zeros, sizeof zeros);
             }
-#endif
             for (; i < n; ++i) {
                 depth[i] = zero;
                 primitive[i] = empty;
