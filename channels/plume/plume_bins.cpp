@@ -23,6 +23,37 @@ namespace {
 // PlumeScreenBins::kStride, the floats of one puff's record (for the loaders below).
 constexpr size_t kPuffRecord = 16;
 
+// For each set of lanes (bit l for lane l), the indices of its lanes in increasing order,
+// then the other lanes': a shuffle that moves the set's values to the front, in order.
+struct CompressIndices {
+    uint8_t lanes[size_t(1) << simd::kLanes][simd::kLanes];
+};
+constexpr CompressIndices MakeCompressIndices() {
+    CompressIndices table{};
+    for (size_t bits = 0; bits < (size_t(1) << simd::kLanes); ++bits) {
+        size_t at = 0;
+        for (size_t l = 0; l < simd::kLanes; ++l)
+            if ((bits >> l) & 1u) table.lanes[bits][at++] = uint8_t(l);
+        for (size_t l = 0; l < simd::kLanes; ++l)
+            if (!((bits >> l) & 1u)) table.lanes[bits][at++] = uint8_t(l);
+    }
+    return table;
+}
+constexpr CompressIndices kCompressIndices = MakeCompressIndices();
+
+// Writes the values of the lanes set in bits (bit l for lane l) to dst, in lane order, and
+// returns how many; writes kLanes values in all (dst must have room for them), one shuffle
+// (AVX2's vpermd) instead of a test and a store per lane.
+using VU = uint32_t __attribute__((vector_size(sizeof(simd::VI))));
+inline size_t CompressStore(uint32_t* dst, VU values, unsigned bits) {
+    using Bytes = uint8_t __attribute__((vector_size(simd::kLanes)));
+    Bytes lanes;
+    std::memcpy(&lanes, kCompressIndices.lanes[bits], sizeof lanes);
+    const VU packed = __builtin_shuffle(values, __builtin_convertvector(lanes, VU));
+    std::memcpy(dst, &packed, sizeof packed);
+    return size_t(__builtin_popcount(bits));
+}
+
 // The screen ellipse of a puff's cutoff ellipsoid wholly in front of the eye: the pixel
 // coordinates p = (x, y) whose rays meet the ellipsoid of Mahalanobis radius² r2, as
 // {p : (p − centre)ᵀ Q (p − centre) ≤ 1}; out = centre x, y, Q_xx, Q_xy, Q_yy, √λmax(Q), or
@@ -564,7 +595,8 @@ void PlumeScreenBins::GatherRow(const RowSource& from, int x0, int y0, int y1, i
     VI laneBit;
     for (size_t l = 0; l < kLanes; ++l) laneBit[l] = int32_t(1u << l);
     constexpr size_t kVectors = (kMaxRowCells + kLanes - 1) / kLanes;
-    std::vector<std::pair<uint32_t, uint32_t>>& block = out.block;
+    std::vector<uint32_t>& blockPuffs = out.blockPuffs;
+    std::vector<uint32_t>& blockMasks = out.blockMasks;
     for (int b = 0; b < blockCount; ++b) {
         const int cb0 = b * cellsPerBlock, n = std::min(cellsPerBlock, cells - cb0);
         // The block's rectangles' ranges, sums and counts, kLanes rectangles a vector, as Begin
@@ -577,7 +609,7 @@ void PlumeScreenBins::GatherRow(const RowSource& from, int x0, int y0, int y1, i
             farV[v] = smallV[v] = halfSmallV[v] = twiceSmallV[v] = simd::Splat(0.0f);
             countV[v] = VI{};
         }
-        block.clear();
+        blockPuffs.clear(), blockMasks.clear();
         const uint32_t all = uint32_t((uint64_t(1) << n) - 1);
         for (const ListRow::Reach& reach : reached) {
             if (!((reach.blocks >> b) & 1u)) continue;
@@ -596,7 +628,7 @@ void PlumeScreenBins::GatherRow(const RowSource& from, int x0, int y0, int y1, i
                 mask |= uint32_t(edge) & all;
             }
             if (mask == 0) continue;
-            block.emplace_back(reach.k, mask);
+            blockPuffs.push_back(reach.k), blockMasks.push_back(mask);
             // The puff's ranges and sums into the rectangles it reaches, in from's order as Add
             // puts them in one list: std::min and std::max are simd::Min and Max lane for lane,
             // and a rectangle the puff does not reach keeps its values.
@@ -635,14 +667,20 @@ void PlumeScreenBins::GatherRow(const RowSource& from, int x0, int y0, int y1, i
         }
         size_t end = out.index.size();
         for (int c = 0; c < n; ++c) end += (size_t(countA[c]) + 3) & ~size_t(3);
-        // One slot more: the loop below writes each puff before it knows whether it keeps it.
-        out.index.resize(end + 1);
+        // kLanes − 1 slots more: CompressStore writes a whole lane group at the list's end.
+        out.index.resize(end + kLanes);
+        // Whole lane groups: the padding puffs reach no rectangle.
+        const size_t groups = (blockPuffs.size() + kLanes - 1) / kLanes * kLanes;
+        blockPuffs.resize(groups, inert_), blockMasks.resize(groups, 0u);
         uint32_t* dst = out.index.data() + out.start.back();
         for (int c = 0; c < n; ++c) {
+            // The block's puffs whose masks hold bit c, in order, kLanes puffs at a time.
             size_t m = 0;
-            for (const auto& [k, mask] : block) {
-                dst[m] = k;
-                m += (mask >> c) & 1u;
+            for (size_t j = 0; j < groups; j += kLanes) {
+                VU puffs, masks;
+                std::memcpy(&puffs, blockPuffs.data() + j, sizeof puffs);
+                std::memcpy(&masks, blockMasks.data() + j, sizeof masks);
+                m += CompressStore(dst + m, puffs, simd::LaneBits(VI(masks << (31 - c))));
             }
             const size_t padded = (m + 3) & ~size_t(3);
             std::fill(dst + m, dst + padded, inert_);
