@@ -23,6 +23,37 @@ namespace {
 // PlumeScreenBins::kStride, the floats of one puff's record (for the loaders below).
 constexpr size_t kPuffRecord = 16;
 
+// For each set of lanes (bit l for lane l), the indices of its lanes in increasing order,
+// then the other lanes': a shuffle that moves the set's values to the front, in order.
+struct CompressIndices {
+    uint8_t lanes[size_t(1) << simd::kLanes][simd::kLanes];
+};
+constexpr CompressIndices MakeCompressIndices() {
+    CompressIndices table{};
+    for (size_t bits = 0; bits < (size_t(1) << simd::kLanes); ++bits) {
+        size_t at = 0;
+        for (size_t l = 0; l < simd::kLanes; ++l)
+            if ((bits >> l) & 1u) table.lanes[bits][at++] = uint8_t(l);
+        for (size_t l = 0; l < simd::kLanes; ++l)
+            if (!((bits >> l) & 1u)) table.lanes[bits][at++] = uint8_t(l);
+    }
+    return table;
+}
+constexpr CompressIndices kCompressIndices = MakeCompressIndices();
+
+// Writes the values of the lanes set in bits (bit l for lane l) to dst, in lane order, and
+// returns how many; writes kLanes values in all (dst must have room for them), one shuffle
+// (AVX2's vpermd) instead of a test and a store per lane.
+using VU = uint32_t __attribute__((vector_size(sizeof(simd::VI))));
+inline size_t CompressStore(uint32_t* dst, VU values, unsigned bits) {
+    using Bytes = uint8_t __attribute__((vector_size(simd::kLanes)));
+    Bytes lanes;
+    std::memcpy(&lanes, kCompressIndices.lanes[bits], sizeof lanes);
+    const VU packed = __builtin_shuffle(values, __builtin_convertvector(lanes, VU));
+    std::memcpy(dst, &packed, sizeof packed);
+    return size_t(__builtin_popcount(bits));
+}
+
 // The screen ellipse of a puff's cutoff ellipsoid wholly in front of the eye: the pixel
 // coordinates p = (x, y) whose rays meet the ellipsoid of Mahalanobis radius² r2, as
 // {p : (p − centre)ᵀ Q (p − centre) ≤ 1}; out = centre x, y, Q_xx, Q_xy, Q_yy, √λmax(Q), or
@@ -564,7 +595,8 @@ void PlumeScreenBins::GatherRow(const RowSource& from, int x0, int y0, int y1, i
     VI laneBit;
     for (size_t l = 0; l < kLanes; ++l) laneBit[l] = int32_t(1u << l);
     constexpr size_t kVectors = (kMaxRowCells + kLanes - 1) / kLanes;
-    std::vector<std::pair<uint32_t, uint32_t>>& block = out.block;
+    std::vector<uint32_t>& blockPuffs = out.blockPuffs;
+    std::vector<uint32_t>& blockMasks = out.blockMasks;
     for (int b = 0; b < blockCount; ++b) {
         const int cb0 = b * cellsPerBlock, n = std::min(cellsPerBlock, cells - cb0);
         // The block's rectangles' ranges, sums and counts, kLanes rectangles a vector, as Begin
@@ -577,7 +609,7 @@ void PlumeScreenBins::GatherRow(const RowSource& from, int x0, int y0, int y1, i
             farV[v] = smallV[v] = halfSmallV[v] = twiceSmallV[v] = simd::Splat(0.0f);
             countV[v] = VI{};
         }
-        block.clear();
+        blockPuffs.clear(), blockMasks.clear();
         const uint32_t all = uint32_t((uint64_t(1) << n) - 1);
         for (const ListRow::Reach& reach : reached) {
             if (!((reach.blocks >> b) & 1u)) continue;
@@ -596,7 +628,7 @@ void PlumeScreenBins::GatherRow(const RowSource& from, int x0, int y0, int y1, i
                 mask |= uint32_t(edge) & all;
             }
             if (mask == 0) continue;
-            block.emplace_back(reach.k, mask);
+            blockPuffs.push_back(reach.k), blockMasks.push_back(mask);
             // The puff's ranges and sums into the rectangles it reaches, in from's order as Add
             // puts them in one list: std::min and std::max are simd::Min and Max lane for lane,
             // and a rectangle the puff does not reach keeps its values.
@@ -635,14 +667,20 @@ void PlumeScreenBins::GatherRow(const RowSource& from, int x0, int y0, int y1, i
         }
         size_t end = out.index.size();
         for (int c = 0; c < n; ++c) end += (size_t(countA[c]) + 3) & ~size_t(3);
-        // One slot more: the loop below writes each puff before it knows whether it keeps it.
-        out.index.resize(end + 1);
+        // kLanes − 1 slots more: CompressStore writes a whole lane group at the list's end.
+        out.index.resize(end + kLanes);
+        // Whole lane groups: the padding puffs reach no rectangle.
+        const size_t groups = (blockPuffs.size() + kLanes - 1) / kLanes * kLanes;
+        blockPuffs.resize(groups, inert_), blockMasks.resize(groups, 0u);
         uint32_t* dst = out.index.data() + out.start.back();
         for (int c = 0; c < n; ++c) {
+            // The block's puffs whose masks hold bit c, in order, kLanes puffs at a time.
             size_t m = 0;
-            for (const auto& [k, mask] : block) {
-                dst[m] = k;
-                m += (mask >> c) & 1u;
+            for (size_t j = 0; j < groups; j += kLanes) {
+                VU puffs, masks;
+                std::memcpy(&puffs, blockPuffs.data() + j, sizeof puffs);
+                std::memcpy(&masks, blockMasks.data() + j, sizeof masks);
+                m += CompressStore(dst + m, puffs, simd::LaneBits(VI(masks << (31 - c))));
             }
             const size_t padded = (m + 3) & ~size_t(3);
             std::fill(dst + m, dst + padded, inert_);
@@ -780,7 +818,7 @@ inline F4 Load4(const std::vector<float>& copied, const float* field, const uint
 using F8 = __m256;
 
 // Exp4 on eight lanes (AVX2), the same operations lane for lane.
-__attribute__((target("avx2"))) inline F8 Exp8(F8 x) {
+__attribute__((target("avx2"), always_inline)) inline F8 Exp8(F8 x) {
     x = _mm256_min_ps(_mm256_max_ps(x, _mm256_set1_ps(-87.0f)), _mm256_set1_ps(88.0f));
     const __m256i n = _mm256_cvtps_epi32(_mm256_mul_ps(x, _mm256_set1_ps(1.44269504f)));
     const F8 fn = _mm256_cvtepi32_ps(n);
@@ -797,7 +835,7 @@ __attribute__((target("avx2"))) inline F8 Exp8(F8 x) {
 // ErfOrSign4 on eight lanes (Erf4's operations lane for lane; the shortcut, taken when every
 // lane that is used saturates, gives what Erf4 gives there, ±1; the unused lanes' values are
 // discarded).
-__attribute__((target("avx2"))) inline F8 ErfOrSign8(F8 x, F8 use) {
+__attribute__((target("avx2"), always_inline)) inline F8 ErfOrSign8(F8 x, F8 use) {
     const F8 sign = _mm256_and_ps(x, _mm256_set1_ps(-0.0f));
     const F8 ax = _mm256_andnot_ps(_mm256_set1_ps(-0.0f), x);
     const F8 saturated = _mm256_cmp_ps(ax, _mm256_set1_ps(3.9f), _CMP_GE_OS);
@@ -872,7 +910,7 @@ struct BandAccumulator8 {
             scatteringG = _mm256_setzero_ps();
     }
     // BandAccumulator::Add lane for lane, of the optical depths kept where use and τ > 0.
-    __attribute__((target("avx2"))) void Add(const F8 (&w)[5], F8 use, F8 tau) {
+    __attribute__((target("avx2"), always_inline)) void Add(const F8 (&w)[5], F8 use, F8 tau) {
         tau = _mm256_and_ps(_mm256_and_ps(use, _mm256_cmp_ps(tau, _mm256_setzero_ps(), _CMP_GT_OS)),
                             tau);
         extinction = _mm256_add_ps(extinction, tau);
@@ -912,20 +950,23 @@ void PlumeScreenBins::UseWideTraces(bool on) {
 }
 
 #ifdef SEASENSE_PLUME_WIDE
-// Trace2Impl's loop body on eight lanes, into the even and odd groups' sums, as the four-lane
+// TraceImpl's loop body on eight lanes, into the even and odd groups' sums, as the four-lane
 // loop adds them.
-template <bool Copied, bool Two>
+template <bool Copied, int Ranges>
 __attribute__((target("avx2"))) void PlumeScreenBins::TraceWide(const List& l, const glm::vec3& dir,
-                                                                float range_m, float range2_m,
-                                                                BandTrace& out1,
-                                                                BandTrace& out2) const {
+                                                                const float* range_m,
+                                                                BandTrace* out) const {
     const F8 dx = _mm256_set1_ps(dir.x), dy = _mm256_set1_ps(dir.y), dz = _mm256_set1_ps(dir.z);
     const F8 dh2 = _mm256_set1_ps(dir.x * dir.x + dir.y * dir.y);
     const F8 dz2 = _mm256_set1_ps(dir.z * dir.z);
-    const F8 end = _mm256_set1_ps(std::max(range_m, range2_m));
-    const F8 r1 = _mm256_set1_ps(range_m), r2 = _mm256_set1_ps(range2_m);
+    // The ranges and each pair's end (named, not arrays, so the sums stay in registers).
+    const auto range = [&](int i) { return range_m[std::min(i, Ranges - 1)]; };
+    const F8 r0 = _mm256_set1_ps(range(0)), r1 = _mm256_set1_ps(range(1));
+    const F8 r2 = _mm256_set1_ps(range(2)), r3 = _mm256_set1_ps(range(3));
+    const F8 end01 = _mm256_set1_ps(std::max(range(0), range(1)));
+    const F8 end23 = _mm256_set1_ps(std::max(range(2), range(3)));
     const F8 zero = _mm256_setzero_ps(), half = _mm256_set1_ps(0.5f);
-    BandAccumulator8 first, second;
+    BandAccumulator8 s0, s1, s2, s3;
     // Eight puffs, their fields given by load(field).
     const auto eight = [&](const auto& load) __attribute__((target("avx2"), always_inline)) {
         const F8 qx = load(kQx), qy = load(kQy), qz = load(kQz);
@@ -941,21 +982,31 @@ __attribute__((target("avx2"))) void PlumeScreenBins::TraceWide(const List& l, c
         const F8 m2 = _mm256_add_ps(
             _mm256_mul_ps(_mm256_add_ps(_mm256_mul_ps(rx, rx), _mm256_mul_ps(ry, ry)), ivh),
             _mm256_mul_ps(_mm256_mul_ps(rz, rz), ivz));
-        const F8 use = _mm256_and_ps(_mm256_cmp_ps(m2, load(kCutoff2), _CMP_LE_OS),
-                                     _mm256_cmp_ps(load(kNear), end, _CMP_LT_OS));
-        if (_mm256_movemask_ps(use) == 0) return;
+        const F8 inside = _mm256_cmp_ps(m2, load(kCutoff2), _CMP_LE_OS);
+        const F8 nearest = load(kNear);
+        // Per pair of ranges the puffs it uses; any: those some range uses (the erfs' shortcut
+        // gives ±1 exactly where the full form does, so the wider mask changes no used lane).
+        const F8 use01 = _mm256_and_ps(inside, _mm256_cmp_ps(nearest, end01, _CMP_LT_OS));
+        F8 use23 = use01, any = use01;
+        if constexpr (Ranges == 4) {
+            use23 = _mm256_and_ps(inside, _mm256_cmp_ps(nearest, end23, _CMP_LT_OS));
+            any = _mm256_or_ps(use01, use23);
+        }
+        if (_mm256_movemask_ps(any) == 0) return;
         const F8 scale = _mm256_sqrt_ps(_mm256_mul_ps(half, A));
         const F8 u0 = _mm256_sub_ps(zero, _mm256_mul_ps(sStar, scale));
         const F8 amplitude = _mm256_div_ps(
             _mm256_mul_ps(load(kKappa), Exp8(_mm256_mul_ps(_mm256_set1_ps(-0.5f), m2))), scale);
-        const F8 e0 = ErfOrSign8(u0, use);
-        const F8 e1 = ErfOrSign8(_mm256_add_ps(u0, _mm256_mul_ps(r1, scale)), use);
+        const F8 e0 = ErfOrSign8(u0, any);
         const F8 w[5] = {load(kWs), load(kWAbsT), load(kWHot), load(kWHotT), load(kWg)};
-        first.Add(w, use, _mm256_mul_ps(amplitude, _mm256_sub_ps(e1, e0)));
-        if constexpr (Two) {
-            const F8 e2 = ErfOrSign8(_mm256_add_ps(u0, _mm256_mul_ps(r2, scale)), use);
-            second.Add(w, use, _mm256_mul_ps(amplitude, _mm256_sub_ps(e2, e0)));
-        }
+        const auto to = [&](F8 r, F8 use, BandAccumulator8 & sums)
+            __attribute__((target("avx2"), always_inline)) {
+            const F8 e = ErfOrSign8(_mm256_add_ps(u0, _mm256_mul_ps(r, scale)), any);
+            sums.Add(w, use, _mm256_mul_ps(amplitude, _mm256_sub_ps(e, e0)));
+        };
+        to(r0, use01, s0);
+        if constexpr (Ranges >= 2) to(r1, use01, s1);
+        if constexpr (Ranges == 4) to(r2, use23, s2), to(r3, use23, s3);
     };
     size_t k = 0;
     for (; k + 8 <= l.index.size(); k += 8) {
@@ -977,15 +1028,14 @@ __attribute__((target("avx2"))) void PlumeScreenBins::TraceWide(const List& l, c
                                             l.data[f], puffData_.data() + f, l.index.data(), k)),
                                         _mm_set1_ps(puffData_[inert_ * kStride + size_t(f)]), 1);
         });
-    BandAccumulator lo, hi;
-    first.Split(lo, hi);
-    out1 = Result(lo, hi);
-    if constexpr (Two) {
-        second.Split(lo, hi);
-        out2 = Result(lo, hi);
-    } else {
-        out2 = out1;
-    }
+    const auto result = [](const BandAccumulator8& sums) __attribute__((target("avx2"))) {
+        BandAccumulator lo, hi;
+        sums.Split(lo, hi);
+        return Result(lo, hi);
+    };
+    out[0] = result(s0);
+    if constexpr (Ranges >= 2) out[1] = result(s1);
+    if constexpr (Ranges == 4) out[2] = result(s2), out[3] = result(s3);
 }
 #endif
 
@@ -995,39 +1045,52 @@ __attribute__((target("avx2"))) void PlumeScreenBins::TraceWide(const List& l, c
 // u1 = u0 + S √(A/2).
 void PlumeScreenBins::Trace2(const List& list, const glm::vec3& dir, float range_m, float range2_m,
                              BandTrace& first, BandTrace& second) const {
-    const bool two = range2_m != range_m;
-    if (list.copied && two)
-        Trace2Impl<true, true>(list, dir, range_m, range2_m, first, second);
-    else if (list.copied)
-        Trace2Impl<true, false>(list, dir, range_m, range2_m, first, second);
-    else if (two)
-        Trace2Impl<false, true>(list, dir, range_m, range2_m, first, second);
+    if (range2_m == range_m) {
+        first = Trace(list, dir, range_m);
+        second = first;
+        return;
+    }
+    const float range[2] = {range_m, range2_m};
+    BandTrace out[2];
+    if (list.copied)
+        TraceImpl<true, 2>(list, dir, range, out);
     else
-        Trace2Impl<false, false>(list, dir, range_m, range2_m, first, second);
+        TraceImpl<false, 2>(list, dir, range, out);
+    first = out[0], second = out[1];
 }
 
-template <bool Copied, bool Two>
-void PlumeScreenBins::Trace2Impl(const List& l, const glm::vec3& dir, float range_m, float range2_m,
-                                 BandTrace& first, BandTrace& second) const {
+void PlumeScreenBins::Trace4(const List& list, const glm::vec3& dir, const float (&range_m)[4],
+                             BandTrace (&out)[4]) const {
+    if (list.copied)
+        TraceImpl<true, 4>(list, dir, range_m, out);
+    else
+        TraceImpl<false, 4>(list, dir, range_m, out);
+}
+
+template <bool Copied, int Ranges>
+void PlumeScreenBins::TraceImpl(const List& l, const glm::vec3& dir, const float* range_m,
+                                BandTrace* out) const {
+    static_assert(Ranges == 1 || Ranges == 2 || Ranges == 4);
     const auto load = [&](int f, size_t k) {
         return Load4<Copied>(l.data[f], puffData_.data() + f, l.index.data(), k);
     };
 #ifdef SEASENSE_PLUME_WIDE
     if (wide_) {
-        TraceWide<Copied, Two>(l, dir, range_m, range2_m, first, second);
+        TraceWide<Copied, Ranges>(l, dir, range_m, out);
         return;
     }
 #endif
     // The even groups' sums and the odd groups'.
-    BandAccumulator even1, even2, odd1, odd2;
+    BandAccumulator even[Ranges], odd[Ranges];
     size_t k = 0;
     const F4 dx = _mm_set1_ps(dir.x), dy = _mm_set1_ps(dir.y), dz = _mm_set1_ps(dir.z);
     const F4 dh2 = _mm_set1_ps(dir.x * dir.x + dir.y * dir.y), dz2 = _mm_set1_ps(dir.z * dir.z);
-    const F4 end = _mm_set1_ps(std::max(range_m, range2_m));
-    const F4 r1 = _mm_set1_ps(range_m), r2 = _mm_set1_ps(range2_m);
+    const auto range = [&](int i) { return range_m[std::min(i, Ranges - 1)]; };
+    const F4 end01 = _mm_set1_ps(std::max(range(0), range(1)));
+    const F4 end23 = _mm_set1_ps(std::max(range(2), range(3)));
     const F4 zero = _mm_setzero_ps(), half = _mm_set1_ps(0.5f);
-    // One group of four puffs from k on, into a1 (and a2).
-    const auto group = [&](size_t k, BandAccumulator & a1, BandAccumulator & a2)
+    // One group of four puffs from k on, into sums.
+    const auto group = [&](size_t k, BandAccumulator(&sums)[Ranges])
         __attribute__((always_inline)) {
         const F4 qx = load(kQx, k), qy = load(kQy, k), qz = load(kQz, k);
         const F4 ivh = load(kIvh, k), ivz = load(kIvz, k);
@@ -1043,38 +1106,44 @@ void PlumeScreenBins::Trace2Impl(const List& l, const glm::vec3& dir, float rang
         const F4 m2 =
             _mm_add_ps(_mm_mul_ps(_mm_add_ps(_mm_mul_ps(rx, rx), _mm_mul_ps(ry, ry)), ivh),
                        _mm_mul_ps(_mm_mul_ps(rz, rz), ivz));
-        const F4 use =
-            _mm_and_ps(_mm_cmple_ps(m2, load(kCutoff2, k)), _mm_cmplt_ps(load(kNear, k), end));
-        if (_mm_movemask_ps(use) == 0) return;
+        const F4 inside = _mm_cmple_ps(m2, load(kCutoff2, k));
+        const F4 nearest = load(kNear, k);
+        const F4 use01 = _mm_and_ps(inside, _mm_cmplt_ps(nearest, end01));
+        F4 use23 = use01, any = use01;
+        if constexpr (Ranges == 4) {
+            use23 = _mm_and_ps(inside, _mm_cmplt_ps(nearest, end23));
+            any = _mm_or_ps(use01, use23);
+        }
+        if (_mm_movemask_ps(any) == 0) return;
         const F4 scale = _mm_sqrt_ps(_mm_mul_ps(half, A));
         const F4 u0 = _mm_sub_ps(zero, _mm_mul_ps(sStar, scale));
         const F4 amplitude = _mm_div_ps(
             _mm_mul_ps(load(kKappa, k), Exp4(_mm_mul_ps(_mm_set1_ps(-0.5f), m2))), scale);
-        const F4 u1 = _mm_add_ps(u0, _mm_mul_ps(r1, scale));
-        const F4 e0 = ErfOrSign4(u0), e1 = ErfOrSign4(u1);
+        const F4 e0 = ErfOrSign4(u0);
         const F4 w[5] = {load(kWs, k), load(kWAbsT, k), load(kWHot, k), load(kWHotT, k),
                          load(kWg, k)};
-        const F4 tau1 = _mm_mul_ps(amplitude, _mm_sub_ps(e1, e0));
-        a1.Add(w, _mm_and_ps(_mm_and_ps(use, _mm_cmpgt_ps(tau1, zero)), tau1));
-        if constexpr (Two) {
-            const F4 e2 = ErfOrSign4(_mm_add_ps(u0, _mm_mul_ps(r2, scale)));
-            const F4 tau2 = _mm_mul_ps(amplitude, _mm_sub_ps(e2, e0));
-            a2.Add(w, _mm_and_ps(_mm_and_ps(use, _mm_cmpgt_ps(tau2, zero)), tau2));
+        for (int i = 0; i < Ranges; ++i) {
+            const F4 e = ErfOrSign4(_mm_add_ps(u0, _mm_mul_ps(_mm_set1_ps(range(i)), scale)));
+            const F4 tau = _mm_mul_ps(amplitude, _mm_sub_ps(e, e0));
+            const F4 use = i < 2 ? use01 : use23;
+            sums[i].Add(w, _mm_and_ps(_mm_and_ps(use, _mm_cmpgt_ps(tau, zero)), tau));
         }
     };
     // The even groups into the first accumulators, the odd ones into the second (k is a
     // multiple of 8 here).
     for (; k < l.index.size(); k += 8) {
-        group(k, even1, even2);
-        if (k + 4 < l.index.size()) group(k + 4, odd1, odd2);
+        group(k, even);
+        if (k + 4 < l.index.size()) group(k + 4, odd);
     }
-    first = Result(even1, odd1);
-    second = Two ? Result(even2, odd2) : first;
+    for (int i = 0; i < Ranges; ++i) out[i] = Result(even[i], odd[i]);
 }
 
 BandTrace PlumeScreenBins::Trace(const List& list, const glm::vec3& dir, float range_m) const {
-    BandTrace t, unused;
-    Trace2(list, dir, range_m, range_m, t, unused);
+    BandTrace t;
+    if (list.copied)
+        TraceImpl<true, 1>(list, dir, &range_m, &t);
+    else
+        TraceImpl<false, 1>(list, dir, &range_m, &t);
     return t;
 }
 

@@ -108,14 +108,15 @@ class PlumeScreenBins {
         friend class PlumeScreenBins;
         // GatherRow's scratch: the puffs reaching the row (their rectangles: an interval of
         // full-width ones and a mask of those clipped at the bin area's edge), and those of
-        // one block with the mask of its rectangles they reach.
+        // one block with the masks of its rectangles they reach (two arrays, read a lane
+        // group at a time).
         struct Reach {
             uint32_t k;
             int first, last;
             uint64_t edge, blocks;
         };
         std::vector<Reach> reached;
-        std::vector<std::pair<uint32_t, uint32_t>> block;
+        std::vector<uint32_t> blockPuffs, blockMasks;
     };
     // The puffs of a row of up to 64 blocks' lists (each in kept order): each puff once, in
     // kept order, with the blocks whose lists hold it (bit b for block b).
@@ -153,6 +154,11 @@ class PlumeScreenBins {
     BandTrace Trace(const List& list, const glm::vec3& dir, float range_m) const;
     void Trace2(const List& list, const glm::vec3& dir, float range_m, float range2_m,
                 BandTrace& first, BandTrace& second) const;
+    // Trace2(list, dir, range_m[0], range_m[1], out[0], out[1]) and Trace2(list, dir,
+    // range_m[2], range_m[3], out[2], out[3]) in one pass over the puffs (each puff's closest
+    // approach, scale and amplitude made once for the four): the same four traces bit for bit.
+    void Trace4(const List& list, const glm::vec3& dir, const float (&range_m)[4],
+                BandTrace (&out)[4]) const;
 
   private:
     struct Rect {
@@ -214,16 +220,17 @@ class PlumeScreenBins {
               List& out) const;
     void Finish(bool copy, List& out) const;
     bool wide_ = false;
-    // Trace2Impl where the CPU has AVX2: eight puffs at a time (a last four with the inert
+    // TraceImpl where the CPU has AVX2: eight puffs at a time (a last four with the inert
     // puff), summed as the four-lane loop sums them.
-    template <bool Copied, bool Two>
-    void TraceWide(const List& list, const glm::vec3& dir, float range_m, float range2_m,
-                   BandTrace& first, BandTrace& second) const;
-    // Two: the second range differs from the first (a separate loop without it keeps the
-    // accumulators of one trace in registers).
-    template <bool Copied, bool Two>
-    void Trace2Impl(const List& list, const glm::vec3& dir, float range_m, float range2_m,
-                    BandTrace& first, BandTrace& second) const;
+    template <bool Copied, int Ranges>
+    void TraceWide(const List& list, const glm::vec3& dir, const float* range_m,
+                   BandTrace* out) const;
+    // The traces to Ranges ranges (1, 2 or 4) in one pass, out[i] to range_m[i]; ranges 2p and
+    // 2p + 1 skip the puffs whose nearest range lies beyond both of them, as Trace2 does for
+    // its two (fewer ranges: a loop whose accumulators stay in registers).
+    template <bool Copied, int Ranges>
+    void TraceImpl(const List& list, const glm::vec3& dir, const float* range_m,
+                   BandTrace* out) const;
     // Per tile, the kept positions of its puffs in increasing order.
     std::vector<uint32_t> tileStart_, tileEntries_;
 };

@@ -884,19 +884,23 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
         row.lists.Take(size_t(cx), list);
         const glm::vec3 dir = PixelDirection(nx * kCell, ny * kCell);
         if (SurfaceCorner(rMin, rMax)) {
-            // Both in one pass over the puffs (the sky trace the same bits as alone).
-            bins.Trace2(list, dir, rMin, kPlumeSkyRange_m, surfaceNodes[n], nodes[n]);
-            surfaceNodeT[n] = std::exp(-surfaceNodes[n].opticalDepth);
-            // The cells that blend this trace admit pixels whose ranges differ from the blend
-            // of their nodes' by up to the depth-edge ratio, so it serves them only where the
-            // traces to that ratio before and beyond the surface match (BlendMatches): a
+            // The surface and sky traces, and (for the test below) the traces to the
+            // depth-edge ratio before and beyond the surface, all in one pass over the puffs
+            // (each the same bits as alone).
+            // The cells that blend the surface trace admit pixels whose ranges differ from the
+            // blend of their nodes' by up to the depth-edge ratio, so it serves them only where
+            // the traces to that ratio before and beyond the surface match (BlendMatches): a
             // surface inside puffs (a hull across a boat's exhaust) cuts them, and a step in
             // it of well under 10 % of the range changes the optical depth within a pixel,
             // which the nodes' agreement cannot show (FLIR frame 128 of five-channel.yaml: a
             // step of 0.6 m at 278 m across 1500 K exhaust, 0.007 in T and 19 K in the image).
-            BandTrace nearer, farther;
-            bins.Trace2(list, dir, rMin / kDepthEdgeRatio, rMin * kDepthEdgeRatio, nearer, farther);
-            if (BlendMatches(nearer, farther)) surfaceNodeRange[n] = rMin;
+            const float ranges[4] = {rMin, kPlumeSkyRange_m, rMin / kDepthEdgeRatio,
+                                     rMin * kDepthEdgeRatio};
+            BandTrace t[4];
+            bins.Trace4(list, dir, ranges, t);
+            surfaceNodes[n] = t[0], nodes[n] = t[1];
+            surfaceNodeT[n] = std::exp(-surfaceNodes[n].opticalDepth);
+            if (BlendMatches(t[2], t[3])) surfaceNodeRange[n] = rMin;
             traces += 4;
             tests += list.size();
         } else {

@@ -365,6 +365,19 @@ TEST(PlumeScreenBins, ListsHoldEveryPuffWhoseCutoffEllipsoidARayMeets) {
     EXPECT_LE(double(listed), 1.6 * double(met)) << listed << " listed, " << met << " met";
 }
 
+// visit(list, dir, px, py) for the lists (not copied) of the 2 × 2-pixel rectangles at every
+// third pixel (px, py) of cam that hold some puff, dir the direction through the pixel.
+template <class Visit>
+void ForEachPixelList(const PlumeScreenBins& bins, const ChannelCamera& cam, const Visit& visit) {
+    PlumeScreenBins::List list;
+    for (int py = 0; py <= cam.height; py += 3) {
+        for (int px = 0; px <= cam.width; px += 3) {
+            bins.Gather(px, py, px + 2, py + 2, 4.0f, false, list);
+            if (list.size() != 0) visit(list, glm::vec3(cam.SampleDirection(px, py)), px, py);
+        }
+    }
+}
+
 // Eight puffs at a time (AVX2) or four (SSE2): the same traces bit for bit, gathered and
 // copied lists, one range and two, for lists of every length modulo 8.
 TEST(PlumeScreenBins, WideAndNarrowTracesAreBitIdentical) {
@@ -372,14 +385,10 @@ TEST(PlumeScreenBins, WideAndNarrowTracesAreBitIdentical) {
     const ChannelCamera cam = NorthCamera({0.0, 0.0, 20.0}, 96, 72, 40.0, 3.0);
     PlumeScreenBins bins(field, cam, ObscurantBand::Visible);
     if (!bins.WideTraces()) GTEST_SKIP() << "no AVX2 on this CPU";
-    PlumeScreenBins::List list;
     int lengths = 0, seen = 0;
-    for (int py = 0; py <= cam.height; py += 3) {
-        for (int px = 0; px <= cam.width; px += 3) {
-            bins.Gather(px, py, px + 2, py + 2, 4.0f, false, list);
-            if (list.size() == 0) continue;
+    ForEachPixelList(
+        bins, cam, [&](PlumeScreenBins::List& list, const glm::vec3& dir, int px, int py) {
             lengths |= 1 << (list.index.size() / 4 % 2);
-            const glm::vec3 dir(cam.SampleDirection(px, py));
             BandTrace t[2][2][2];  // [wide][copied][range]
             for (int copied = 0; copied < 2; ++copied) {
                 if (copied) bins.Copy(list);
@@ -394,10 +403,52 @@ TEST(PlumeScreenBins, WideAndNarrowTracesAreBitIdentical) {
                     EXPECT_EQ(std::memcmp(&t[0][copied][r], &t[1][copied][r], sizeof(BandTrace)), 0)
                         << px << ", " << py << " copied " << copied << " range " << r;
             seen += t[0][0][1].opticalDepth > 0.01f;
-        }
-    }
+        });
     EXPECT_EQ(lengths, 3);  // lists of 4 mod 8 and 0 mod 8 puffs (a four-lane tail and none)
     EXPECT_GT(seen, 50);
+}
+
+// Trace4 is Trace2 of its two pairs of ranges, bit for bit: eight puffs at a time and four,
+// gathered and copied lists, ranges that end before, inside and beyond the plumes (CompositePlumes
+// traces a node's surface, the sky and 10 % before and beyond the surface at once). The larger
+// range of each pair is also the trace to it alone.
+TEST(PlumeScreenBins, FourRangesInOnePassEqualTwoPairs) {
+    const scene::PlumeField field = CommittedPlumes();
+    const ChannelCamera cam = NorthCamera({0.0, 0.0, 20.0}, 96, 72, 40.0, 3.0);
+    PlumeScreenBins bins(field, cam, ObscurantBand::Visible);
+    int compared = 0, cut = 0;
+    ForEachPixelList(
+        bins, cam, [&](PlumeScreenBins::List& list, const glm::vec3& dir, int px, int py) {
+            // A surface range inside the listed puffs' span of ranges.
+            const float surface_m = list.near_m + 0.37f * (list.far_m - list.near_m);
+            const float ranges[4] = {surface_m, kPlumeSkyRange_m, surface_m / 1.1f,
+                                     surface_m * 1.1f};
+            for (int copied = 0; copied < 2; ++copied) {
+                if (copied) bins.Copy(list);
+                for (int wide = 0; wide < 2; ++wide) {
+                    bins.UseWideTraces(wide == 1);
+                    BandTrace four[4], pairs[4];
+                    bins.Trace4(list, dir, ranges, four);
+                    bins.Trace2(list, dir, ranges[0], ranges[1], pairs[0], pairs[1]);
+                    bins.Trace2(list, dir, ranges[2], ranges[3], pairs[2], pairs[3]);
+                    for (int r = 0; r < 4; ++r)
+                        EXPECT_EQ(std::memcmp(&four[r], &pairs[r], sizeof(BandTrace)), 0)
+                            << px << ", " << py << " copied " << copied << " wide " << wide
+                            << " range " << r;
+                    for (const int r : {1, 3}) {
+                        const BandTrace alone = bins.Trace(list, dir, ranges[r]);
+                        EXPECT_EQ(std::memcmp(&four[r], &alone, sizeof(BandTrace)), 0)
+                            << px << ", " << py << " range " << r;
+                    }
+                    ++compared;
+                    cut += four[0].opticalDepth > 0.001f &&
+                           four[0].opticalDepth < four[1].opticalDepth - 0.001f &&
+                           four[2].opticalDepth < four[3].opticalDepth - 0.001f;
+                }
+            }
+        });
+    EXPECT_GT(compared, 200);
+    EXPECT_GT(cut, 50);  // surfaces that cut through the puffs
 }
 
 // A flame puff of optical depth ~300 through its centre: at 3.5 σ (where a fixed cutoff
