@@ -326,10 +326,12 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
             GeometrySums s{};
             const double x0 = req.eye_m.x + rx, y0 = req.eye_m.y + ry;
             // The surf path: the seabed DryLandSums looked up, no velocity, the dominant
-            // component only where the foam reads it (none of it changes the surface's bits).
+            // component only where the foam reads it, no variance shares (none of it changes
+            // the surface's bits).
             SurfWaves::TermsOptions options;
             options.velocity = false;
             options.dominant = SurfWaves::Dominant::kWhereBroken;
+            options.shareWeights = false;
             if (!surf || frame.Surf()->Bathy().Frame().ShoreFromWorld(x0, y0).s_m >= openSea) {
                 frame.AccumulateFft(x0, y0, filter, s);
                 if (ringGerstner)

@@ -130,6 +130,32 @@ inline void Longest(F4& sum, simd4::F8 v) {
 }
 #endif
 
+// A sum's four lanes in double, (lane 0 + lane 2) + (lane 1 + lane 3).
+inline double SumLanes(F4 v) {
+    const __m128d pairs = _mm_add_pd(_mm_cvtps_pd(v), _mm_cvtps_pd(_mm_movehl_ps(v, v)));
+    return _mm_cvtsd_f64(_mm_add_sd(pairs, _mm_unpackhi_pd(pairs, pairs)));
+}
+// SumLanes of a, b, c and d into out[0 … 3]: with AVX the four at once (the pairs of two sums
+// in one register, then one horizontal add of each register's neighbours), the same additions
+// of the same operands in the same order.
+inline void SumLanes(F4 a, F4 b, F4 c, F4 d, double* out) {
+#if defined(__AVX__)
+    const __m256d da = _mm256_cvtps_pd(a), db = _mm256_cvtps_pd(b);
+    const __m256d dc = _mm256_cvtps_pd(c), dd = _mm256_cvtps_pd(d);
+    // (a0 + a2, a1 + a3, b0 + b2, b1 + b3) and the same of c and d.
+    const __m256d ab =
+        _mm256_add_pd(_mm256_permute2f128_pd(da, db, 0x20), _mm256_permute2f128_pd(da, db, 0x31));
+    const __m256d cd =
+        _mm256_add_pd(_mm256_permute2f128_pd(dc, dd, 0x20), _mm256_permute2f128_pd(dc, dd, 0x31));
+    // (a, c, b, d)
+    alignas(32) std::array<double, 4> r;
+    _mm256_store_pd(r.data(), _mm256_hadd_pd(ab, cd));
+    out[0] = r[0], out[1] = r[2], out[2] = r[1], out[3] = r[3];
+#else
+    out[0] = SumLanes(a), out[1] = SumLanes(b), out[2] = SumLanes(c), out[3] = SumLanes(d);
+#endif
+}
+
 struct ComponentInputs {
     const float* reduced;                  // reduced phases per lane
     const float *kuF, *omegaF, *spectral;  // per lane constants
@@ -285,6 +311,9 @@ SurfWaves::SurfWaves(const Bathymetry& bathymetry, std::vector<SurfComponent> co
     laneSpectral_.assign(lanes_, 0.0f);
     laneDepth_.assign(size_t(depthSamples_) * kLaneFields * lanes_, 0.0f);
     lanePhase_.assign(size_t(samples) * lanes_, 0.0);
+    phaseSamples_ = size_t(samples);
+    seawardWorld_ = bathy_.Frame().WorldFromShoreDirection({1.0, 0.0});
+    alongshoreWorld_ = bathy_.Frame().WorldFromShoreDirection({0.0, 1.0});
     for (size_t m = 0; m < lanes_; ++m) {
         for (int i = 0; i < depthSamples_; ++i) {
             float* d = laneDepth_.data() + size_t(i) * kLaneFields * lanes_ + m;
@@ -418,9 +447,15 @@ void SurfWaves::BuildShelters() {
     }
 }
 
-double SurfWaves::Shelter(double s_m, double u_m, double h) const {
+// Inlined into Terms: most surf points lie seaward of every bar, where the call cost more than
+// the test.
+[[gnu::always_inline]] inline double SurfWaves::Shelter(double s_m, double u_m, double h) const {
     // Seaward of every bar's foot, or too shallow: no shelter (skips the region lookup).
     if (shelters_.empty() || h <= kMinDepth_m || s_m > shelterSeaward_m_) return 1.0;
+    return ShelterBehindBar(s_m, u_m, h);
+}
+
+double SurfWaves::ShelterBehindBar(double s_m, double u_m, double h) const {
     double offset = 0.0;
     const int region = bathy_.RegionAt(u_m, &offset);
     if (region < 0 || shelterOfRegion_[size_t(region)] < 0) return 1.0;
@@ -536,7 +571,9 @@ double SurfWaves::DepthTable(const std::vector<double>& t, double h) const {
     return Interp(t, h / dh_m_);
 }
 
-SurfWeights SurfWaves::Weights(double depth_m) const {
+// Inlined into Terms (a surf point's one call): the call and the copy of its result cost as much
+// as the all-deep case's whole work.
+[[gnu::always_inline]] inline SurfWeights SurfWaves::WeightsAt(double depth_m) const {
     SurfWeights w;
     // At or below the deepest fade every Fade below is 1, so the defaults are exactly what the
     // sums give: gerstnerSurf = √(1 − 1) = 0, lost = Σ var (1 − 1) = 0, spectralSurf = 0. Most
@@ -559,6 +596,8 @@ SurfWeights SurfWaves::Weights(double depth_m) const {
     w.spectralSurf = std::sqrt(std::clamp(lost / cascadeVariance_m2_, 0.0, 1.0));
     return w;
 }
+
+SurfWeights SurfWaves::Weights(double depth_m) const { return WeightsAt(depth_m); }
 
 namespace {
 
@@ -874,14 +913,14 @@ SurfaceTerms SurfWaves::TermsImpl(double x0, double y0, double t, SurfPointInfo*
     const double zBed =
         std::isnan(options.seabedZ_m) ? bathy_.SeabedZAtShore_m(p.s_m, p.u_m) : options.seabedZ_m;
     const double h = bathy_.Tide_m() - zBed;
-    const SurfWeights weights = Weights(h);
+    const SurfWeights weights = WeightsAt(h);
     SurfPointInfo local;
     local.depth_m = h;
     local.seabedZ_m = zBed;
     local.weights = weights;
     const double variance = spectralVariance_m2_ + gerstnerVariance_m2_;
     // All deep: surfShare is 0 / variance = 0, so the weights are exactly 0 and 1 (the defaults).
-    if (variance > 0.0 && !weights.AllDeep()) {
+    if (options.shareWeights && variance > 0.0 && !weights.AllDeep()) {
         const double surfShare =
             (weights.spectralSurf * weights.spectralSurf * spectralVariance_m2_ +
              weights.gerstnerSurf * weights.gerstnerSurf * gerstnerVariance_m2_) /
@@ -895,7 +934,8 @@ SurfaceTerms SurfWaves::TermsImpl(double x0, double y0, double t, SurfPointInfo*
         local.breaking.timeSinceBreaking_s = Interp(breakTime_s_, tableIndex);
     }
     // Swash run-up (Swash_m): the waterline's rise and fall, in the inner surf and on the beach.
-    out.displacement.z += Swash_m(p.s_m, p.u_m, t, h);
+    // Where it is +0 (SwashReaches) the height stays the +0 that adding it leaves.
+    if (SwashReaches(h)) out.displacement.z += Swash_m(p.s_m, p.u_m, t, h);
     if (weights.AllDeep() || h <= 0.0 || incoming_.empty()) {
         if (info) *info = local;
         return out;
@@ -908,7 +948,7 @@ SurfaceTerms SurfWaves::TermsImpl(double x0, double y0, double t, SurfPointInfo*
     const double dx = std::min(hh / dh_m_, double(depthSamples_ - 1));
     const size_t di = std::min(size_t(dx), size_t(depthSamples_ - 2));
     const double df = dx - double(di);
-    const size_t phaseSamples = lanePhase_.size() / lanes;
+    const size_t phaseSamples = phaseSamples_;
     const double px = std::clamp(tableIndex, 0.0, double(phaseSamples - 1));
     const size_t pi = std::min(size_t(px), phaseSamples - 2);
     const double pf = px - double(pi);
@@ -968,12 +1008,20 @@ SurfaceTerms SurfWaves::TermsImpl(double x0, double y0, double t, SurfPointInfo*
 #endif
     for (; lane < lanes; lane += 4)
         ComponentGroup<kVelocity, F4>(in, lane, sums, amplitudes.data());
-    // (lane 0 + lane 2) + (lane 1 + lane 3), in double.
-    const auto sum = [](F4 v) {
-        const __m128d pairs = _mm_add_pd(_mm_cvtps_pd(v), _mm_cvtps_pd(_mm_movehl_ps(v, v)));
-        return _mm_cvtsd_f64(_mm_add_sd(pairs, _mm_unpackhi_pd(pairs, pairs)));
+    // Each sum's lanes reduced in double, (lane 0 + lane 2) + (lane 1 + lane 3): with kWide
+    // four sums at a time (SumLanes), else one by one, the reference the tests compare with.
+    alignas(32) std::array<double, 12> total;
+    const auto reduce = [](F4 a, F4 b, F4 c, F4 d, double* out) {
+        if constexpr (kWide) {
+            SumLanes(a, b, c, d, out);
+        } else {
+            out[0] = SumLanes(a), out[1] = SumLanes(b), out[2] = SumLanes(c), out[3] = SumLanes(d);
+        }
     };
-    const double envelopeRe = sum(sums.re), envelopeIm = sum(sums.im);
+    reduce(sums.re, sums.im, sums.slopeS, sums.slopeU, total.data());
+    reduce(sums.dispS, sums.dispU, sums.tSS, sums.tUU, total.data() + 4);
+    reduce(sums.tSU, sums.orbit, sums.velZ, sums.velS, total.data() + 8);
+    const double envelopeRe = total[0], envelopeIm = total[1];
     const double A = std::sqrt(envelopeRe * envelopeRe + envelopeIm * envelopeIm);
     // Behind a sandbar only the energy flux the bar let through arrives (Shelter).
     const double shelter = Shelter(p.s_m, p.u_m, h);
@@ -984,17 +1032,16 @@ SurfaceTerms SurfWaves::TermsImpl(double x0, double y0, double t, SurfPointInfo*
     const double q = settings_.deepSteepness + (1.0 - settings_.deepSteepness) *
                                                    std::min(1.0, 2.0 * A / std::max(gammaH, 1e-9));
     // Shore frame to world: the seaward and alongshore unit vectors.
-    const glm::dvec2 es = bathy_.Frame().WorldFromShoreDirection({1.0, 0.0});
-    const glm::dvec2 eu = bathy_.Frame().WorldFromShoreDirection({0.0, 1.0});
+    const glm::dvec2 es = seawardWorld_, eu = alongshoreWorld_;
     out.displacement.z += cap * envelopeRe;
-    const glm::dvec2 slope = cap * (sum(sums.slopeS) * es + sum(sums.slopeU) * eu);
+    const glm::dvec2 slope = cap * (total[2] * es + total[3] * eu);
     out.sx = slope.x;
     out.sy = slope.y;
-    if constexpr (kVelocity) out.velocity_mps.z = cap * sum(sums.velZ);
+    if constexpr (kVelocity) out.velocity_mps.z = cap * total[10];
     const double qc = q * cap;
-    const glm::dvec2 horizontal = qc * (sum(sums.dispS) * es + sum(sums.dispU) * eu);
+    const glm::dvec2 horizontal = qc * (total[4] * es + total[5] * eu);
     // The tensor T = R T_shore Rᵀ with R's columns es, eu.
-    const double ss = qc * sum(sums.tSS), uu = qc * sum(sums.tUU), su = qc * sum(sums.tSU);
+    const double ss = qc * total[6], uu = qc * total[7], su = qc * total[8];
     const double dxx = ss * es.x * es.x + 2.0 * su * es.x * eu.x + uu * eu.x * eu.x;
     const double dyy = ss * es.y * es.y + 2.0 * su * es.y * eu.y + uu * eu.y * eu.y;
     const double dxy = ss * es.x * es.y + su * (es.x * eu.y + eu.x * es.y) + uu * eu.x * eu.y;
@@ -1008,7 +1055,7 @@ SurfaceTerms SurfWaves::TermsImpl(double x0, double y0, double t, SurfPointInfo*
     _mm_store_ps(longestLanes.data(), sums.longest);
     const double longestInvTanh =
         double(std::max({longestLanes[0], longestLanes[1], longestLanes[2], longestLanes[3]}));
-    const double limit = std::min(cap * sum(sums.orbit), 0.5 * gammaH * longestInvTanh);
+    const double limit = std::min(cap * total[9], 0.5 * gammaH * longestInvTanh);
     const double len = std::sqrt(horizontal.x * horizontal.x + horizontal.y * horizontal.y);
     const double f = len > limit && len > 0.0 ? limit / len : 1.0;
     out.displacement.x = f * horizontal.x;
@@ -1017,7 +1064,7 @@ SurfaceTerms SurfWaves::TermsImpl(double x0, double y0, double t, SurfPointInfo*
     out.dyy = f * dyy;
     out.dxy = f * dxy;
     if constexpr (kVelocity) {
-        const glm::dvec2 horizontalVelocity = qc * (sum(sums.velS) * es + sum(sums.velU) * eu);
+        const glm::dvec2 horizontalVelocity = qc * (total[11] * es + SumLanes(sums.velU) * eu);
         out.velocity_mps.x = f * horizontalVelocity.x;
         out.velocity_mps.y = f * horizontalVelocity.y;
     }

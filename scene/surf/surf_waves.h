@@ -141,6 +141,9 @@ class SurfWaves {
     struct TermsOptions {
         bool velocity = true;  // false: velocity_mps left 0 (three sums fewer per component)
         Dominant dominant = Dominant::kEverywhere;
+        // false: SurfPointInfo::surfWeight and deepWeight left at their defaults (0 and 1), which
+        // the mesh and the foam do not read (two square roots and a division per point).
+        bool shareWeights = true;
         // Bathy().SeabedZAtShore_m at the point's shore coordinates when the caller has it
         // (OceanSurfaceFrame::DryLandSums), else NaN and Terms looks it up.
         double seabedZ_m = std::numeric_limits<double>::quiet_NaN();
@@ -254,6 +257,11 @@ class SurfWaves {
     const SwashParameters& Swash() const { return swash_; }
     // ζ (m, added to the surface height) at shore point (s, u), time t, still-water depth h.
     double Swash_m(double s_m, double u_m, double t_s, double depth_m) const;
+    // False where Swash_m is +0 whatever s, u and t (inactive, or still water at least twice the
+    // run-up deep: most of the surf zone), so that Terms can skip the call there.
+    bool SwashReaches(double depth_m) const {
+        return swash_.active && !(depth_m > 0.0 && depth_m >= 2.0 * swash_.runup2_m);
+    }
     // --- end swash
 
   private:
@@ -315,6 +323,8 @@ class SurfWaves {
     void BuildShelters();
     double FluxProxy(double h) const;
     double Shelter(double s_m, double u_m, double h) const;
+    double ShelterBehindBar(double s_m, double u_m, double h) const;  // Shelter's lookup
+    SurfWeights WeightsAt(double depth_m) const;                      // Weights, inlined into Terms
     std::vector<int> shelterOfRegion_;  // index into shelters_ or −1
     std::vector<BarShelter> shelters_;
     size_t dominant_ = 0;
@@ -328,6 +338,10 @@ class SurfWaves {
     double cascadeVariance_m2_ = 0.0;
     double spectralVariance_m2_ = 0.0, gerstnerVariance_m2_ = 0.0;  // of the components
     double sRef_m_ = 0.0, sShore_m_ = 0.0, ds_m_ = 0.5;
+    size_t phaseSamples_ = 0;  // cross-shore samples of lanePhase_ (lanePhase_.size() / lanes_)
+    // The shore frame's seaward and alongshore unit vectors in the world, as
+    // Frame().WorldFromShoreDirection gives them for (1, 0) and (0, 1).
+    glm::dvec2 seawardWorld_{1.0, 0.0}, alongshoreWorld_{0.0, 1.0};
     double dh_m_ = 0.02;
     int depthSamples_ = 0;
     std::vector<Track> tracks_;

@@ -527,7 +527,8 @@ TEST(OceanMesh, DryLandShortcutIsTheFullEvaluationBitForBit) {
 
 TEST(OceanMesh, SurfTermsOptionsOfTheMeshChangeNothingItUses) {
     // The mesh asks SurfWaves::Terms for less (TermsOptions: no velocity, the dominant component
-    // only where the water has broken) and hands in the seabed that DryLandSums looked up.
+    // only where the water has broken, no variance shares) and hands in the seabed that
+    // DryLandSums looked up.
     // Against the full evaluation, across the barred beach of configs/surf.yaml from beyond the
     // fade onto the dry sand at three times: DryLandSums' seabed is the point's seabedZ_m, the
     // terms other than the velocity and everything else in the point's information are the same
@@ -549,6 +550,7 @@ TEST(OceanMesh, SurfTermsOptionsOfTheMeshChangeNothingItUses) {
                 SurfWaves::TermsOptions options;
                 options.velocity = false;
                 options.dominant = SurfWaves::Dominant::kWhereBroken;
+                options.shareWeights = false;
                 GeometrySums dry{};
                 if (frame->DryLandSums(x, y, dry, &options.seabedZ_m)) continue;
                 SurfPointInfo all, lazy;
@@ -565,7 +567,9 @@ TEST(OceanMesh, SurfTermsOptionsOfTheMeshChangeNothingItUses) {
                     all.breaking.broken == lazy.breaking.broken &&
                     same(all.breaking.timeSinceBreaking_s, lazy.breaking.timeSinceBreaking_s) &&
                     all.weights.cascade == lazy.weights.cascade &&
-                    same(all.surfWeight, lazy.surfWeight));
+                    same(all.weights.gerstner, lazy.weights.gerstner));
+                // The variance shares are left at their defaults (the foam below ignores them).
+                ASSERT_TRUE(same(lazy.surfWeight, 0.0) && same(lazy.deepWeight, 1.0));
                 if (all.breaking.broken) {
                     ++broken;
                     ASSERT_TRUE(same(all.direction_rad, lazy.direction_rad) &&

@@ -5,7 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <numbers>
 #include <vector>
@@ -127,6 +129,40 @@ TEST(Swash, WaterlineMovesWithTheWaveGroups) {
     s.swash.enabled = false;
     const SurfWaves still(Bathymetry(s, 40.0), w.Components(), 100.0);
     for (int i = 0; i < 50; ++i) EXPECT_NEAR(Runup(still, 0.0, 7.0 * i), 0.0, 0.01);
+}
+
+// Terms skips Swash_m where SwashReaches says it is +0: there it must be +0 bit for bit at
+// every s, u and t (depths from the beach through 2 R2 and beyond, the bound itself, −0 and 0),
+// and it must reach just shallower than 2 R2 (a tighter skip, at R2, fails this).
+TEST(Swash, ReachesNoDeeperThanTwiceTheRunup) {
+    const SurfWaves w = Beach();
+    ASSERT_TRUE(w.Swash().active);
+    const double edge = 2.0 * w.Swash().runup2_m;
+    std::vector<double> depths{0.0, -0.0, edge, std::nextafter(edge, 0.0),
+                               std::nextafter(edge, 1e9)};
+    for (int i = -200; i <= 400; ++i) depths.push_back(edge * i / 200.0);
+    int skipped = 0, reached = 0;
+    for (const double h : depths) {
+        const bool reaches = w.SwashReaches(h);
+        (reaches ? reached : skipped) += 1;
+        for (int k = 0; k < 40; ++k) {
+            const double s = -30.0 + 3.1 * k, u = 17.0 * k, t = 2.3 * k * k;
+            const double zeta = w.Swash_m(s, u, t, h);
+            if (!reaches) {
+                ASSERT_EQ(std::bit_cast<uint64_t>(zeta), 0u) << h << " " << s;
+            }
+        }
+        if (h > 0.0 && h < edge) {
+            EXPECT_TRUE(reaches) << h;
+        }
+    }
+    EXPECT_GT(skipped, 150);
+    EXPECT_GT(reached, 300);
+    // Inactive: nowhere.
+    SurfSettings st = w.Bathy().Settings();
+    st.swash.enabled = false;
+    const SurfWaves still(Bathymetry(st, 40.0), w.Components(), 100.0);
+    for (const double h : depths) EXPECT_FALSE(still.SwashReaches(h));
 }
 
 }  // namespace
