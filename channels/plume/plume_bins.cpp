@@ -1052,19 +1052,13 @@ void PlumeScreenBins::Trace2(const List& list, const glm::vec3& dir, float range
     }
     const float range[2] = {range_m, range2_m};
     BandTrace out[2];
-    if (list.copied)
-        TraceImpl<true, 2>(list, dir, range, out);
-    else
-        TraceImpl<false, 2>(list, dir, range, out);
+    TraceRanges<2>(list, dir, range, out);
     first = out[0], second = out[1];
 }
 
 void PlumeScreenBins::Trace4(const List& list, const glm::vec3& dir, const float (&range_m)[4],
                              BandTrace (&out)[4]) const {
-    if (list.copied)
-        TraceImpl<true, 4>(list, dir, range_m, out);
-    else
-        TraceImpl<false, 4>(list, dir, range_m, out);
+    TraceRanges<4>(list, dir, range_m, out);
 }
 
 template <bool Copied, int Ranges>
@@ -1140,10 +1134,7 @@ void PlumeScreenBins::TraceImpl(const List& l, const glm::vec3& dir, const float
 
 BandTrace PlumeScreenBins::Trace(const List& list, const glm::vec3& dir, float range_m) const {
     BandTrace t;
-    if (list.copied)
-        TraceImpl<true, 1>(list, dir, &range_m, &t);
-    else
-        TraceImpl<false, 1>(list, dir, &range_m, &t);
+    TraceRanges<1>(list, dir, &range_m, &t);
     return t;
 }
 

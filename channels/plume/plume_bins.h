@@ -231,6 +231,15 @@ class PlumeScreenBins {
     template <bool Copied, int Ranges>
     void TraceImpl(const List& list, const glm::vec3& dir, const float* range_m,
                    BandTrace* out) const;
+    // TraceImpl for the list as it is (copied or not).
+    template <int Ranges>
+    void TraceRanges(const List& list, const glm::vec3& dir, const float* range_m,
+                     BandTrace* out) const {
+        if (list.copied)
+            TraceImpl<true, Ranges>(list, dir, range_m, out);
+        else
+            TraceImpl<false, Ranges>(list, dir, range_m, out);
+    }
     // Per tile, the kept positions of its puffs in increasing order.
     std::vector<uint32_t> tileStart_, tileEntries_;
 };

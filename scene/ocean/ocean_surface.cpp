@@ -556,11 +556,10 @@ void OceanSurfaceFrame::FilterLevels(size_t c, double minFootprint_m, double max
 }
 
 SurfWaves::Bound OceanSurfaceFrame::CascadeBoundNear(size_t c, double x, double y, double radius_m,
-                                                     double minFootprint_m,
                                                      double maxFootprint_m) const {
     const CascadeTexture& t = textures_[c];
     int first = 0, last = 0;
-    FilterLevels(c, minFootprint_m, maxFootprint_m, first, last);
+    FilterLevels(c, 0.0, maxFootprint_m, first, last);
     SurfWaves::Bound b;
     for (size_t level = size_t(first); level <= size_t(last); ++level) {
         // AddBilinear at rest position x0 reads texels floor(u) and floor(u) + 1 of the level,
@@ -600,13 +599,12 @@ SurfWaves::Bound OceanSurfaceFrame::CascadeBoundNear(size_t c, double x, double 
 }
 
 SurfaceBounds OceanSurfaceFrame::LocalBoundsNear(double x, double y, double radius_m,
-                                                 double maxFootprint_m,
-                                                 double minFootprint_m) const {
-    CHECK(radius_m >= 0.0 && minFootprint_m >= 0.0 && maxFootprint_m >= minFootprint_m);
+                                                 double maxFootprint_m) const {
+    CHECK(radius_m >= 0.0 && maxFootprint_m >= 0.0);
     const SurfaceBounds global = BoundsNear(x, y, radius_m);
     std::vector<SurfWaves::Bound> cascades(textures_.size());
     for (size_t c = 0; c < textures_.size(); ++c)
-        cascades[c] = CascadeBoundNear(c, x, y, radius_m, minFootprint_m, maxFootprint_m);
+        cascades[c] = CascadeBoundNear(c, x, y, radius_m, maxFootprint_m);
     SurfWaves::Bound gerstner = GerstnerBound();
     gerstner.height_m = gerstner_.ElevationBoundNear_m(x, y, radius_m, t_s_, maxFootprint_m);
     SurfaceBounds local;

@@ -163,18 +163,16 @@ class OceanSurfaceFrame {
     // eyepoint in deeper water is bounded far more tightly than the whole surface.
     SurfaceBounds BoundsNear(double x, double y, double radius_m) const;
     // BoundsNear taken from the waves near (x, y) rather than from their maxima over the whole
-    // surface: each FFT cascade bounded by the highest texel (and the longest horizontal
-    // displacement) that a lookup within the disc can read at any mip level, the Gerstner
-    // waves' elevation by GerstnerOcean::MaxElevationNear_m; the surf zone and the seabed as in
-    // BoundsNear. Never above BoundsNear; the height includes kLocalBoundMargin_m. With
-    // maxFootprint_m, for the points of a mesh whose rings there have footprints of at most
-    // maxFootprint_m: the Gerstner waves' footprint weights are then bounded from below, and
-    // their elevation signed (GerstnerOcean::ElevationBoundNear_m), following their troughs.
-    // With minFootprint_m too, the FFT cascades are bounded over the mip levels such footprints
-    // read (see Filter) rather than all.
-    SurfaceBounds LocalBoundsNear(double x, double y, double radius_m,
-                                  double maxFootprint_m = std::numeric_limits<double>::infinity(),
-                                  double minFootprint_m = 0.0) const;
+    // surface, for the points of a mesh whose rings there have footprints of at most
+    // maxFootprint_m (∞: any): each FFT cascade bounded by the highest texel (and the longest
+    // horizontal displacement) that a lookup within the disc can read at the mip levels such
+    // footprints read (FilterLevels), the Gerstner waves' elevation by
+    // GerstnerOcean::ElevationBoundNear_m (signed where the footprint bounds their weights from
+    // below, following their troughs); the surf zone and the seabed as in BoundsNear. Never
+    // above BoundsNear; the height includes kLocalBoundMargin_m.
+    SurfaceBounds LocalBoundsNear(
+        double x, double y, double radius_m,
+        double maxFootprint_m = std::numeric_limits<double>::infinity()) const;
     // Added to LocalBoundsNear's height and reach: the float rounding of the mesh's sums (a few
     // ulp of metres) far below it.
     static constexpr double kLocalBoundMargin_m = 1e-3;
@@ -200,9 +198,9 @@ class OceanSurfaceFrame {
     };
     void BuildTextures();
     // Cascade c's bound over the lookups at rest positions within radius_m of (x, y) by
-    // footprints in [minFootprint_m, maxFootprint_m] (the levels FilterLevels gives).
+    // footprints of at most maxFootprint_m (the levels FilterLevels gives).
     SurfWaves::Bound CascadeBoundNear(size_t c, double x, double y, double radius_m,
-                                      double minFootprint_m, double maxFootprint_m) const;
+                                      double maxFootprint_m) const;
     SurfWaves::Bound GerstnerBound() const;
     // OpenSeaFrom_m for the frame's bounds (surfBounds_ made).
     double OpenSeaFrom(const SurfWaves& surf) const;
