@@ -329,6 +329,7 @@ int ClipAndEmit(const glm::vec3 (&clip)[3], uint32_t prim, bool cullBackFaces, c
 // Output of the per-tile pass: a visibility buffer or a coverage count.
 struct Targets {
     int width = 0;
+    int x0 = 0, y0 = 0;  // the sample stored at index 0
     float* depth = nullptr;
     uint32_t* primitive = nullptr;
     float* b1 = nullptr;
@@ -396,7 +397,8 @@ template <bool kCount, bool kClipped>
     const bool exactInDoubles = absArea2 <= (int64_t(1) << 53);
     const double step1 = double(stepX[1]), step2 = double(stepX[2]);
 
-    size_t rowBase = size_t(y0) * size_t(t.width);
+    size_t rowBase = size_t(y0 - t.y0) * size_t(t.width);
+    const int64_t xo = t.x0;
     for (int y = y0; y <= y1; ++y, rowBase += size_t(t.width)) {
         // The covered samples of a row form one span: each edge bounds it from one side,
         // found by exact integer division rather than by testing every sample of the box.
@@ -420,7 +422,7 @@ template <bool kCount, bool kClipped>
         int64_t e2 = r2 + (lo - x0) * stepX[2] + u2;
         if constexpr (kCount) {
             uint32_t* __restrict hitsRow = t.hits + rowBase;
-            for (int64_t x = lo; x <= hi; ++x) ++hitsRow[x];
+            for (int64_t x = lo; x <= hi; ++x) ++hitsRow[x - xo];
         } else {
             float* __restrict depthRow = t.depth + rowBase;
             uint32_t* __restrict primRow = t.primitive + rowBase;
@@ -446,17 +448,43 @@ template <bool kCount, bool kClipped>
             };
             if (exactInDoubles) [[likely]] {
                 double f1 = double(e1), f2 = double(e2);
-                for (int64_t x = lo; x <= hi; ++x, f1 += step1, f2 += step2) sample(x, f1, f2);
+                for (int64_t x = lo; x <= hi; ++x, f1 += step1, f2 += step2) sample(x - xo, f1, f2);
             } else {
                 for (int64_t x = lo; x <= hi; ++x, e1 += stepX[1], e2 += stepX[2])
-                    sample(x, double(e1), double(e2));
+                    sample(x - xo, double(e1), double(e2));
             }
         }
     }
 }
 
-// Clears one tile of the targets, then draws every triangle binned to it in global
-// triangle order (chunks in order, set-ups in order within a chunk).
+// Copies n 4-byte values to dst with non-temporal stores where dst is 16-byte aligned: the
+// frame's targets are far larger than the caches, and streaming stores write whole lines
+// without first reading them (Intel 64 and IA-32 Architectures Optimization Reference Manual,
+// "Non-temporal stores"); the ends that share a line with a neighbouring tile use plain stores.
+template <class T>
+void StreamRow(T* __restrict dst, const T* __restrict src, size_t n) {
+    static_assert(sizeof(T) == 4);
+    size_t i = 0;
+    for (; i < n && (reinterpret_cast<uintptr_t>(dst + i) & 63) != 0; ++i) dst[i] = src[i];
+    for (; i + 16 <= n; i += 16) {
+        __m128i* d = reinterpret_cast<__m128i*>(dst + i);
+        const __m128i* q = reinterpret_cast<const __m128i*>(src + i);
+        _mm_stream_si128(d, _mm_loadu_si128(q));
+        _mm_stream_si128(d + 1, _mm_loadu_si128(q + 1));
+        _mm_stream_si128(d + 2, _mm_loadu_si128(q + 2));
+        _mm_stream_si128(d + 3, _mm_loadu_si128(q + 3));
+    }
+    for (; i < n; ++i) dst[i] = src[i];
+}
+
+// One tile's targets while it is drawn: small enough to stay in the core's cache.
+struct TileTargets {
+    std::vector<float> depth, b1, b2;
+    std::vector<uint32_t> primitive;
+};
+
+// Draws every triangle binned to one tile in global triangle order (chunks in order, set-ups
+// in order within a chunk) into cleared tile-sized targets, then copies the tile out.
 template <bool kCount>
 void RasterTile(int tile, const Context& ctx, const std::vector<Chunk>& chunks, size_t numChunks,
                 const Targets& t) {
@@ -464,39 +492,25 @@ void RasterTile(int tile, const Context& ctx, const std::vector<Chunk>& chunks, 
     const int tx = tile % ctx.tilesX, ty = tile / ctx.tilesX;
     const TileRect r{tx * tileSize, ty * tileSize, std::min(ctx.width, (tx + 1) * tileSize) - 1,
                      std::min(ctx.height, (ty + 1) * tileSize) - 1};
-    for (int y = r.y0; y <= r.y1; ++y) {
-        const size_t b = size_t(y) * size_t(t.width) + size_t(r.x0);
-        const size_t n = size_t(r.x1 - r.x0 + 1);
-        if constexpr (kCount) {
-            std::fill_n(t.hits + b, n, 0u);
-        } else {
-            float* __restrict depth = t.depth + b;
-            uint32_t* __restrict primitive = t.primitive + b;
-            float* __restrict b1 = t.b1 + b;
-            float* __restrict b2 = t.b2 + b;
-            // The compiler turned the plain loop into four memset calls per tile row (~77 k
-            // calls per 1280×960 frame). Stores of values it cannot see to be constant (the
-            // empty asm statement hides them) stay stores: simd::kLanes samples at a time (32-byte
-            // stores with AVX, 16-byte ones with SSE2).
-            float zero = 0.0f;
-            uint32_t empty = kNoPrimitive;
-            asm("" : "+r"(zero), "+r"(empty));
-            const simd::VF zeros = simd::Splat(zero);
-            const simd::VI empties = simd::VI{} + int32_t(empty);
-            size_t i = 0;
-            for (; i + simd::kLanes <= n; i += simd::kLanes) {
-                std::memcpy(depth + i, &zeros, sizeof zeros);
-                std::memcpy(primitive + i, &empties, sizeof empties);
-                std::memcpy(b1 + i, &zeros, sizeof zeros);
-                std::memcpy(b2 + i, &zeros, sizeof zeros);
-            }
-            for (; i < n; ++i) {
-                depth[i] = zero;
-                primitive[i] = empty;
-                b1[i] = zero;
-                b2[i] = zero;
-            }
-        }
+    const size_t w = size_t(r.x1 - r.x0 + 1), h = size_t(r.y1 - r.y0 + 1);
+    Targets local;
+    thread_local TileTargets scratch;
+    if constexpr (kCount) {
+        for (int y = r.y0; y <= r.y1; ++y)
+            std::fill_n(t.hits + size_t(y) * size_t(t.width) + size_t(r.x0), w, 0u);
+        local = t;
+    } else {
+        scratch.depth.assign(w * h, 0.0f);
+        scratch.b1.assign(w * h, 0.0f);
+        scratch.b2.assign(w * h, 0.0f);
+        scratch.primitive.assign(w * h, kNoPrimitive);
+        local.width = int(w);
+        local.x0 = r.x0;
+        local.y0 = r.y0;
+        local.depth = scratch.depth.data();
+        local.primitive = scratch.primitive.data();
+        local.b1 = scratch.b1.data();
+        local.b2 = scratch.b2.data();
     }
     for (size_t c = 0; c < numChunks; ++c) {
         const Chunk& chunk = chunks[c];
@@ -506,10 +520,21 @@ void RasterTile(int tile, const Context& ctx, const std::vector<Chunk>& chunks, 
         for (uint32_t k = begin; k < end; ++k) {
             const TriSetup& s = chunk.setups[chunk.binned[k]];
             if (s.attr < 0)
-                RasterTriangle<kCount, false>(s, attrs, r, t);
+                RasterTriangle<kCount, false>(s, attrs, r, local);
             else
-                RasterTriangle<kCount, true>(s, attrs, r, t);
+                RasterTriangle<kCount, true>(s, attrs, r, local);
         }
+    }
+    if constexpr (!kCount) {
+        for (size_t y = 0; y < h; ++y) {
+            const size_t b = (size_t(r.y0) + y) * size_t(t.width) + size_t(r.x0);
+            StreamRow(t.depth + b, local.depth + y * w, w);
+            StreamRow(t.primitive + b, local.primitive + y * w, w);
+            StreamRow(t.b1 + b, local.b1 + y * w, w);
+            StreamRow(t.b2 + b, local.b2 + y * w, w);
+        }
+        // Streaming stores are weakly ordered: fence before the tile counts as done.
+        _mm_sfence();
     }
 }
 

@@ -2,6 +2,8 @@
 // (depth, primitive id, perspective-correct barycentrics) shared by every channel kind.
 #pragma once
 
+#include <tbb/cache_aligned_allocator.h>
+
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <memory>
@@ -45,12 +47,16 @@ struct RasterCamera {
 // vertex (indices[3t+1], indices[3t+2]); the first vertex's weight is 1 - b1 - b2. They refer
 // to the original triangle also where it was clipped. Empty samples have b1 = b2 = 0.
 struct VisibilityBuffer {
+    // Cache-line aligned, so that the rasterizer writes whole lines (see StreamRow).
+    template <class T>
+    using Plane = std::vector<T, tbb::cache_aligned_allocator<T>>;
+
     int width = 0;
     int height = 0;
-    std::vector<float> depth;
-    std::vector<uint32_t> primitive;
-    std::vector<float> b1;
-    std::vector<float> b2;
+    Plane<float> depth;
+    Plane<uint32_t> primitive;
+    Plane<float> b1;
+    Plane<float> b2;
     std::vector<uint32_t> primitiveBase;  // one per mesh of the last Render call
 
     size_t Index(int x, int y) const { return size_t(y) * size_t(width) + size_t(x); }

@@ -874,6 +874,54 @@ TEST(RasterInterpolation, SpanValuesEqualEachSamplesEdgeFunctionsBitForBit) {
 // ---------------------------------------------------------------------------------------
 // Shading helper and bad input.
 
+// A visibility buffer drawn into again holds only the new frame's triangles: a screen-filling
+// quad, then one small triangle into the same buffer (sides that are no multiple of the tile
+// size, one and two threads). Every sample centre strictly inside the triangle — its
+// hypotenuse x + y = 90.25 never passes through a centre — shows it at depth near_m / w; every
+// other sample is empty (depth 0, no primitive, barycentrics 0).
+TEST(RasterTargets, ReusedBufferHoldsOnlyTheLastFramesTriangles) {
+    const RasterCamera cam = SampleSpaceCamera(150, 97);
+    Mesh quad;
+    quad.positions = {{-10.0f, -10.0f, 0.0f},
+                      {160.0f, -10.0f, 0.0f},
+                      {160.0f, 107.0f, 0.0f},
+                      {-10.0f, 107.0f, 0.0f}};
+    quad.indices = {0, 1, 2, 0, 2, 3};
+    Mesh small;
+    small.positions = {{20.0f, 30.0f, 0.0f}, {60.25f, 30.0f, 0.0f}, {20.0f, 70.25f, 0.0f}};
+    small.indices = {0, 1, 2};
+    for (int threads : {1, 2}) {
+        SCOPED_TRACE("threads " + std::to_string(threads));
+        tbb::task_arena arena(threads);
+        Rasterizer r(32);
+        VisibilityBuffer vis;
+        const RasterMesh first[] = {quad.Raster(false)};
+        arena.execute([&] { r.Render(first, cam, vis); });
+        int uncovered = 0;
+        for (uint32_t p : vis.primitive) uncovered += p == kNoPrimitive;
+        EXPECT_EQ(uncovered, 0);
+
+        const RasterMesh second[] = {small.Raster(false)};
+        arena.execute([&] { r.Render(second, cam, vis); });
+        int inside = 0, wrong = 0;
+        for (int y = 0; y < cam.height; ++y) {
+            for (int x = 0; x < cam.width; ++x) {
+                const double cx = x + 0.5, cy = y + 0.5;
+                const bool in = cx > 20.0 && cy > 30.0 && cx + cy < 90.25;
+                const size_t i = vis.Index(x, y);
+                inside += in;
+                if (in)
+                    wrong += vis.primitive[i] != 0u || vis.depth[i] != cam.near_m;
+                else
+                    wrong += vis.primitive[i] != kNoPrimitive || vis.depth[i] != 0.0f ||
+                             vis.b1[i] != 0.0f || vis.b2[i] != 0.0f;
+            }
+        }
+        EXPECT_EQ(wrong, 0);
+        EXPECT_GT(inside, 700);  // about 40.25² / 2 ≈ 810 sample centres
+    }
+}
+
 TEST(RasterShadePass, VisitsEverySampleOnceWithItsIndex) {
     VisibilityBuffer vis;
     vis.width = 37;
