@@ -337,6 +337,13 @@ struct Targets {
     uint32_t* hits = nullptr;
 };
 
+// Span lanes: four samples' doubles (one AVX register, two SSE2 ones) and their floats.
+inline constexpr int64_t kSpanLanes = 4;
+using D4 = double __attribute__((vector_size(32)));
+using F4 = float __attribute__((vector_size(16)));
+using I4 = int32_t __attribute__((vector_size(16)));
+using U4 = uint32_t __attribute__((vector_size(16)));
+
 struct TileRect {
     int x0, y0, x1, y1;  // inclusive samples
 };
@@ -447,8 +454,49 @@ template <bool kCount, bool kClipped>
                 }
             };
             if (exactInDoubles) [[likely]] {
-                double f1 = double(e1), f2 = double(e2);
-                for (int64_t x = lo; x <= hi; ++x, f1 += step1, f2 += step2) sample(x - xo, f1, f2);
+                // kSpanLanes samples at a time: lane i holds the sample's E_1, E_2 as the scalar
+                // steps would (exact integers, so stepping by kSpanLanes steps is exact), and
+                // every operation is the scalar's, lane for lane. Lanes past the span, and
+                // samples failing the depth test, store back the values they loaded (the tile's
+                // targets are this thread's and padded past their last sample).
+                const D4 lane{0.0, 1.0, 2.0, 3.0};
+                D4 f1 = double(e1) + lane * step1, f2 = double(e2) + lane * step2;
+                const double groupStep1 = double(kSpanLanes) * step1;
+                const double groupStep2 = double(kSpanLanes) * step2;
+                const I4 primV = I4{} + int32_t(prim);
+                const I4 laneI{0, 1, 2, 3};
+                for (int64_t x = lo; x <= hi; x += kSpanLanes, f1 += groupStep1, f2 += groupStep2) {
+                    const int64_t i = x - xo;
+                    const D4 d = k0 + f1 * dc1 + f2 * dc2;
+                    const F4 depth = __builtin_convertvector(d, F4);
+                    F4 old, oldB1, oldB2;
+                    I4 oldPrim;
+                    std::memcpy(&old, depthRow + i, sizeof old);
+                    std::memcpy(&oldPrim, primRow + i, sizeof oldPrim);
+                    const I4 inSpan = laneI <= int32_t(hi - x);
+                    const I4 wins = inSpan & (depth > 0.0f) &
+                                    ((depth > old) | ((depth == old) & (U4(primV) < U4(oldPrim))));
+                    if (!_mm_movemask_ps(F4(wins))) continue;
+                    const D4 inv = 1.0 / d;
+                    F4 nb1, nb2;
+                    if constexpr (kClipped) {
+                        nb1 = __builtin_convertvector((g0 + f1 * g1 + f2 * g2) * inv, F4);
+                        nb2 = __builtin_convertvector((h0 + f1 * h1 + f2 * h2) * inv, F4);
+                    } else {
+                        nb1 = __builtin_convertvector(f1 * c1 * inv, F4);
+                        nb2 = __builtin_convertvector(f2 * c2 * inv, F4);
+                    }
+                    std::memcpy(&oldB1, b1Row + i, sizeof oldB1);
+                    std::memcpy(&oldB2, b2Row + i, sizeof oldB2);
+                    const F4 outDepth = wins ? depth : old;
+                    const I4 outPrim = wins ? primV : oldPrim;
+                    const F4 outB1 = wins ? nb1 : oldB1;
+                    const F4 outB2 = wins ? nb2 : oldB2;
+                    std::memcpy(depthRow + i, &outDepth, sizeof outDepth);
+                    std::memcpy(primRow + i, &outPrim, sizeof outPrim);
+                    std::memcpy(b1Row + i, &outB1, sizeof outB1);
+                    std::memcpy(b2Row + i, &outB2, sizeof outB2);
+                }
             } else {
                 for (int64_t x = lo; x <= hi; ++x, e1 += stepX[1], e2 += stepX[2])
                     sample(x - xo, double(e1), double(e2));
@@ -500,10 +548,12 @@ void RasterTile(int tile, const Context& ctx, const std::vector<Chunk>& chunks, 
             std::fill_n(t.hits + size_t(y) * size_t(t.width) + size_t(r.x0), w, 0u);
         local = t;
     } else {
-        scratch.depth.assign(w * h, 0.0f);
-        scratch.b1.assign(w * h, 0.0f);
-        scratch.b2.assign(w * h, 0.0f);
-        scratch.primitive.assign(w * h, kNoPrimitive);
+        // Padded by kSpanLanes - 1 samples for the span's last lane group.
+        const size_t padded = w * h + size_t(kSpanLanes - 1);
+        scratch.depth.assign(padded, 0.0f);
+        scratch.b1.assign(padded, 0.0f);
+        scratch.b2.assign(padded, 0.0f);
+        scratch.primitive.assign(padded, kNoPrimitive);
         local.width = int(w);
         local.x0 = r.x0;
         local.y0 = r.y0;
