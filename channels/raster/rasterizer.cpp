@@ -21,6 +21,7 @@
 #include "scene/core/check.h"
 #include "scene/core/error.h"
 #include "scene/core/simd_lanes.h"
+#include "scene/core/stream_store.h"
 
 namespace seasense::channels {
 namespace {
@@ -505,26 +506,6 @@ template <bool kCount, bool kClipped>
     }
 }
 
-// Copies n 4-byte values to dst with non-temporal stores where dst is 16-byte aligned: the
-// frame's targets are far larger than the caches, and streaming stores write whole lines
-// without first reading them (Intel 64 and IA-32 Architectures Optimization Reference Manual,
-// "Non-temporal stores"); the ends that share a line with a neighbouring tile use plain stores.
-template <class T>
-void StreamRow(T* __restrict dst, const T* __restrict src, size_t n) {
-    static_assert(sizeof(T) == 4);
-    size_t i = 0;
-    for (; i < n && (reinterpret_cast<uintptr_t>(dst + i) & 63) != 0; ++i) dst[i] = src[i];
-    for (; i + 16 <= n; i += 16) {
-        __m128i* d = reinterpret_cast<__m128i*>(dst + i);
-        const __m128i* q = reinterpret_cast<const __m128i*>(src + i);
-        _mm_stream_si128(d, _mm_loadu_si128(q));
-        _mm_stream_si128(d + 1, _mm_loadu_si128(q + 1));
-        _mm_stream_si128(d + 2, _mm_loadu_si128(q + 2));
-        _mm_stream_si128(d + 3, _mm_loadu_si128(q + 3));
-    }
-    for (; i < n; ++i) dst[i] = src[i];
-}
-
 // One tile's targets while it is drawn: small enough to stay in the core's cache.
 struct TileTargets {
     std::vector<float> depth, b1, b2;
@@ -548,12 +529,28 @@ void RasterTile(int tile, const Context& ctx, const std::vector<Chunk>& chunks, 
             std::fill_n(t.hits + size_t(y) * size_t(t.width) + size_t(r.x0), w, 0u);
         local = t;
     } else {
-        // Padded by kSpanLanes - 1 samples for the span's last lane group.
-        const size_t padded = w * h + size_t(kSpanLanes - 1);
-        scratch.depth.assign(padded, 0.0f);
-        scratch.b1.assign(padded, 0.0f);
-        scratch.b2.assign(padded, 0.0f);
-        scratch.primitive.assign(padded, kNoPrimitive);
+        // Padded for the span's last lane group, and to whole simd::kLanes for the clear.
+        const size_t padded =
+            (w * h + size_t(kSpanLanes - 1) + simd::kLanes - 1) / simd::kLanes * simd::kLanes;
+        if (scratch.depth.size() < padded) {
+            scratch.depth.resize(padded);
+            scratch.b1.resize(padded);
+            scratch.b2.resize(padded);
+            scratch.primitive.resize(padded);
+        }
+        // Plain vector stores: the compiler would make each fill a memset call, whose
+        // `rep stosb` valgrind counts byte by byte, hiding the rest of a profile.
+        float zero = 0.0f;
+        uint32_t empty = kNoPrimitive;
+        asm("" : "+r"(zero), "+r"(empty));
+        const simd::VF zeros = simd::Splat(zero);
+        const simd::VI empties = simd::VI{} + int32_t(empty);
+        for (size_t i = 0; i < padded; i += simd::kLanes) {
+            std::memcpy(scratch.depth.data() + i, &zeros, sizeof zeros);
+            std::memcpy(scratch.primitive.data() + i, &empties, sizeof empties);
+            std::memcpy(scratch.b1.data() + i, &zeros, sizeof zeros);
+            std::memcpy(scratch.b2.data() + i, &zeros, sizeof zeros);
+        }
         local.width = int(w);
         local.x0 = r.x0;
         local.y0 = r.y0;
@@ -578,13 +575,12 @@ void RasterTile(int tile, const Context& ctx, const std::vector<Chunk>& chunks, 
     if constexpr (!kCount) {
         for (size_t y = 0; y < h; ++y) {
             const size_t b = (size_t(r.y0) + y) * size_t(t.width) + size_t(r.x0);
-            StreamRow(t.depth + b, local.depth + y * w, w);
-            StreamRow(t.primitive + b, local.primitive + y * w, w);
-            StreamRow(t.b1 + b, local.b1 + y * w, w);
-            StreamRow(t.b2 + b, local.b2 + y * w, w);
+            simd::StreamCopy(t.depth + b, local.depth + y * w, w);
+            simd::StreamCopy(t.primitive + b, local.primitive + y * w, w);
+            simd::StreamCopy(t.b1 + b, local.b1 + y * w, w);
+            simd::StreamCopy(t.b2 + b, local.b2 + y * w, w);
         }
-        // Streaming stores are weakly ordered: fence before the tile counts as done.
-        _mm_sfence();
+        simd::StreamFence();
     }
 }
 

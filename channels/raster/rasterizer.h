@@ -47,7 +47,7 @@ struct RasterCamera {
 // vertex (indices[3t+1], indices[3t+2]); the first vertex's weight is 1 - b1 - b2. They refer
 // to the original triangle also where it was clipped. Empty samples have b1 = b2 = 0.
 struct VisibilityBuffer {
-    // Cache-line aligned, so that the rasterizer writes whole lines (see StreamRow).
+    // Cache-line aligned, so that the rasterizer writes whole lines (see simd::StreamCopy).
     template <class T>
     using Plane = std::vector<T, tbb::cache_aligned_allocator<T>>;
 
