@@ -25,7 +25,6 @@
 #include "scene/core/check.h"
 #include "scene/core/simd4.h"
 #include "scene/core/simd_lanes.h"
-#include "scene/core/stream_store.h"
 
 namespace seasense::channels {
 
@@ -356,7 +355,6 @@ struct BlockScratch {
     // originOwner: model entry index, or kSeaOwner | sea entry index.
     std::vector<uint32_t> originOwner;
     std::vector<uint8_t> vis;
-    std::vector<float> out;  // the block's radiance samples (rgb), before they go to the image
     size_t skyCount = 0, seaCount = 0;
     SeaChunk chunk{};  // zeroed: lanes past a chunk's end are computed, then dropped
     // Triangles met, direct-mapped by primitive id and tagged with the frame: neighbouring
@@ -1409,12 +1407,8 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
             for (int py = py0; py < py1; ++py) classify.Pixels(py, span(py).begin, span(py).end);
         }
         blockRays[size_t(block)] = TraceSunVisibility(f, n, s);
-        // The block is shaded into s.out, which stays in cache, then streamed to the image,
-        // whose rows are contiguous (sample k of the block is at out + 3k in both): every
-        // sample of the block is written.
-        const size_t blockValues = 3 * size_t(py1 - py0) * size_t(n) * size_t(sw);
-        s.out.resize(blockValues);
-        float* out = s.out.data();
+        // The block's rows are contiguous in the image: sample k is at out + 3k.
+        float* out = radiance.At(0, py0 * n);
         ShadeSky(f, g, s, out);
         ShadeSea(f, g, s, out);
         ShadeModels(f, g, s, out);
@@ -1422,12 +1416,10 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
         if (!renderSpans_.empty())
             for (int py = py0; py < py1; ++py)
                 for (int j = 0; j < n; ++j) {
-                    float* row = out + 3 * size_t((py - py0) * n + j) * size_t(sw);
+                    float* row = radiance.At(0, py * n + j);
                     std::fill(row, row + size_t(3 * n * span(py).begin), 0.0f);
                     std::fill(row + size_t(3 * n * span(py).end), row + size_t(3 * sw), 0.0f);
                 }
-        simd::StreamCopy(radiance.At(0, py0 * n), out, blockValues);
-        simd::StreamFence();
     });
     for (uint64_t r : blockRays) stats_.shadowRays += r;
     stats_.shadeMs = Ms(t2, Clock::now());

@@ -545,12 +545,6 @@ void RasterTile(int tile, const Context& ctx, const std::vector<Chunk>& chunks, 
         asm("" : "+r"(zero), "+r"(empty));
         const simd::VF zeros = simd::Splat(zero);
         const simd::VI empties = simd::VI{} + int32_t(empty);
-        for (size_t i = 0; i < padded; i += simd::kLanes) {
-            std::memcpy(scratch.depth.data() + i, &zeros, sizeof zeros);
-            std::memcpy(scratch.primitive.data() + i, &empties, sizeof empties);
-            std::memcpy(scratch.b1.data() + i, &zeros, sizeof zeros);
-            std::memcpy(scratch.b2.data() + i, &zeros, sizeof zeros);
-        }
         local.width = int(w);
         local.x0 = r.x0;
         local.y0 = r.y0;
@@ -558,6 +552,16 @@ void RasterTile(int tile, const Context& ctx, const std::vector<Chunk>& chunks, 
         local.primitive = scratch.primitive.data();
         local.b1 = scratch.b1.data();
         local.b2 = scratch.b2.data();
+        float* __restrict depth = local.depth;
+        uint32_t* __restrict primitive = local.primitive;
+        float* __restrict b1 = local.b1;
+        float* __restrict b2 = local.b2;
+        for (size_t i = 0; i < padded; i += simd::kLanes) {
+            std::memcpy(depth + i, &zeros, sizeof zeros);
+            std::memcpy(primitive + i, &empties, sizeof empties);
+            std::memcpy(b1 + i, &zeros, sizeof zeros);
+            std::memcpy(b2 + i, &zeros, sizeof zeros);
+        }
     }
     for (size_t c = 0; c < numChunks; ++c) {
         const Chunk& chunk = chunks[c];
