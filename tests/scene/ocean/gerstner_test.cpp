@@ -33,6 +33,17 @@ OceanSettings WithShortWave(OceanSettings s) {
     return s;
 }
 
+// visit(x, y) at the centre (cx, cy) and at `spokes` points on each of `rings` circles out to
+// radius r.
+template <class Visit>
+void ForEachPointInDisc(double cx, double cy, double r, int rings, int spokes, const Visit& visit) {
+    for (int i = 0; i <= rings; ++i)
+        for (int j = 0; j < (i == 0 ? 1 : spokes); ++j) {
+            const double rho = r * i / rings, a = 2.0 * M_PI * j / spokes;
+            visit(cx + rho * std::cos(a), cy + rho * std::sin(a));
+        }
+}
+
 // Position of the crest nearest x_guess along a wave travelling east (+x), by golden-section
 // search on the drawn height.
 double CrestX(const GerstnerOcean& o, double xGuess, double halfWidth, double t) {
@@ -63,14 +74,11 @@ TEST(Gerstner, ElevationNearADiscBoundsEveryPointInIt) {
                 const double bound = o.MaxElevationNear_m(cx, cy, r, t);
                 EXPECT_LE(bound, o.MaxAmplitude_m());
                 double highest = -1.0;
-                for (int i = 0; i <= 40; ++i)
-                    for (int j = 0; j < (i == 0 ? 1 : 144); ++j) {
-                        const double rho = r * i / 40.0, a = 2.0 * M_PI * j / 144.0;
-                        const double x = cx + rho * std::cos(a), y = cy + rho * std::sin(a);
-                        const SurfaceTerms terms = o.Terms(x, y, t);
-                        highest = std::max(highest, terms.displacement.z);
-                        EXPECT_LE(terms.displacement.z, bound + 1e-12) << f << " " << r;
-                    }
+                ForEachPointInDisc(cx, cy, r, 40, 144, [&](double x, double y) {
+                    const SurfaceTerms terms = o.Terms(x, y, t);
+                    highest = std::max(highest, terms.displacement.z);
+                    EXPECT_LE(terms.displacement.z, bound + 1e-12) << f << " " << r;
+                });
                 if (s.waves.size() == 1) {
                     // The margin moves the phase by 0.01 rad (≤ 0.005 m at A = 0.5 m).
                     EXPECT_LE(bound, std::max(highest, 0.0) + 0.006) << f << " " << r;
@@ -104,16 +112,13 @@ TEST(Gerstner, SignedElevationBoundHoldsForEveryFootprintUpToTheLargest) {
                     const double bound = o.ElevationBoundNear_m(cx, cy, r, t, maxFootprint);
                     EXPECT_LE(bound, o.MaxElevationNear_m(cx, cy, r, t));
                     double highest = -1.0;
-                    for (int i = 0; i <= 20; ++i)
-                        for (int j = 0; j < (i == 0 ? 1 : 72); ++j) {
-                            const double rho = r * i / 20.0, a = 2.0 * M_PI * j / 72.0;
-                            const double x = cx + rho * std::cos(a), y = cy + rho * std::sin(a);
-                            for (const double fp : {0.0, 0.5 * maxFootprint, maxFootprint}) {
-                                const double z = o.Terms(x, y, t, fp).displacement.z;
-                                highest = std::max(highest, z);
-                                EXPECT_LE(z, bound + 1e-12) << f << " " << r << " " << fp;
-                            }
+                    ForEachPointInDisc(cx, cy, r, 20, 72, [&](double x, double y) {
+                        for (const double fp : {0.0, 0.5 * maxFootprint, maxFootprint}) {
+                            const double z = o.Terms(x, y, t, fp).displacement.z;
+                            highest = std::max(highest, z);
+                            EXPECT_LE(z, bound + 1e-12) << f << " " << r << " " << fp;
                         }
+                    });
                     if (s.waves.size() == 1) {
                         EXPECT_LE(bound, highest + 0.006) << f << " " << r;
                         if (bound < -0.1) ++negative;

@@ -340,6 +340,14 @@ TEST(OceanMesh, SurfVertexHeightsMatchTheQueryAtThatPoint) {
     EXPECT_LT(worst, 1e-4);
 }
 
+// Rest position of mesh vertex v on ring j.
+glm::dvec2 RestPosition(const OceanMesh& m, const glm::dvec3& eye, int j, uint32_t v) {
+    const int64_t column = m.ringFirstColumn[size_t(j)] +
+                           int64_t(v - m.ringStart[size_t(j)]) * m.ringStride[size_t(j)];
+    const double az = 2.0 * kPi * double(column) / m.circleSegments, r = m.radii_m[size_t(j)];
+    return {eye.x + r * std::sin(az), eye.y + r * std::cos(az)};
+}
+
 // The bounds near a point that cull the sea nearest a view (OceanSurfaceFrame::LocalBoundsNear)
 // hold at every vertex the mesh draws from a rest position inside the disc (whatever mip level
 // and Gerstner footprint weights its ring uses) and at the unfiltered surface there, over many
@@ -378,12 +386,8 @@ TEST(OceanMesh, LocalBoundsHoldAtEveryVertexDrawnFromTheDisc) {
                         const double drop = CurvatureDrop_m(rho);
                         for (uint32_t v = m.ringStart[size_t(j)]; v < m.ringStart[size_t(j) + 1];
                              ++v) {
-                            const int64_t column =
-                                m.ringFirstColumn[size_t(j)] +
-                                int64_t(v - m.ringStart[size_t(j)]) * m.ringStride[size_t(j)];
-                            const double az = 2.0 * kPi * double(column) / m.circleSegments;
-                            const double x0 = eye.x + rho * std::sin(az),
-                                         y0 = eye.y + rho * std::cos(az);
+                            const glm::dvec2 rest = RestPosition(m, eye, j, v);
+                            const double x0 = rest.x, y0 = rest.y;
                             const glm::dvec3 p(m.positions[v]);
                             EXPECT_LE(p.z + drop, b.height_m) << surf << " " << cx << " " << r;
                             EXPECT_LE(std::hypot(p.x - x0, p.y - y0), b.horizontal_m + 1e-3)
@@ -406,14 +410,6 @@ TEST(OceanMesh, LocalBoundsHoldAtEveryVertexDrawnFromTheDisc) {
             EXPECT_GT(tighterInFade, fadeDiscs / 2) << fadeDiscs;
         }
     }
-}
-
-// Rest position of mesh vertex v on ring j.
-glm::dvec2 RestPosition(const OceanMesh& m, const glm::dvec3& eye, int j, uint32_t v) {
-    const int64_t column = m.ringFirstColumn[size_t(j)] +
-                           int64_t(v - m.ringStart[size_t(j)]) * m.ringStride[size_t(j)];
-    const double az = 2.0 * kPi * double(column) / m.circleSegments, r = m.radii_m[size_t(j)];
-    return {eye.x + r * std::sin(az), eye.y + r * std::cos(az)};
 }
 
 // The bounds over small discs for the largest footprint of the rings there (signed Gerstner
@@ -629,12 +625,8 @@ TEST(OceanMesh, ShortcutsAreTheWholePathBitForBit) {
                 std::any_of(weights.begin(), weights.end(), [](float w) { return w > 0.0f; });
             ++(weighted ? gerstner : noGerstner);
             for (uint32_t i = 0; shore && i < n; ++i) {
-                const int64_t c =
-                    fast.ringFirstColumn[size_t(j)] + int64_t(i) * fast.ringStride[size_t(j)];
-                const double az = 2.0 * kPi * double(c) / fast.circleSegments;
-                const double r = fast.radii_m[size_t(j)];
-                const glm::dvec2 rest(req.eye_m.x + r * std::sin(az),
-                                      req.eye_m.y + r * std::cos(az));
+                const glm::dvec2 rest =
+                    RestPosition(fast, req.eye_m, j, fast.ringStart[size_t(j)] + i);
                 ++(shore->ShoreFromWorld(rest.x, rest.y).s_m >= frame.OpenSeaFrom_m() ? open
                                                                                       : surfPath);
             }
