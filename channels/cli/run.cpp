@@ -286,8 +286,8 @@ int RunHost(const RunOptions& opt) {
         video = std::make_unique<sync::MosaicVideo>(outDir / "mosaic.mp4", tiles, fps);
     }
     StreamedFile csv(outDir / "sync.csv");
-    csv.Out()
-        << "frame,channel,time_utc,publish_ns,start_ns,done_ns,present_ns,render_ms,wait_us\n";
+    csv.Out() << "frame,channel,time_utc,publish_ns,start_ns,done_ns,present_ns,render_ms,cpu_ms,"
+                 "wait_us\n";
 
     const int64_t periodNs = opt.rate_hz > 0.0 ? int64_t(std::llround(1e9 / opt.rate_hz)) : 0;
     int64_t runStartNs = 0, lastPresentNs = 0, firstPresentNs = 0;
@@ -307,7 +307,8 @@ int RunHost(const RunOptions& opt) {
     };
 
     std::vector<double> skewUs, waitUs, frameMs;
-    std::vector<std::vector<double>> renderMs(channelCount);
+    std::vector<std::vector<double>> renderMs(channelCount), cpuMs(channelCount);
+    std::vector<double> frameCpuMs;  // per frame, summed over the channels
     int64_t overruns = 0, completed = 0;
     std::string status = "complete";
     int exitStatus = 0;
@@ -336,6 +337,10 @@ int RunHost(const RunOptions& opt) {
         for (uint32_t c = 0; c < channelCount; ++c)
             render[spec.channelNames[c]] = Stats(renderMs[c]);
         doc["render_ms"] = render;
+        nlohmann::json cpu;
+        for (uint32_t c = 0; c < channelCount; ++c) cpu[spec.channelNames[c]] = Stats(cpuMs[c]);
+        doc["cpu_ms"] = cpu;
+        doc["frame_cpu_ms"] = Stats(frameCpuMs);
         doc["threads_per_channel"] = spec.threadsPerChannel;
         doc["hardware_threads"] = std::thread::hardware_concurrency();
         sensors::WriteTextFileAtomic(outDir / "summary.json", doc.dump(2) + "\n");
@@ -386,6 +391,7 @@ int RunHost(const RunOptions& opt) {
         const sync::StateSlot& st = header.slots[slot];
         int64_t minPresent = INT64_MAX, maxPresent = INT64_MIN;
         std::vector<const uint8_t*> images(channelCount, nullptr);
+        double frameCpu = 0.0;
         const std::string utc = scene::FormatIso8601(scenario.world.start.PlusSeconds(
             double(st.frame) * scenario.world.timeScale / scenario.world.frameRate_hz));
         for (uint32_t c = 0; c < channelCount; ++c) {
@@ -395,13 +401,15 @@ int RunHost(const RunOptions& opt) {
             maxPresent = std::max(maxPresent, t.presentNs);
             const auto rel = [&](int64_t ns) { return ns - header.startNs; };
             char row[512];
-            std::snprintf(row, sizeof row, "%lld,%s,%s,%lld,%lld,%lld,%lld,%.3f,%.1f\n",
+            std::snprintf(row, sizeof row, "%lld,%s,%s,%lld,%lld,%lld,%lld,%.3f,%.3f,%.1f\n",
                           (long long)st.frame, header.channels[c].name, utc.c_str(),
                           (long long)rel(st.publishNs), (long long)rel(t.startNs),
                           (long long)rel(t.doneNs), (long long)rel(t.presentNs), t.renderMs,
-                          t.waitUs);
+                          t.cpuMs, t.waitUs);
             csv.Out() << row;
             renderMs[c].push_back(t.renderMs);
+            cpuMs[c].push_back(t.cpuMs);
+            frameCpu += t.cpuMs;
             waitUs.push_back(t.waitUs);
             int w = 0, h = 0;
             sync::MosaicPreviewSize(scenario.channels[c].width, scenario.channels[c].height, w, h);
@@ -410,6 +418,7 @@ int RunHost(const RunOptions& opt) {
                 images[c] = segment.ImageBytes(int(c), slot);
         }
         csv.Out().flush();
+        frameCpuMs.push_back(frameCpu);
         skewUs.push_back(double(maxPresent - minPresent) * 1e-3);
         if (periodNs > 0 && maxPresent > runStartNs + int64_t(i + 1) * periodNs) ++overruns;
         frameMs.push_back(double(maxPresent - lastPresentNs) * 1e-6);
@@ -453,9 +462,11 @@ int RunHost(const RunOptions& opt) {
     std::fprintf(
         stderr,
         "seasense: %lld frames of %u channels in %.2f s (%.2f fps; %.2f fps after the "
-        "first frame), skew p99 %.0f us; start-up %.2f s\n",
+        "first frame), skew p99 %.0f us, renderers' CPU %.1f ms per frame (median); start-up "
+        "%.2f s\n",
         (long long)completed, channelCount, wall_s, wall_s > 0 ? double(completed) / wall_s : 0.0,
-        SteadyFps(completed, firstPresentNs, lastPresentNs), Percentile(skewUs, 99), startup_s);
+        SteadyFps(completed, firstPresentNs, lastPresentNs), Percentile(skewUs, 99),
+        Percentile(frameCpuMs, 50), startup_s);
     return exitStatus;
 }
 
@@ -553,6 +564,7 @@ int RunChannelRenderer(const ChannelOptions& opt) {
         item.index = i;
         item.timing.frame = frame;
         item.timing.startNs = sync::MonotonicNs();
+        const int64_t cpuStartNs = sync::ProcessCpuNs();
         const sync::StateSlotContents slot = sync::DecodeStateSlot(stateBytes, n);
         const scene::FrameState& state = slot.state;
         FrameRecord rec;
@@ -563,6 +575,7 @@ int RunChannelRenderer(const ChannelOptions& opt) {
         });
         item.timing.doneNs = sync::MonotonicNs();
         item.timing.renderMs = double(item.timing.doneNs - item.timing.startNs) * 1e-6;
+        item.timing.cpuMs = double(sync::ProcessCpuNs() - cpuStartNs) * 1e-6;
         if (copyImages) {
             item.timing.imageWidth = uint32_t(previewW);
             item.timing.imageHeight = uint32_t(previewH);

@@ -115,6 +115,12 @@ int64_t MonotonicNs() {
     return int64_t(ts.tv_sec) * 1000000000 + ts.tv_nsec;
 }
 
+int64_t ProcessCpuNs() {
+    timespec ts{};
+    ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return int64_t(ts.tv_sec) * 1000000000 + ts.tv_nsec;
+}
+
 bool ProcessExists(int pid) {
     if (pid <= 0) return false;
     return ::kill(pid, 0) == 0 || errno != ESRCH;

@@ -15,7 +15,7 @@ inline constexpr uint64_t kSegmentMagic = 0x31304d4853414553ull;
 // Bumped whenever the layout below or the protocol over it changes; a segment of another
 // version is refused. 4: renderers render ahead, the barrier reads each channel's counters.
 // 5: a state slot also carries the sea's synthesized fields (sync::EncodeStateSlot).
-inline constexpr uint32_t kLayoutVersion = 5;
+inline constexpr uint32_t kLayoutVersion = 6;
 inline constexpr int kMaxChannels = 16;
 // State slots: the host publishes frame n+1 while channels may still present frame n, and
 // never writes the slot of frame n+2 before every channel has presented frame n.
@@ -47,7 +47,10 @@ struct FrameTiming {
     int64_t doneNs = 0;     // rendering and sensor model finished
     int64_t presentNs = 0;  // every channel finished: this channel presents
     double renderMs = 0.0;  // render + sensor model
-    double waitUs = 0.0;    // waiting at the frame-lock barrier (done → present)
+    // CPU time the renderer process used from startNs to doneNs (all its threads): what the
+    // frame cost the machine, where renderMs also counts time other processes held the cores.
+    double cpuMs = 0.0;
+    double waitUs = 0.0;  // waiting at the frame-lock barrier (done → present)
     uint32_t imageWidth = 0, imageHeight = 0, imageChannels = 0;  // display image in the slot
     uint32_t imageBytes = 0;
 };
@@ -169,6 +172,9 @@ std::vector<std::string> RemoveStaleSegments();
 
 // CLOCK_MONOTONIC in nanoseconds.
 int64_t MonotonicNs();
+
+// CPU time this process has used, all its threads (CLOCK_PROCESS_CPUTIME_ID), in nanoseconds.
+int64_t ProcessCpuNs();
 
 // True if a process with this pid exists (kill(pid, 0) does not fail with ESRCH).
 bool ProcessExists(int pid);

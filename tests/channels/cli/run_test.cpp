@@ -82,7 +82,7 @@ struct CsvRow {
     int64_t frame;
     std::string channel, utc;
     int64_t publish, start, done, present;
-    double renderMs, waitUs;
+    double renderMs, cpuMs, waitUs;
 };
 
 std::vector<CsvRow> ReadSyncCsv(const fs::path& p) {
@@ -90,14 +90,16 @@ std::vector<CsvRow> ReadSyncCsv(const fs::path& p) {
     std::string line;
     std::getline(in, line);
     EXPECT_EQ(line,
-              "frame,channel,time_utc,publish_ns,start_ns,done_ns,present_ns,render_ms,wait_us");
+              "frame,channel,time_utc,publish_ns,start_ns,done_ns,present_ns,render_ms,cpu_ms,"
+              "wait_us");
     std::vector<CsvRow> rows;
     while (std::getline(in, line)) {
         std::stringstream ss(line);
-        std::string f[9];
+        std::string f[10];
         for (std::string& x : f) std::getline(ss, x, ',');
         rows.push_back({std::stoll(f[0]), f[1], f[2], std::stoll(f[3]), std::stoll(f[4]),
-                        std::stoll(f[5]), std::stoll(f[6]), std::stod(f[7]), std::stod(f[8])});
+                        std::stoll(f[5]), std::stoll(f[6]), std::stod(f[7]), std::stod(f[8]),
+                        std::stod(f[9])});
     }
     return rows;
 }
@@ -143,10 +145,14 @@ TEST(Run, WritesImagesSyncLogMosaicAndSummaryUnderTheFrameLock) {
     ASSERT_EQ(byFrame.size(), 6u);
     int64_t previousLatestDone = INT64_MIN;
     std::map<std::string, int64_t> previousPresent;
+    std::vector<double> frameCpuMs;
     for (auto& [frame, rs] : byFrame) {
         ASSERT_EQ(rs.size(), kChannels.size()) << "frame " << frame;
         int64_t latestDone = INT64_MIN, earliestPresent = INT64_MAX;
+        double cpuMs = 0.0;
         for (const CsvRow& row : rs) {
+            EXPECT_GT(row.cpuMs, 0.0) << row.channel << " frame " << frame;
+            cpuMs += row.cpuMs;
             EXPECT_LE(row.publish, row.start);
             EXPECT_LE(row.start, row.done);
             EXPECT_LE(row.done, row.present);
@@ -161,6 +167,7 @@ TEST(Run, WritesImagesSyncLogMosaicAndSummaryUnderTheFrameLock) {
         }
         // Nobody presents before everyone is done: the lock.
         EXPECT_GE(earliestPresent, latestDone) << "frame " << frame;
+        frameCpuMs.push_back(cpuMs);
         previousLatestDone = latestDone;
     }
 
@@ -187,6 +194,13 @@ TEST(Run, WritesImagesSyncLogMosaicAndSummaryUnderTheFrameLock) {
     EXPECT_NEAR(summary["steady_fps"].get<double>(),
                 5.0 / (double(lastLatest - firstLatest) * 1e-9), 1e-9);
     EXPECT_GE(summary["skew_us"]["max"].get<double>(), summary["skew_us"]["p50"].get<double>());
+    // frame_cpu_ms: the channels' CPU times summed per frame (the log rounds each to 1 µs).
+    double meanFrameCpuMs = 0.0;
+    for (double v : frameCpuMs) meanFrameCpuMs += v / double(frameCpuMs.size());
+    EXPECT_NEAR(summary["frame_cpu_ms"]["mean"].get<double>(), meanFrameCpuMs,
+                0.5e-3 * double(kChannels.size()));
+    for (const std::string& ch : kChannels)
+        EXPECT_GT(summary["cpu_ms"][ch]["p50"].get<double>(), 0.0) << ch;
 
     cv::VideoCapture video((out / "mosaic.mp4").string());
     ASSERT_TRUE(video.isOpened());
@@ -200,6 +214,37 @@ TEST(Run, WritesImagesSyncLogMosaicAndSummaryUnderTheFrameLock) {
     EXPECT_EQ(frames, 6);
     for (const auto& e : fs::directory_iterator(out))
         EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
+    fs::remove_all(out);
+}
+
+// cpu_ms is CPU time: each channel's lies inside its own start … done, so all of a frame's
+// inside the frame's window from the earliest start to the latest done, and the renderers
+// cannot have used more CPU there than the machine's cores give (+1 ms for the clocks'
+// accounting). The default's five renderers share the cores, so their wall times (render_ms)
+// add up to more than that.
+TEST(Run, ChannelCpuTimesFitTheCoresInEachFrame) {
+    const fs::path out = TempDir("cpu");
+    const auto r = Shell(kBinary + " run --config " + std::string(SEASENSE_SOURCE_DIR) +
+                         "/configs/five-channel.yaml --frames 3 --no-images --no-video --out " +
+                         out.string() + " --run-id " + RunId("cpu"));
+    ASSERT_EQ(r.status, 0) << r.output;
+    std::map<int64_t, std::vector<CsvRow>> byFrame;
+    for (const CsvRow& row : ReadSyncCsv(out / "sync.csv")) byFrame[row.frame].push_back(row);
+    ASSERT_EQ(byFrame.size(), 3u);
+    const double cores = std::max(1u, std::thread::hardware_concurrency());
+    for (const auto& [frame, rs] : byFrame) {
+        ASSERT_EQ(rs.size(), 5u);
+        int64_t earliestStart = INT64_MAX, latestDone = INT64_MIN;
+        double cpuMs = 0.0;
+        for (const CsvRow& row : rs) {
+            earliestStart = std::min(earliestStart, row.start);
+            latestDone = std::max(latestDone, row.done);
+            cpuMs += row.cpuMs;
+            EXPECT_GT(row.cpuMs, 0.0) << row.channel << " frame " << frame;
+        }
+        EXPECT_LE(cpuMs, cores * double(latestDone - earliestStart) * 1e-6 + 1.0)
+            << "frame " << frame;
+    }
     fs::remove_all(out);
 }
 
