@@ -15,6 +15,7 @@ inline constexpr uint64_t kSegmentMagic = 0x31304d4853414553ull;
 // Bumped whenever the layout below or the protocol over it changes; a segment of another
 // version is refused. 4: renderers render ahead, the barrier reads each channel's counters.
 // 5: a state slot also carries the sea's synthesized fields (sync::EncodeStateSlot).
+// 6: a channel's timing record also carries its renderer's CPU time (FrameTiming::cpuMs).
 inline constexpr uint32_t kLayoutVersion = 6;
 inline constexpr int kMaxChannels = 16;
 // State slots: the host publishes frame n+1 while channels may still present frame n, and
