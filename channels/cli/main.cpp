@@ -78,7 +78,9 @@ int main(int argc, char** argv) {
         "run",
         "Frame-locked multi-channel run: a host process advances the scene and publishes each\n"
         "frame's state in shared memory; one renderer process per channel renders it. Writes\n"
-        "DIR/<channel>/ images, DIR/sync.csv, DIR/mosaic.mp4 and DIR/summary.json.");
+        "DIR/<channel>/ images, DIR/sync.csv (per channel and frame: timestamps, render_ms\n"
+        "wall time, cpu_ms the renderer's CPU time, wait_us at the barrier), DIR/mosaic.mp4\n"
+        "and DIR/summary.json.");
     runCmd->add_option("--config", run.config, "Scenario YAML file")
         ->capture_default_str()
         ->default_val(seasense::channels::DefaultRunConfig().string());
