@@ -134,10 +134,12 @@ class SurfWaves {
     // Which points Terms describes the dominant component at (SurfPointInfo::direction_rad,
     // phaseSpeed_mps, groupSpeed_mps, phase_rad): everywhere, or only shoreward of the breaker
     // line (breaking.broken), the one place the surf foam reads them (SurfFoamCoverage's streaks
-    // follow the broken water); elsewhere they are left 0, saving an atan2 and an fmod per point.
+    // follow the broken water); elsewhere they are left 0, saving an atan2 and an fmod per point,
+    // and breaking.timeSinceBreaking_s is left −1 there (the foam reads it only where broken),
+    // saving a table lookup.
     enum class Dominant { kEverywhere, kWhereBroken };
     // What a caller that needs less than everything (the mesh) can leave out or hand in. None of
-    // it changes a bit of what is computed.
+    // it changes a bit of the terms, nor of what the surf foam reads.
     struct TermsOptions {
         bool velocity = true;  // false: velocity_mps left 0 (three sums fewer per component)
         Dominant dominant = Dominant::kEverywhere;

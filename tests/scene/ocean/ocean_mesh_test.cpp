@@ -520,13 +520,13 @@ TEST(OceanMesh, DryLandShortcutIsTheFullEvaluationBitForBit) {
 
 TEST(OceanMesh, SurfTermsOptionsOfTheMeshChangeNothingItUses) {
     // The mesh asks SurfWaves::Terms for less (TermsOptions: no velocity, the dominant component
-    // only where the water has broken, no variance shares) and hands in the seabed that
-    // DryLandSums looked up.
+    // and the breaking travel time only where the water has broken, no variance shares) and
+    // hands in the seabed that DryLandSums looked up.
     // Against the full evaluation, across the barred beach of configs/surf.yaml from beyond the
     // fade onto the dry sand at three times: DryLandSums' seabed is the point's seabedZ_m, the
     // terms other than the velocity and everything else in the point's information are the same
-    // bits, the dominant component is the same where broken, and the surf foam coverage is the
-    // same everywhere.
+    // bits, the dominant component and the travel time are the same where broken (the travel
+    // time −1 elsewhere), and the surf foam coverage is the same everywhere.
     const Scenario sc =
         LoadScenario(std::filesystem::path(SEASENSE_SOURCE_DIR) / "configs/surf.yaml");
     const OceanSurface sea(sc.environment.ocean);
@@ -553,24 +553,27 @@ TEST(OceanMesh, SurfTermsOptionsOfTheMeshChangeNothingItUses) {
                 ASSERT_EQ(b.velocity_mps, glm::dvec3(0.0));
                 b.velocity_mps = a.velocity_mps;
                 ASSERT_EQ(std::memcmp(&a, &b, sizeof(a)), 0) << x << " " << y << " " << t;
-                ASSERT_TRUE(
-                    same(all.depth_m, lazy.depth_m) && same(all.envelope_m, lazy.envelope_m) &&
-                    same(all.unbrokenHeight_m, lazy.unbrokenHeight_m) &&
-                    same(all.breaking.intensity, lazy.breaking.intensity) &&
-                    all.breaking.broken == lazy.breaking.broken &&
-                    same(all.breaking.timeSinceBreaking_s, lazy.breaking.timeSinceBreaking_s) &&
-                    all.weights.cascade == lazy.weights.cascade &&
-                    same(all.weights.gerstner, lazy.weights.gerstner));
+                ASSERT_TRUE(same(all.depth_m, lazy.depth_m) &&
+                            same(all.envelope_m, lazy.envelope_m) &&
+                            same(all.unbrokenHeight_m, lazy.unbrokenHeight_m) &&
+                            same(all.breaking.intensity, lazy.breaking.intensity) &&
+                            all.breaking.broken == lazy.breaking.broken &&
+                            all.weights.cascade == lazy.weights.cascade &&
+                            same(all.weights.gerstner, lazy.weights.gerstner));
                 // The variance shares are left at their defaults (the foam below ignores them).
                 ASSERT_TRUE(same(lazy.surfWeight, 0.0) && same(lazy.deepWeight, 1.0));
                 if (all.breaking.broken) {
                     ++broken;
-                    ASSERT_TRUE(same(all.direction_rad, lazy.direction_rad) &&
-                                same(all.groupSpeed_mps, lazy.groupSpeed_mps) &&
-                                same(all.phaseSpeed_mps, lazy.phaseSpeed_mps) &&
-                                same(all.phase_rad, lazy.phase_rad));
+                    ASSERT_TRUE(
+                        same(all.breaking.timeSinceBreaking_s, lazy.breaking.timeSinceBreaking_s) &&
+                        same(all.direction_rad, lazy.direction_rad) &&
+                        same(all.groupSpeed_mps, lazy.groupSpeed_mps) &&
+                        same(all.phaseSpeed_mps, lazy.phaseSpeed_mps) &&
+                        same(all.phase_rad, lazy.phase_rad));
                 } else {
                     ++unbroken;
+                    // Seaward of the breaker line the lazy call leaves the travel time at −1.
+                    ASSERT_TRUE(same(lazy.breaking.timeSinceBreaking_s, -1.0));
                 }
                 const double fa = SurfFoamCoverage(all, x, y, t, foamSettings);
                 ASSERT_TRUE(same(fa, SurfFoamCoverage(lazy, x, y, t, foamSettings)));
