@@ -1026,46 +1026,119 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             // cell's pixel (lx, ly) at ((ox + lx) / span, (oy + ly) / span): each with its source
             // function made on the blend's lanes (BlendedVisibleSources and
             // BlendedInfraredSources, the bits of Bilinear4 and the one-pixel source functions),
-            // then composited as ApplyCell does; pixel (centreX, centreY) takes its own trace
+            // then composited as CompositeAll does; pixel (centreX, centreY) takes its own trace
             // instead where it has one (centre, else nullptr).
+            // All kCell² pixels go through the lanes in row order (the centre's too, its values
+            // then dropped: each lane's values depend on its own pixel alone, and the glow that
+            // BlendedVisibleSources adds only where some lane of a group glows adds +0 to the
+            // others), and with 2 × 2 samples a pixel row's samples are composited from two
+            // sample-row pointers, the same L_bg·T + (1 − T)·S per value as CompositeAll (a
+            // generic per-pixel path with its bookkeeping was ~110 instructions a pixel, most
+            // of BlendCell's cost, where smoke covers large areas thinly).
             const auto BlendCell = [&](int cx, int cy, const BandTrace* const c[4],
                                        const BandTrace* centre, int centreX, int centreY, int ox,
                                        int oy, float span) {
-                float fx[kCellPixels], fy[kCellPixels], a[kCellPixels], b[kCellPixels];
-                int px[kCellPixels], py[kCellPixels], n = 0;
-                for (int ly = 0; ly < kCell; ++ly)
-                    for (int lx = 0; lx < kCell; ++lx) {
-                        if (centre && lx == centreX && ly == centreY) continue;
-                        fx[n] = float(ox + lx) / span, fy[n] = float(oy + ly) / span;
-                        px[n] = cx * kCell + lx, py[n] = cy * kCell + ly;
-                        a[n] = colA[size_t(px[n])], b[n] = rowB[size_t(py[n])];
-                        ++n;
-                    }
-                alignas(16) float tau[kCellPixels] = {}, T[kCellPixels];
+                float colFx[kCell], rowFy[kCell];
+                for (int l = 0; l < kCell; ++l)
+                    colFx[l] = float(ox + l) / span, rowFy[l] = float(oy + l) / span;
+                alignas(16) float fx[kCellPixels], fy[kCellPixels], a[kCellPixels], b[kCellPixels];
+                for (int k = 0; k < kCellPixels; ++k) {
+                    const int lx = k % kCell, ly = k / kCell;
+                    fx[k] = colFx[lx], fy[k] = rowFy[ly];
+                    a[k] = colA[size_t(cx * kCell + lx)], b[k] = rowB[size_t(cy * kCell + ly)];
+                }
+                // Lanes of the pixel that keeps its own trace (all bits set), else 0.
+                alignas(16) int32_t drop[kCellPixels] = {};
+                if (centre) drop[centreY * kCell + centreX] = -1;
+                alignas(16) float tau[kCellPixels], T[kCellPixels];
                 // e^(−τ) four pixels at a time (simd4::Exp4, within 2e-7 relative of std::exp).
                 const auto Transmittances = [&] {
-                    for (int l = 0; l < n; l += 4)
+                    for (int l = 0; l < kCellPixels; l += 4)
                         _mm_store_ps(
                             T + l, simd4::Exp4(_mm_sub_ps(_mm_setzero_ps(), _mm_load_ps(tau + l))));
                 };
+                // The pixels CompositeAll takes one by one (other than 2 × 2 samples).
+                const auto CompositeEach = [&](const auto& source) {
+                    for (int k = 0; k < kCellPixels; ++k) {
+                        if (!(tau[k] > 0.0f) || drop[k]) continue;
+                        const glm::vec3 s = source(k);
+                        const float Sk[3] = {s.x, s.y, s.z};
+                        CompositeAll(cx * kCell + k % kCell, cy * kCell + k / kCell, T[k], Sk);
+                    }
+                };
+                const size_t sampleRow = size_t(radiance.width) * size_t(radiance.channels);
                 if (visible) {
-                    glm::vec3 S[kCellPixels];
-                    plume_detail::BlendedVisibleSources(c, fx, fy, a, b, n, worldFromCamera, light,
-                                                        tau, S);
+                    // One more for the four-value load of the last pixel's colour.
+                    glm::vec3 S[kCellPixels + 1];
+                    S[kCellPixels] = glm::vec3(0.0f);
+                    plume_detail::BlendedVisibleSources(c, fx, fy, a, b, kCellPixels,
+                                                        worldFromCamera, light, tau, S);
                     Transmittances();
-                    for (int l = 0; l < n; ++l) {
-                        if (!(tau[l] > 0.0f)) continue;
-                        const float Sl[3] = {S[l].x, S[l].y, S[l].z};
-                        CompositeAll(px[l], py[l], T[l], Sl);
+                    if (N != 2) {
+                        CompositeEach([&](int k) { return S[k]; });
+                    } else {
+                        static_assert(sizeof(glm::vec3) == 3 * sizeof(float));
+                        for (int ly = 0; ly < kCell; ++ly) {
+                            float* o = radiance.At(cx * kCell * 2, (cy * kCell + ly) * 2);
+                            for (int lx = 0; lx < kCell; ++lx, o += 6) {
+                                const int k = ly * kCell + lx;
+                                if (!(tau[k] > 0.0f) || drop[k]) continue;
+                                // CompositeAll's six values (R G B R G B) of each sample row.
+                                const __m128 Tv = _mm_set1_ps(T[k]);
+                                const __m128 oneMinusT = _mm_set1_ps(1.0f - T[k]);
+                                const __m128 rgb = _mm_loadu_ps(&S[k].x);
+                                const __m128 s0 = _mm_mul_ps(
+                                    oneMinusT, _mm_shuffle_ps(rgb, rgb, _MM_SHUFFLE(0, 2, 1, 0)));
+                                const __m128 s1 = _mm_mul_ps(
+                                    oneMinusT, _mm_shuffle_ps(rgb, rgb, _MM_SHUFFLE(2, 2, 2, 1)));
+                                for (int j = 0; j < 2; ++j) {
+                                    float* p = o + size_t(j) * sampleRow;
+                                    _mm_storeu_ps(p,
+                                                  _mm_add_ps(_mm_mul_ps(_mm_loadu_ps(p), Tv), s0));
+                                    const __m128 hi = _mm_castsi128_ps(
+                                        _mm_loadl_epi64(reinterpret_cast<__m128i*>(p + 4)));
+                                    _mm_storel_epi64(
+                                        reinterpret_cast<__m128i*>(p + 4),
+                                        _mm_castps_si128(_mm_add_ps(_mm_mul_ps(hi, Tv), s1)));
+                                }
+                            }
+                        }
                     }
                 } else {
-                    float S[kCellPixels];
-                    plume_detail::BlendedInfraredSources(c, fx, fy, n, light, tau, S);
+                    alignas(16) float S[kCellPixels];
+                    plume_detail::BlendedInfraredSources(c, fx, fy, kCellPixels, light, tau, S);
                     Transmittances();
-                    for (int l = 0; l < n; ++l) {
-                        if (!(tau[l] > 0.0f)) continue;
-                        const float Sl[3] = {S[l], 0.0f, 0.0f};
-                        CompositeAll(px[l], py[l], T[l], Sl);
+                    if (N != 2) {
+                        CompositeEach([&](int k) { return glm::vec3(S[k], 0.0f, 0.0f); });
+                    } else {
+                        // A pixel row's eight samples of each sample row at once (SSE2), pixels
+                        // 0, 1 in the low vector and 2, 3 in the high one: per sample
+                        // CompositeAll's L_bg·T + (1 − T)·S, and the samples of pixels not
+                        // composited (τ not positive, or the centre) left bit for bit.
+                        for (int ly = 0; ly < kCell; ++ly) {
+                            const int k = ly * kCell;
+                            const __m128 t4 = _mm_load_ps(T + k);
+                            const __m128 s4 =
+                                _mm_mul_ps(_mm_sub_ps(_mm_set1_ps(1.0f), t4), _mm_load_ps(S + k));
+                            const __m128 keep4 = _mm_andnot_ps(
+                                _mm_castsi128_ps(
+                                    _mm_load_si128(reinterpret_cast<const __m128i*>(drop + k))),
+                                _mm_cmpgt_ps(_mm_load_ps(tau + k), _mm_setzero_ps()));
+                            if (_mm_movemask_ps(keep4) == 0) continue;
+                            const __m128 t[2] = {_mm_unpacklo_ps(t4, t4), _mm_unpackhi_ps(t4, t4)};
+                            const __m128 s[2] = {_mm_unpacklo_ps(s4, s4), _mm_unpackhi_ps(s4, s4)};
+                            const __m128 keep[2] = {_mm_unpacklo_ps(keep4, keep4),
+                                                    _mm_unpackhi_ps(keep4, keep4)};
+                            float* o = radiance.At(cx * kCell * 2, (cy * kCell + ly) * 2);
+                            for (int j = 0; j < 2; ++j)
+                                for (int h = 0; h < 2; ++h) {
+                                    float* p = o + size_t(j) * sampleRow + size_t(h) * 4;
+                                    const __m128 old = _mm_loadu_ps(p);
+                                    const __m128 out = _mm_add_ps(_mm_mul_ps(old, t[h]), s[h]);
+                                    _mm_storeu_ps(p, _mm_or_ps(_mm_and_ps(keep[h], out),
+                                                               _mm_andnot_ps(keep[h], old)));
+                                }
+                        }
                     }
                 }
                 if (centre) {

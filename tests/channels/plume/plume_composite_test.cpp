@@ -349,6 +349,57 @@ TEST(PlumeComposite, CommittedPlumesSameImageForAnyThreadCount) {
     }
 }
 
+// Cells blended from their corners composite 2 × 2 samples a pixel row at a time (SSE2), every
+// other number of samples per pixel one pixel at a time: with each pixel's four samples alike
+// (the same surface and background), the supersampled image holds the one-sample image's value
+// at every sample bit for bit, in the visible and in LWIR, over sky and sea.
+TEST(PlumeComposite, TwoByTwoSamplesAsOneWhereTheSamplesAgree) {
+    const scene::PlumeField field = CommittedFourPlumes();
+    const glm::dvec3 eye{0.0, 0.0, 10.0};
+    const ChannelCamera one = NorthCamera(eye, 240, 160, 1), two = NorthCamera(eye, 240, 160, 2);
+    const VisibilityBuffer visOne = SkyAndLevelSea(one, eye);
+    VisibilityBuffer visTwo = SkyOnly(two);
+    for (int y = 0; y < two.SampleHeight(); ++y)
+        for (int x = 0; x < two.SampleWidth(); ++x) {
+            visTwo.primitive[visTwo.Index(x, y)] = visOne.primitive[visOne.Index(x / 2, y / 2)];
+            visTwo.depth[visTwo.Index(x, y)] = visOne.depth[visOne.Index(x / 2, y / 2)];
+        }
+    const BlackbodyGlowTable glow;
+    const radiometry::BandRadianceTable table(radiometry::BuiltinBand("LWIR"));
+    for (const bool visible : {true, false}) {
+        PlumeLighting light = visible ? Sunlit(glow) : Lwir(table);
+        // Colours that differ from channel to channel.
+        light.sunIlluminance = glm::vec3(5000.0f, 4000.0f, 3000.0f);
+        light.ambientRgb = glm::vec3(200.0f, 250.0f, 300.0f);
+        const int channels = visible ? 3 : 1;
+        // A background that differs from pixel to pixel and channel to channel.
+        Image imageOne(one.SampleWidth(), one.SampleHeight(), channels);
+        for (size_t i = 0; i < imageOne.pixels.size(); ++i)
+            imageOne.pixels[i] = 10.0f + float(i % 97) * 0.37f;
+        Image imageTwo(two.SampleWidth(), two.SampleHeight(), channels);
+        for (int y = 0; y < two.SampleHeight(); ++y)
+            for (int x = 0; x < two.SampleWidth(); ++x)
+                for (int c = 0; c < channels; ++c)
+                    imageTwo.At(x, y)[c] = imageOne.At(x / 2, y / 2)[c];
+        const Image before = imageOne;
+        const PlumeCompositeStats stats = CompositePlumes(field, one, visOne, light, imageOne);
+        CompositePlumes(field, two, visTwo, light, imageTwo);
+        // Coarse cells blended from their corners among them.
+        EXPECT_GT(stats.coarseSkyCells, 0u);
+        int changed = 0;
+        for (size_t i = 0; i < imageOne.pixels.size(); ++i)
+            changed += imageOne.pixels[i] != before.pixels[i];
+        EXPECT_GT(changed, 1000);
+        int differ = 0;
+        for (int y = 0; y < two.SampleHeight(); ++y)
+            for (int x = 0; x < two.SampleWidth(); ++x)
+                for (int c = 0; c < channels; ++c)
+                    differ += std::memcmp(&imageTwo.At(x, y)[c], &imageOne.At(x / 2, y / 2)[c],
+                                          sizeof(float)) != 0;
+        EXPECT_EQ(differ, 0) << "visible " << visible;
+    }
+}
+
 // e^(−τ) along eye + s·d, s in [0, range_m] (d a unit vector), τ the exact visible optical depth
 // of every puff of field (erf, in double).
 double ExactVisibleTransmittance(const scene::PlumeField& field, const glm::dvec3& eye,
