@@ -211,17 +211,17 @@ FrameRecord ChannelPipeline::Render(const scene::FrameState& frame) {
     rec.renderMs = MsSince(t0);
 
     t0 = std::chrono::steady_clock::now();
-    sensors::IntegrateFootprint(samples_, channel_.supersampling, pixels_);
-    switch (channel_.exposure.mode) {
-        case scene::ExposureMode::Auto:
-            ev_ = sensors::AutoExposureEv(pixels_, channel_.exposure.keyValue);
-            break;
-        case scene::ExposureMode::Adapted:
-            ev_ = sensors::AdaptedExposureEv(pixels_);
-            break;
-        case scene::ExposureMode::Manual:
-            ev_ = channel_.exposure.ev;
-            break;
+    if (channel_.exposure.mode == scene::ExposureMode::Manual) {
+        sensors::IntegrateFootprint(samples_, channel_.supersampling, pixels_);
+        ev_ = channel_.exposure.ev;
+    } else {
+        // The log-average luminance taken in the footprint pass (AutoExposureEv and
+        // AdaptedExposureEv of pixels_, without reading the image back).
+        const double Lavg =
+            sensors::IntegrateFootprintLogAverage(samples_, channel_.supersampling, pixels_);
+        ev_ = channel_.exposure.mode == scene::ExposureMode::Auto
+                  ? sensors::ExposureEv(Lavg, channel_.exposure.keyValue)
+                  : sensors::ExposureEv(Lavg, sensors::AdaptedKey(Lavg));
     }
     rec.exposureEv = ev_;
     displayValid_ = false;

@@ -17,6 +17,15 @@ void IntegrateFootprint(const Image& samples, int n, Image& out);
 // "Photographic Tone Reproduction for Digital Images", SIGGRAPH 2002, Eq. 1).
 double LogAverageLuminance(const Image& rgb);
 
+// IntegrateFootprint(samples, n, out), returning LogAverageLuminance(out): one pass, each row's
+// logarithms summed right after the row is written, while it is in L1, instead of a second
+// pass reading the whole image back (3.7 MB at 640×480 RGB). Bit for bit the two calls'
+// results (the same row sums, added in the same order). samples: at least 3 channels.
+double IntegrateFootprintLogAverage(const Image& samples, int n, Image& out);
+
+// Exposure value (stops) mapping log-average luminance Lavg_cdm2 to `key`: log2(key / Lavg).
+double ExposureEv(double Lavg_cdm2, double key);
+
 // Exposure value (stops) that maps the log-average luminance to `key` (Reinhard's 0.18):
 // display-referred input = scene-linear · 2^ev.
 double AutoExposureEv(const Image& rgb, double key);

@@ -4,8 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <random>
 
 namespace seasense::sensors {
 namespace {
@@ -95,6 +98,47 @@ TEST(Detector, LogAverageLuminanceOfANonFiniteImageIsNotFinite) {
         std::fill(row.pixels.begin(), row.pixels.end(), 5.0f);
         row.At(x, 1)[2] = -std::numeric_limits<float>::quiet_NaN();
         EXPECT_TRUE(std::isnan(LogAverageLuminance(row))) << x;
+    }
+}
+
+TEST(Detector, FusedFootprintAndLogAverageEqualTheTwoPassesBitForBit) {
+    // Random radiances over many decades (some negative, some zero), with odd and even widths,
+    // widths below a block and not a multiple of four, 2×2 RGB (the SSE2 path) and the
+    // general path (n = 1, 3; four channels), and a row with an inf.
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> decade(-6.0f, 6.0f), unit(0.0f, 1.0f);
+    struct Case {
+        int width, height, n, channels;
+    };
+    for (const Case& k : {Case{1, 1, 2, 3}, Case{3, 2, 2, 3}, Case{17, 5, 2, 3}, Case{64, 4, 2, 3},
+                          Case{101, 7, 2, 3}, Case{640, 3, 2, 3}, Case{21, 3, 1, 3},
+                          Case{19, 4, 3, 3}, Case{13, 3, 2, 4}}) {
+        Image s(k.width * k.n, k.height * k.n, k.channels);
+        for (float& v : s.pixels) {
+            const float u = unit(rng);
+            v = u < 0.05f ? 0.0f : (u < 0.1f ? -unit(rng) : std::pow(10.0f, decade(rng)));
+        }
+        for (const bool inf : {false, true}) {
+            if (inf) s.At(s.width - 1, s.height - 1)[0] = std::numeric_limits<float>::infinity();
+            const Image twoPass = IntegrateFootprint(s, k.n);
+            const double expected = LogAverageLuminance(twoPass);
+            Image fused(1, 1, 1);  // resized by the call
+            const double lavg = IntegrateFootprintLogAverage(s, k.n, fused);
+            EXPECT_EQ(std::bit_cast<uint64_t>(lavg), std::bit_cast<uint64_t>(expected))
+                << k.width << "×" << k.height << " n " << k.n << " c " << k.channels << " inf "
+                << inf;
+            ASSERT_EQ(fused.width, twoPass.width);
+            ASSERT_EQ(fused.height, twoPass.height);
+            ASSERT_EQ(fused.channels, twoPass.channels);
+            for (size_t i = 0; i < fused.pixels.size(); ++i)
+                ASSERT_EQ(std::bit_cast<uint32_t>(fused.pixels[i]),
+                          std::bit_cast<uint32_t>(twoPass.pixels[i]))
+                    << i;
+            EXPECT_EQ(std::bit_cast<uint64_t>(ExposureEv(lavg, 0.18)),
+                      std::bit_cast<uint64_t>(AutoExposureEv(twoPass, 0.18)));
+            EXPECT_EQ(std::bit_cast<uint64_t>(ExposureEv(lavg, AdaptedKey(lavg))),
+                      std::bit_cast<uint64_t>(AdaptedExposureEv(twoPass)));
+        }
     }
 }
 
