@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <sstream>
 
@@ -263,6 +264,25 @@ double BandRadianceTable::Radiance(double T_K) const {
     const double u = (T_K - minT_K_) / step_K_;
     const size_t i = std::min(size_t(u), cells_.size() - 1);
     return std::exp(Interpolate(i, u - double(i), nullptr));
+}
+
+void BandRadianceTable::Radiances(size_t n, const double* T_K, double* out) const {
+    // Radiance's steps for each value, split at the exponential, the first loop without a
+    // branch (the compiler's vector code): u = (T − min) / step and the cell i = min(⌊u⌋, last)
+    // as Radiance makes them where T lies in the range (u ≥ 0 there, so the signed conversion
+    // is the unsigned one), u = 0 elsewhere (its polynomial then dropped).
+    const double lo = minT_K_, hi = maxT_K_, step = step_K_;
+    const auto last = int64_t(cells_.size()) - 1;
+    for (size_t k = 0; k < n; ++k) {
+        const double T = T_K[k];
+        const double u = (T >= lo && T <= hi ? T - lo : 0.0) / step;
+        const int64_t i = std::min(int64_t(u), last);
+        out[k] = Interpolate(size_t(i), u - double(i), nullptr);
+    }
+    for (size_t k = 0; k < n; ++k) {
+        const double T = T_K[k];
+        out[k] = T >= lo && T <= hi ? std::exp(out[k]) : BandRadiance(band_, T);
+    }
 }
 
 double BandRadianceTable::RadianceDerivative(double T_K) const {

@@ -66,6 +66,11 @@ class BandRadianceTable {
 
     // L_B(T_K) in W·m⁻²·sr⁻¹. Throws InputError unless T_K is finite and > 0.
     double Radiance(double T_K) const;
+    // Radiance(T_K[k]) into out[k] for k < n, each the bits of its own call: the polynomials of
+    // the values in the table's range first, then their exponentials (one library call each,
+    // none between the polynomials), the others Radiance's direct evaluation. For callers with
+    // many temperatures at once (a plume cell's pixels), saving a call per value.
+    void Radiances(size_t n, const double* T_K, double* out) const;
     // dL_B/dT in W·m⁻²·sr⁻¹·K⁻¹. Throws InputError unless T_K is finite and > 0.
     double RadianceDerivative(double T_K) const;
     // Temperature (K) of the blackbody with band radiance radiance_W_m2_sr, inverting the

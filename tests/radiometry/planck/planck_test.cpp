@@ -6,8 +6,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <functional>
 #include <limits>
+#include <vector>
 
 #include "scene/core/error.h"
 
@@ -278,6 +280,24 @@ TEST(BandRadianceTable, EqualsTheCubicHermiteOfItsNodesBitForBit) {
         const double slope = m0 + t * (2.0 * c2 + 3.0 * t * c3);
         ASSERT_EQ(table.Radiance(T), std::exp(lnL)) << T;
         ASSERT_EQ(table.RadianceDerivative(T), std::exp(lnL) * slope / step) << T;
+    }
+}
+
+// The batch form gives each value the bits of its own Radiance call: in the range (its ends, a
+// node, between nodes, as float temperatures as the plumes pass them) and outside it (direct
+// evaluation), in one call with the values mixed.
+TEST(BandRadianceTable, RadiancesEqualRadianceBitForBit) {
+    for (const Band& band : {Band::Lwir(), Band::Mwir()}) {
+        const BandRadianceTable table(band, 200.0, 1200.0, 2.0);
+        std::vector<double> T = {200.0, 1200.0, 202.0, 50.0, 199.999, 1200.001, 3000.0};
+        for (double t = 150.0; t <= 1300.0; t += 0.6133) T.push_back(double(float(t)));
+        std::vector<double> out(T.size(), -1.0);
+        table.Radiances(T.size(), T.data(), out.data());
+        for (size_t k = 0; k < T.size(); ++k) {
+            const double expected = table.Radiance(T[k]);
+            EXPECT_EQ(std::memcmp(&out[k], &expected, sizeof(double)), 0)
+                << band.Name() << " " << T[k];
+        }
     }
 }
 
