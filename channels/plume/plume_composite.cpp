@@ -428,6 +428,21 @@ Scratch& LocalScratch() {
     return scratch;
 }
 
+// A pixel's 2 × 2 RGB samples composited through a plume of transmittance T and source S (RGB):
+// L_bg·T + (1 − T)·S per value, each sample row's six values (R G B R G B) at once (SSE2); o is
+// the pixel's first sample, sampleRow the floats from one sample row to the next.
+inline void CompositeRgb2x2(float* o, size_t sampleRow, float T, const float* S) {
+    const __m128 Tv = _mm_set1_ps(T), oneMinusT = _mm_set1_ps(1.0f - T);
+    const __m128 s0 = _mm_mul_ps(oneMinusT, _mm_setr_ps(S[0], S[1], S[2], S[0]));
+    const __m128 s1 = _mm_mul_ps(oneMinusT, _mm_setr_ps(S[1], S[2], 0.0f, 0.0f));
+    for (int j = 0; j < 2; ++j, o += sampleRow) {
+        _mm_storeu_ps(o, _mm_add_ps(_mm_mul_ps(_mm_loadu_ps(o), Tv), s0));
+        const __m128 hi = _mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<__m128i*>(o + 4)));
+        _mm_storel_epi64(reinterpret_cast<__m128i*>(o + 4),
+                         _mm_castps_si128(_mm_add_ps(_mm_mul_ps(hi, Tv), s1)));
+    }
+}
+
 }  // namespace
 
 float HenyeyGreensteinPhase(float cosTheta, float g) {
@@ -497,20 +512,9 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     // Composites every sample of pixel (px, py) with transmittance T and source S (S[0] alone
     // in the infrared): each sample row's N·channels values are contiguous.
     const auto CompositeAll = [&](int px, int py, float T, const float* S) {
-        if (visible && N == 2) {
-            // The usual case, each sample row's six values (R G B R G B) at once (SSE2): the
-            // same L_bg·T + (1 − T)·S per value.
-            const __m128 Tv = _mm_set1_ps(T), oneMinusT = _mm_set1_ps(1.0f - T);
-            const __m128 s0 = _mm_mul_ps(oneMinusT, _mm_setr_ps(S[0], S[1], S[2], S[0]));
-            const __m128 s1 = _mm_mul_ps(oneMinusT, _mm_setr_ps(S[1], S[2], 0.0f, 0.0f));
-            for (int j = 0; j < 2; ++j) {
-                float* o = radiance.At(px * 2, py * 2 + j);
-                _mm_storeu_ps(o, _mm_add_ps(_mm_mul_ps(_mm_loadu_ps(o), Tv), s0));
-                const __m128 hi =
-                    _mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<__m128i*>(o + 4)));
-                _mm_storel_epi64(reinterpret_cast<__m128i*>(o + 4),
-                                 _mm_castps_si128(_mm_add_ps(_mm_mul_ps(hi, Tv), s1)));
-            }
+        if (visible && N == 2) {  // the usual case
+            CompositeRgb2x2(radiance.At(px * 2, py * 2),
+                            size_t(radiance.width) * size_t(radiance.channels), T, S);
             return;
         }
         if (!visible && N == 2) {
@@ -1080,9 +1084,10 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             // then dropped: each lane's values depend on its own pixel alone, and the glow that
             // BlendedVisibleSources adds only where some lane of a group glows adds +0 to the
             // others), and with 2 × 2 samples a pixel row's samples are composited from two
-            // sample-row pointers, the same L_bg·T + (1 − T)·S per value as CompositeAll (a
-            // generic per-pixel path with its bookkeeping was ~110 instructions a pixel, most
-            // of BlendCell's cost, where smoke covers large areas thinly).
+            // sample-row pointers: the visible's pixel by pixel with CompositeAll's
+            // CompositeRgb2x2, the infrared's a pixel row at once, the same L_bg·T + (1 − T)·S
+            // per value (a generic per-pixel path with its bookkeeping was ~110 instructions a
+            // pixel, most of BlendCell's cost, where smoke covers large areas thinly).
             const auto BlendCell = [&](int cx, int cy, const BandTrace* const c[4],
                                        const BandTrace* centre, int centreX, int centreY, int ox,
                                        int oy, float span) {
@@ -1116,39 +1121,19 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                 };
                 const size_t sampleRow = size_t(radiance.width) * size_t(radiance.channels);
                 if (visible) {
-                    // One more for the four-value load of the last pixel's colour.
-                    glm::vec3 S[kCellPixels + 1];
-                    S[kCellPixels] = glm::vec3(0.0f);
+                    glm::vec3 S[kCellPixels];
                     plume_detail::BlendedVisibleSources(c, fx, fy, a, b, kCellPixels,
                                                         worldFromCamera, light, tau, S);
                     Transmittances();
                     if (N != 2) {
                         CompositeEach([&](int k) { return S[k]; });
                     } else {
-                        static_assert(sizeof(glm::vec3) == 3 * sizeof(float));
                         for (int ly = 0; ly < kCell; ++ly) {
                             float* o = radiance.At(cx * kCell * 2, (cy * kCell + ly) * 2);
                             for (int lx = 0; lx < kCell; ++lx, o += 6) {
                                 const int k = ly * kCell + lx;
                                 if (!(tau[k] > 0.0f) || drop[k]) continue;
-                                // CompositeAll's six values (R G B R G B) of each sample row.
-                                const __m128 Tv = _mm_set1_ps(T[k]);
-                                const __m128 oneMinusT = _mm_set1_ps(1.0f - T[k]);
-                                const __m128 rgb = _mm_loadu_ps(&S[k].x);
-                                const __m128 s0 = _mm_mul_ps(
-                                    oneMinusT, _mm_shuffle_ps(rgb, rgb, _MM_SHUFFLE(0, 2, 1, 0)));
-                                const __m128 s1 = _mm_mul_ps(
-                                    oneMinusT, _mm_shuffle_ps(rgb, rgb, _MM_SHUFFLE(2, 2, 2, 1)));
-                                for (int j = 0; j < 2; ++j) {
-                                    float* p = o + size_t(j) * sampleRow;
-                                    _mm_storeu_ps(p,
-                                                  _mm_add_ps(_mm_mul_ps(_mm_loadu_ps(p), Tv), s0));
-                                    const __m128 hi = _mm_castsi128_ps(
-                                        _mm_loadl_epi64(reinterpret_cast<__m128i*>(p + 4)));
-                                    _mm_storel_epi64(
-                                        reinterpret_cast<__m128i*>(p + 4),
-                                        _mm_castps_si128(_mm_add_ps(_mm_mul_ps(hi, Tv), s1)));
-                                }
+                                CompositeRgb2x2(o, sampleRow, T[k], &S[k].x);
                             }
                         }
                     }
