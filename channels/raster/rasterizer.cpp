@@ -3,7 +3,7 @@
 #include "channels/raster/rasterizer.h"
 
 #if defined(__SSE2__)
-#include <emmintrin.h>
+#include <immintrin.h>
 #endif
 
 #include <tbb/blocked_range.h>
@@ -506,10 +506,71 @@ template <bool kCount, bool kClipped>
     }
 }
 
+// Samples per cache line in every plane of the visibility buffer (4-byte values).
+constexpr size_t kLineSamples = 16;
+
+// Streams one cache line (kLineSamples four-byte samples) from src to the line-aligned dst,
+// whole, as simd::StreamCopy's inner loop does, and leaves fill in src's line: the tile's
+// targets are cleared for the next tile while their lines are in the cache anyway.
+inline void StreamLineAndRefill(void* dst, void* src, simd::VI fill) {
+    char* from = static_cast<char*>(src);
+    char* to = static_cast<char*>(dst);
+    for (size_t at = 0; at < kLineSamples * 4; at += sizeof fill) {
+        simd::VI v;
+        std::memcpy(&v, from + at, sizeof v);
+#if defined(__AVX__)
+        _mm256_stream_si256(reinterpret_cast<__m256i*>(to + at), __m256i(v));
+#else
+        _mm_stream_si128(reinterpret_cast<__m128i*>(to + at), __m128i(v));
+#endif
+        std::memcpy(from + at, &fill, sizeof fill);
+    }
+}
+
+// Copies a w × h tile drawn into local (rows of w samples) to the frame's targets at (x0, y0),
+// line by line, and clears local's first w·h samples. Every destination row starts on a cache
+// line and w is a multiple of kLineSamples. kWidth, when not 0, is w known at compile time, so
+// that a row is straight-line code.
+template <size_t kWidth>
+void StreamRowsOut(const Targets& t, int x0, int y0, const Targets& local, size_t w, size_t h,
+                   simd::VI zeros, simd::VI empties) {
+    if constexpr (kWidth != 0) w = kWidth;
+    const size_t stride = size_t(t.width);
+    const size_t b = size_t(y0) * stride + size_t(x0);
+    float* outDepth = t.depth + b;
+    uint32_t* outPrimitive = t.primitive + b;
+    float* outB1 = t.b1 + b;
+    float* outB2 = t.b2 + b;
+    float* depth = local.depth;
+    uint32_t* primitive = local.primitive;
+    float* b1 = local.b1;
+    float* b2 = local.b2;
+    for (size_t y = 0; y < h; ++y) {
+        for (size_t i = 0; i < w; i += kLineSamples) {
+            StreamLineAndRefill(outDepth + i, depth + i, zeros);
+            StreamLineAndRefill(outPrimitive + i, primitive + i, empties);
+            StreamLineAndRefill(outB1 + i, b1 + i, zeros);
+            StreamLineAndRefill(outB2 + i, b2 + i, zeros);
+        }
+        outDepth += stride;
+        outPrimitive += stride;
+        outB1 += stride;
+        outB2 += stride;
+        depth += w;
+        primitive += w;
+        b1 += w;
+        b2 += w;
+    }
+}
+
 // One tile's targets while it is drawn: small enough to stay in the core's cache.
 struct TileTargets {
     std::vector<float> depth, b1, b2;
     std::vector<uint32_t> primitive;
+    // Samples [0, clear) are empty (depth, b1, b2 zero, primitive kNoPrimitive). A tile's
+    // triangles change only its first w·h samples (the span's lanes past them store back what
+    // they loaded).
+    size_t clear = 0;
 };
 
 // Draws every triangle binned to one tile in global triangle order (chunks in order, set-ups
@@ -538,13 +599,6 @@ void RasterTile(int tile, const Context& ctx, const std::vector<Chunk>& chunks, 
             scratch.b2.resize(padded);
             scratch.primitive.resize(padded);
         }
-        // Plain vector stores: the compiler would make each fill a memset call, whose
-        // `rep stosb` valgrind counts byte by byte, hiding the rest of a profile.
-        float zero = 0.0f;
-        uint32_t empty = kNoPrimitive;
-        asm("" : "+r"(zero), "+r"(empty));
-        const simd::VF zeros = simd::Splat(zero);
-        const simd::VI empties = simd::VI{} + int32_t(empty);
         local.width = int(w);
         local.x0 = r.x0;
         local.y0 = r.y0;
@@ -552,15 +606,27 @@ void RasterTile(int tile, const Context& ctx, const std::vector<Chunk>& chunks, 
         local.primitive = scratch.primitive.data();
         local.b1 = scratch.b1.data();
         local.b2 = scratch.b2.data();
-        float* __restrict depth = local.depth;
-        uint32_t* __restrict primitive = local.primitive;
-        float* __restrict b1 = local.b1;
-        float* __restrict b2 = local.b2;
-        for (size_t i = 0; i < padded; i += simd::kLanes) {
-            std::memcpy(depth + i, &zeros, sizeof zeros);
-            std::memcpy(primitive + i, &empties, sizeof empties);
-            std::memcpy(b1 + i, &zeros, sizeof zeros);
-            std::memcpy(b2 + i, &zeros, sizeof zeros);
+        // Cleared here only on a thread's first tile, after the targets grew, or after a tile
+        // copied out without clearing behind it (see below).
+        if (scratch.clear < padded) {
+            // Plain vector stores: the compiler would make each fill a memset call, whose
+            // `rep stosb` valgrind counts byte by byte, hiding the rest of a profile.
+            float zero = 0.0f;
+            uint32_t empty = kNoPrimitive;
+            asm("" : "+r"(zero), "+r"(empty));
+            const simd::VF zeros = simd::Splat(zero);
+            const simd::VI empties = simd::VI{} + int32_t(empty);
+            float* __restrict depth = local.depth;
+            uint32_t* __restrict primitive = local.primitive;
+            float* __restrict b1 = local.b1;
+            float* __restrict b2 = local.b2;
+            for (size_t i = 0; i < padded; i += simd::kLanes) {
+                std::memcpy(depth + i, &zeros, sizeof zeros);
+                std::memcpy(primitive + i, &empties, sizeof empties);
+                std::memcpy(b1 + i, &zeros, sizeof zeros);
+                std::memcpy(b2 + i, &zeros, sizeof zeros);
+            }
+            scratch.clear = padded;
         }
     }
     for (size_t c = 0; c < numChunks; ++c) {
@@ -577,12 +643,27 @@ void RasterTile(int tile, const Context& ctx, const std::vector<Chunk>& chunks, 
         }
     }
     if constexpr (!kCount) {
-        for (size_t y = 0; y < h; ++y) {
-            const size_t b = (size_t(r.y0) + y) * size_t(t.width) + size_t(r.x0);
-            simd::StreamCopy(t.depth + b, local.depth + y * w, w);
-            simd::StreamCopy(t.primitive + b, local.primitive + y * w, w);
-            simd::StreamCopy(t.b1 + b, local.b1 + y * w, w);
-            simd::StreamCopy(t.b2 + b, local.b2 + y * w, w);
+        // The planes are cache-line aligned: where the frame's rows and the tile's columns
+        // start on a line and the tile's rows are whole lines (every tile of the channels'
+        // 1280-sample rows in 64-sample tiles), each tile row goes out line by line for all four
+        // planes in one loop, without StreamCopy's per-call alignment prologue and epilogue,
+        // clearing the tile targets behind it. 64 is the default tile size.
+        if (t.width % kLineSamples == 0 && size_t(r.x0) % kLineSamples == 0 &&
+            w % kLineSamples == 0) {
+            const simd::VI zeros{}, empties = simd::VI{} + int32_t(kNoPrimitive);
+            if (w == 64)
+                StreamRowsOut<64>(t, r.x0, r.y0, local, w, h, zeros, empties);
+            else
+                StreamRowsOut<0>(t, r.x0, r.y0, local, w, h, zeros, empties);
+        } else {
+            scratch.clear = 0;
+            for (size_t y = 0; y < h; ++y) {
+                const size_t b = (size_t(r.y0) + y) * size_t(t.width) + size_t(r.x0);
+                simd::StreamCopy(t.depth + b, local.depth + y * w, w);
+                simd::StreamCopy(t.primitive + b, local.primitive + y * w, w);
+                simd::StreamCopy(t.b1 + b, local.b1 + y * w, w);
+                simd::StreamCopy(t.b2 + b, local.b2 + y * w, w);
+            }
         }
         simd::StreamFence();
     }

@@ -922,6 +922,74 @@ TEST(RasterTargets, ReusedBufferHoldsOnlyTheLastFramesTriangles) {
     }
 }
 
+// Tiles whose rows are whole cache lines of the frame go out line by line and clear the
+// thread's tile targets behind them; the others (a frame width or tile column off the 16-sample
+// lines, tile rows not whole lines) are copied sample-exactly and cleared before the next tile.
+// Frames of different content drawn one after another into one buffer, in grids that mix both
+// kinds of tile within a thread, must equal tile size 8 (never whole lines: every tile cleared
+// before it is drawn) bit for bit.
+TEST(RasterTargets, LineCopyOutAndClearBehindEqualClearingEveryTile) {
+    const auto bumpyGrid = [](uint64_t seed) {
+        const double half = 6.0, cell = 2.0 * half / 48;
+        return MakeGrid(
+            48,
+            [&](int i, int j) {
+                const uint64_t k = uint64_t(j) * 49 + uint64_t(i);
+                return glm::dvec3(i * cell - half, j * cell - half + 4.0,
+                                  0.3 * scene::Uniform01(seed, 0, k));
+            },
+            false);
+    };
+    const Mesh gridA = bumpyGrid(91), gridC = bumpyGrid(92);
+    Mesh fan;  // a few triangles near the view's middle: most of frame B is empty
+    for (int k = 0; k < 5; ++k) {
+        fan.positions.push_back({0.0f, 5.0f, 0.4f});
+        fan.positions.push_back({0.6f * float(k) - 1.5f, 5.5f, 0.0f});
+        fan.positions.push_back({0.6f * float(k) - 1.2f, 5.5f, 0.0f});
+        fan.indices.insert(fan.indices.end(),
+                           {uint32_t(3 * k), uint32_t(3 * k + 1), uint32_t(3 * k + 2)});
+    }
+    const std::vector<std::vector<RasterMesh>> frames = {
+        {gridA.Raster(false)}, {fan.Raster(false)}, {gridC.Raster(false), fan.Raster(false)}};
+    const auto same = [](const VisibilityBuffer& a, const VisibilityBuffer& b) {
+        const auto eq = [](const auto& u, const auto& v) {
+            return u.size() == v.size() &&
+                   std::memcmp(u.data(), v.data(), u.size() * sizeof(u[0])) == 0;
+        };
+        return eq(a.depth, b.depth) && eq(a.primitive, b.primitive) && eq(a.b1, b.b1) &&
+               eq(a.b2, b.b2);
+    };
+    const std::pair<int, int> sizes[] = {{96, 50}, {104, 70}, {112, 33}, {128, 64}, {150, 97}};
+    for (const auto& [width, height] : sizes) {
+        const RasterCamera cam =
+            GroundView({0.1, -0.2, 1.2}, -20.0 * kPi / 180.0, 60.0 * kPi / 180.0, width, height)
+                .Camera();
+        for (int threads : {1, 2}) {
+            tbb::task_arena arena(threads);
+            std::vector<VisibilityBuffer> ref(frames.size());
+            int empty = 0, drawn = 0;
+            Rasterizer eight(8);
+            for (size_t f = 0; f < frames.size(); ++f) {
+                arena.execute([&] { eight.Render(frames[f], cam, ref[f]); });
+                for (uint32_t p : ref[f].primitive) (p == kNoPrimitive ? empty : drawn) += 1;
+            }
+            EXPECT_GT(empty, width * height / 2);
+            EXPECT_GT(drawn, width * height);
+            for (int tileSize : {16, 32, 64}) {
+                SCOPED_TRACE(std::to_string(width) + "x" + std::to_string(height) + ", " +
+                             std::to_string(threads) + " threads, tile size " +
+                             std::to_string(tileSize));
+                Rasterizer r(tileSize);
+                VisibilityBuffer vis;
+                for (size_t f = 0; f < frames.size(); ++f) {
+                    arena.execute([&] { r.Render(frames[f], cam, vis); });
+                    EXPECT_TRUE(same(vis, ref[f])) << "frame " << f;
+                }
+            }
+        }
+    }
+}
+
 TEST(RasterShadePass, VisitsEverySampleOnceWithItsIndex) {
     VisibilityBuffer vis;
     vis.width = 37;
