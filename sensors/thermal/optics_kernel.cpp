@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <numbers>
 #include <sstream>
@@ -202,21 +203,29 @@ SamplingKernel BuildSamplingKernel(const radiometry::Band& band, const OpticsGeo
 
 namespace {
 
-// Vectors per step of the tap loop (KernelSteps): eight accumulators, so that a tap pair's
-// broadcast and column offsets serve 64 pixels (eight lanes); and the pixels of the widest step,
-// which the phase arrays are padded to.
-constexpr int kGroups = 8;
+// Vectors per step of the tap loop (KernelSteps): ten accumulators (twelve of the sixteen vector
+// registers with the tap and the pair sum), so that a tap pair's column offsets and loop overhead
+// serve 80 pixels (eight lanes), a 640-pixel row in eight whole steps; and the pixels of the widest
+// step, which the phase arrays are padded to.
+constexpr int kGroups = 10;
 constexpr int kPixelsPerStep = 8 * kGroups;
+// Floats per tap in the broadcast tap table: one vector of the widest path, so that a pair's tap
+// is one load rather than a load and a broadcast.
+constexpr int kTapLanes = 8;
+
+// Offsets (floats) of a tap pair's two columns within folded row 0 (the centre column twice).
+struct TapColumns {
+    ptrdiff_t first, second;
+};
 
 // The folded rows and tap pairs of one row, as SampleKernelRow lays them out.
 struct FoldedRow {
     const float* phases;  // folded row 0; row i at phases + i · rowStride
     size_t rowStride;
-    const float* taps;  // per folded row, perRow taps broadcast to four lanes
+    const float* taps;  // per folded row, perRow taps, each broadcast to kTapLanes floats
     int folded, pairs, perRow;
-    bool centre;  // odd K: a centre column after the pairs
-    const size_t* first;
-    const size_t* second;
+    bool centre;                // odd K: a centre column after the pairs
+    const TapColumns* columns;  // perRow entries
 };
 
 // GCC vector types of four and eight floats: + and * are the lanes' single-precision adds and
@@ -224,23 +233,27 @@ struct FoldedRow {
 typedef float Lanes4 __attribute__((vector_size(16)));
 typedef float Lanes8 __attribute__((vector_size(32)));
 
-// The tap loop for all pixels of the row, kGroups vectors of V (four accumulators, so that four
-// independent chains of additions hide the adder's latency) per step. Fixed summation order per
-// pixel (folded rows, then pairs, then the centre column): the result of a pixel does not
-// depend on its lane, on the width of V or on the threading. Always inlined, so that it is
-// compiled for the caller's instruction set (KernelSteps8: AVX).
+// The tap loop for all pixels of the row, kGroups vectors of V (independent chains of additions
+// that hide the adder's latency) per step. Fixed summation order per pixel (folded rows, then
+// pairs, then the centre column): the result of a pixel does not depend on its lane, on the
+// width of V or on the threading. Always inlined, so that it is compiled for the caller's
+// instruction set (KernelSteps8: AVX).
 template <class V>
 __attribute__((always_inline)) inline void KernelSteps(const FoldedRow& r, int w, float* out) {
     constexpr int kLanes = int(sizeof(V) / sizeof(float));
     for (int x = 0; x < w; x += kLanes * kGroups) {
-        V acc[kGroups] = {};
+        // Zeroed per vector: the whole-array initialiser zeroes a stack copy (rep stos) first.
+        V acc[kGroups];
+        for (int g = 0; g < kGroups; ++g) acc[g] = V{};
         for (int i = 0; i < r.folded; ++i) {
             const float* row = r.phases + size_t(i) * r.rowStride + size_t(x);
-            const float* tap = r.taps + size_t(i) * size_t(r.perRow) * 4;
-            for (int p = 0; p < r.pairs; ++p) {
-                const float* u = row + r.first[size_t(p)];
-                const float* v = row + r.second[size_t(p)];
-                const V t = V{} + tap[4 * p];
+            const float* tap = r.taps + size_t(i) * size_t(r.perRow) * kTapLanes;
+            const TapColumns* c = r.columns;
+            for (const TapColumns* end = c + r.pairs; c != end; ++c, tap += kTapLanes) {
+                const float* u = row + c->first;
+                const float* v = row + c->second;
+                V t;  // the tap in every lane
+                __builtin_memcpy(&t, tap, sizeof(V));
                 for (int g = 0; g < kGroups; ++g) {
                     V a, b;  // unaligned loads
                     __builtin_memcpy(&a, u + kLanes * g, sizeof(V));
@@ -249,8 +262,9 @@ __attribute__((always_inline)) inline void KernelSteps(const FoldedRow& r, int w
                 }
             }
             if (r.centre) {
-                const float* u = row + r.first[size_t(r.pairs)];
-                const V t = V{} + tap[4 * r.pairs];
+                const float* u = row + c->first;
+                V t;
+                __builtin_memcpy(&t, tap, sizeof(V));
                 for (int g = 0; g < kGroups; ++g) {
                     V a;
                     __builtin_memcpy(&a, u + kLanes * g, sizeof(V));
@@ -258,14 +272,12 @@ __attribute__((always_inline)) inline void KernelSteps(const FoldedRow& r, int w
                 }
             }
         }
+        // A whole step straight to the row, the last partial one through a buffer.
         const int count = std::min(kLanes * kGroups, w - x);
-        if (count == kLanes * kGroups) {
-            __builtin_memcpy(out + x, acc, sizeof(acc));
-        } else {
-            alignas(32) float lanes[kLanes * kGroups];
-            __builtin_memcpy(lanes, acc, sizeof(acc));
-            std::copy(lanes, lanes + count, out + x);
-        }
+        alignas(32) float lanes[kLanes * kGroups];
+        float* dst = count == kLanes * kGroups ? out + x : lanes;
+        for (int g = 0; g < kGroups; ++g) __builtin_memcpy(dst + kLanes * g, &acc[g], sizeof(V));
+        if (dst == lanes) std::copy(lanes, lanes + count, out + x);
     }
 }
 
@@ -304,8 +316,8 @@ void SampleKernelRow(const Image& samples, const SamplingKernel& kernel, int y, 
     const int folded = (K + 1) / 2;
     const int pairs = K / 2;  // columns j and K − 1 − j share a tap (even OTF)
     const size_t phaseStride = size_t(len), rowStride = size_t(n) * phaseStride;
-    const size_t tapFloats = size_t(folded) * size_t(pairs + 1) * 4;
-    scratch.resize(size_t(folded) * rowStride + tapFloats + 4);
+    const size_t tapFloats = size_t(folded) * size_t(pairs + 1) * kTapLanes;
+    scratch.resize(size_t(folded) * rowStride + tapFloats + kTapLanes);
     float* phases = scratch.data();
     for (int i = 0; i < folded; ++i) {
         const float* a = samples.At(0, std::clamp(y * n + o + i, 0, H - 1));
@@ -314,14 +326,14 @@ void SampleKernelRow(const Image& samples, const SamplingKernel& kernel, int y, 
         float* row = phases + size_t(i) * rowStride;
         // Columns n·m + r inside the image for m in [mLo, mHi).
         const int mLo = std::max(0, mMin), mHi = std::min(W / n, mMin + len);
-        auto at = [&](int c) {
-            c = std::clamp(c, 0, W - 1);
-            return centre ? a[c] : a[c] + b[c];
-        };
+        // Outside the image the column n·m + r clamps to the first column (m < 0 ≤ mLo) or
+        // the last (m ≥ mHi = W/n), whatever the phase r.
+        auto at = [&](int c) { return centre ? a[c] : a[c] + b[c]; };
+        const float left = at(0), right = at(W - 1);
         for (int r = 0; r < n; ++r) {
             float* dst = row + size_t(r) * phaseStride - mMin;
-            for (int m = mMin; m < mLo; ++m) dst[m] = at(n * m + r);
-            for (int m = std::max(mHi, mLo); m < mMin + len; ++m) dst[m] = at(n * m + r);
+            std::fill(dst + mMin, dst + mLo, left);
+            std::fill(dst + std::max(mHi, mLo), dst + mMin + len, right);
         }
         int m = mLo;
         if (n == 2 && !centre) {
@@ -358,25 +370,26 @@ void SampleKernelRow(const Image& samples, const SamplingKernel& kernel, int y, 
                 row[size_t(r) * phaseStride + size_t(m - mMin)] =
                     centre ? a[n * m + r] : a[n * m + r] + b[n * m + r];
     }
-    // Taps broadcast to four lanes: pairs (and the centre column of an odd K) per folded row.
+    // Taps broadcast to kTapLanes floats: pairs (and the centre column of an odd K) per folded
+    // row. Each holds 0 + tap, as V{} + tap would broadcast it (the tap, +0 for a −0 tap).
     float* taps = phases + size_t(folded) * rowStride;
-    taps += (16 - reinterpret_cast<uintptr_t>(taps) % 16) % 16 / sizeof(float);
+    taps += (32 - reinterpret_cast<uintptr_t>(taps) % 32) % 32 / sizeof(float);
     const int perRow = pairs + K % 2;
     for (int i = 0; i < folded; ++i)
         for (int p = 0; p < perRow; ++p)
-            std::fill_n(taps + (size_t(i) * size_t(perRow) + size_t(p)) * 4, 4,
-                        kernel.taps[size_t(i) * size_t(Kp) + size_t(p)]);
+            std::fill_n(taps + (size_t(i) * size_t(perRow) + size_t(p)) * kTapLanes, kTapLanes,
+                        0.0f + kernel.taps[size_t(i) * size_t(Kp) + size_t(p)]);
     // Offsets of the two columns of each pair (the centre column twice) within folded row 0.
-    std::array<size_t, (kMaxKernelTaps + 1) / 2> first, second;
+    std::array<TapColumns, (kMaxKernelTaps + 1) / 2> columns;
     for (int p = 0; p < perRow; ++p) {
         const int d1 = o + p, d2 = o + K - 1 - p;
-        first[size_t(p)] =
-            size_t(d1 - FloorDiv(d1, n) * n) * phaseStride + size_t(FloorDiv(d1, n) - mMin);
-        second[size_t(p)] =
-            size_t(d2 - FloorDiv(d2, n) * n) * phaseStride + size_t(FloorDiv(d2, n) - mMin);
+        columns[size_t(p)].first =
+            ptrdiff_t(d1 - FloorDiv(d1, n) * n) * ptrdiff_t(phaseStride) + FloorDiv(d1, n) - mMin;
+        columns[size_t(p)].second =
+            ptrdiff_t(d2 - FloorDiv(d2, n) * n) * ptrdiff_t(phaseStride) + FloorDiv(d2, n) - mMin;
     }
-    const FoldedRow folding{phases, rowStride,  taps,         folded,       pairs,
-                            perRow, K % 2 == 1, first.data(), second.data()};
+    const FoldedRow folding{phases, rowStride, taps,       folded,
+                            pairs,  perRow,    K % 2 == 1, columns.data()};
     if (wide && SamplingKernelWidePath())
         KernelSteps8(folding, w, out);
     else

@@ -1,7 +1,7 @@
 // Thermal imager chain: sampling kernel, lag, NETD noise, fixed pattern, NUC, ADC and AGC.
 #include "sensors/thermal/thermal_imager.h"
 
-#include <emmintrin.h>
+#include <immintrin.h>
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -51,6 +51,79 @@ inline float Gaussian(uint64_t seed, uint64_t stream, uint64_t counter) {
 // Noise counter of pixel (x, y): one hash serves the pair (x, x + 1), x even.
 inline uint64_t PairCounter(int x, int y) {
     return (uint64_t(uint32_t(y)) << 32) | uint32_t(x / 2);
+}
+
+// The frame's constants of the per-pixel chain (ThermalImager::Process).
+struct ChainConstants {
+    double tau, alpha, kE, adcGain, adcOffset;
+    float sigma;
+};
+
+// The four lanes as doubles, one AVX conversion (two SSE2 ones without AVX).
+inline D4 Doubles(__m128 v) {
+#if defined(__AVX__)
+    return D4(_mm256_cvtps_pd(v));
+#else
+    return __builtin_convertvector(Floats4(v), D4);
+#endif
+}
+
+// The per-pixel chain of one row in double, four pixels at a time, with the same operations in
+// the same order as the scalar definition:
+//   L = τ·blurred, lagged = y + α(L − y) (L on a settled frame), E = kE·lagged,
+//   s = gain·E + offset + float(noiseScale·σ·z)  (s = E + float(σ·z) for an ideal response),
+//   counts = Quantize(adcGain·s + adcOffset).
+// rad holds the previous frame's lagged radiance and gets this frame's; sig holds the blurred
+// radiance and gets the signal. The response (ideal or not) and the lag (settled or not) are
+// template arguments and the constants locals, so that the loop neither branches on them nor
+// reloads them per pixel group.
+template <bool kIdeal, bool kSettled>
+void ChainRow(const ChainConstants& c, int w, const float* z, const float* gain,
+              const float* offset, const float* noiseScale, float* rad, float* sig, uint16_t* cnt) {
+    const double tau = c.tau, alpha = c.alpha, kE = c.kE, adcGain = c.adcGain,
+                 adcOffset = c.adcOffset, top = double(kAdcMaxCount);
+    const __m128 sigma4 = _mm_set1_ps(c.sigma);
+    const D4 top4 = D4{} + top;
+    const auto step = [&](int x, size_t lanes) __attribute__((always_inline)) {
+        const __m128 blurred = LoadLanes(sig + x, lanes, 0.0f);
+        // float(noiseScale·σ·z), left to right as the scalar product.
+        const __m128 z4 = LoadLanes(z + x, lanes, 0.0f);
+        const D4 L = tau * Doubles(blurred);
+        D4 lagged = L;
+        if constexpr (!kSettled) {
+            const D4 prev = Doubles(LoadLanes(rad + x, lanes, 0.0f));
+            lagged = prev + alpha * (L - prev);
+        }
+        const D4 E = kE * lagged;
+        D4 signal;
+        if constexpr (kIdeal) {
+            signal = E + Doubles(_mm_mul_ps(sigma4, z4));
+        } else {
+            const __m128 noise =
+                _mm_mul_ps(_mm_mul_ps(LoadLanes(noiseScale + x, lanes, 0.0f), sigma4), z4);
+            signal = (Doubles(LoadLanes(gain + x, lanes, 0.0f)) * E +
+                      Doubles(LoadLanes(offset + x, lanes, 0.0f))) +
+                     Doubles(noise);
+        }
+        StoreLanes(rad + x, lanes, __m128(__builtin_convertvector(lagged, Floats4)));
+        StoreLanes(sig + x, lanes, __m128(__builtin_convertvector(signal, Floats4)));
+        // Quantize: NaN and v ≤ 0 → 0 (as maxpd(v, 0)), v ≥ 16383 → 16383 (minpd(v, 16383)),
+        // else ⌊v + ½⌋.
+        D4 v = adcGain * signal + adcOffset;
+        v = v > 0.0 ? v : D4{};
+        v = v < top ? v : top4;
+        const I4 q = __builtin_convertvector(v + 0.5, I4);
+        if (lanes == 4) {
+            // The four counts (0 … 16383) packed to 16 bits.
+            const __m128i q16 = _mm_packs_epi32(__m128i(q), __m128i(q));
+            _mm_storel_epi64(reinterpret_cast<__m128i*>(cnt + x), q16);
+        } else {
+            for (size_t k = 0; k < lanes; ++k) cnt[size_t(x) + k] = uint16_t(q[k]);
+        }
+    };
+    int x = 0;
+    for (; x + 4 <= w; x += 4) step(x, 4);
+    if (x < w) step(x, size_t(w - x));
 }
 
 void Validate(const ThermalImagerSettings& s, int supersamples) {
@@ -261,20 +334,11 @@ void ThermalImager::Process(const Image& samples, double time_s, int64_t noiseFr
     // the pixel loop.
     const uint64_t key =
         scene::Mix64(scene::Mix64(settings_.seed) ^ (kStreamTemporal + uint64_t(noiseFrame)));
-    // The per-pixel chain in double, two lanes at a time, with the same operations in the same
-    // order as the scalar definition:
-    //   L = τ·blurred, lagged = y + α(L − y) (L on a settled frame), E = kE·lagged,
-    //   s = gain·E + offset + float(noiseScale·σ·z)  (s = E + float(σ·z) for an ideal response),
-    //   counts = Quantize(adcGain·s + adcOffset).
-    const double top = double(kAdcMaxCount);
-    const __m128 sigma4 = _mm_set1_ps(sigma);
     const bool settled = alpha == 1.0;
-    // The frame's constants by value: read through the closure, the compiler reloads them for
-    // every pixel group (the row stores might alias them).
-    const double adcGain = adcGain_, adcOffset = adcOffset_;
-    tbb::parallel_for(tbb::blocked_range<int>(0, h), [&, w, tau, alpha, kE, ideal, noisy, settled,
-                                                      sigma4, top, adcGain, adcOffset,
-                                                      key](const tbb::blocked_range<int>& rows) {
+    const ChainConstants chain{tau, alpha, kE, adcGain_, adcOffset_, sigma};
+    const auto chainRow = ideal ? (settled ? ChainRow<true, true> : ChainRow<true, false>)
+                                : (settled ? ChainRow<false, true> : ChainRow<false, false>);
+    tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
         RowScratch& scratch = scratch_.local();
         scratch.noise.resize(size_t(w) + 4);
         float* z = scratch.noise.data();
@@ -289,44 +353,11 @@ void ThermalImager::Process(const Image& samples, double time_s, int64_t noiseFr
                 NormalPairsRow(key, PairCounter(0, y), size_t(w), z);
             else
                 std::fill_n(z, w, 0.0f);
-            for (int x = 0; x < w; x += 4) {
-                const size_t lanes = size_t(std::min(4, w - x));
-                const __m128 blurred = LoadLanes(sig + x, lanes, 0.0f);
-                const __m128 y4 = LoadLanes(rad + x, lanes, 0.0f);
-                // float(noiseScale·σ·z), left to right as the scalar product.
-                const __m128 z4 = LoadLanes(z + x, lanes, 0.0f);
-                __m128 noise, gain4 = _mm_setzero_ps(), offset4 = _mm_setzero_ps();
-                if (ideal) {
-                    noise = _mm_mul_ps(sigma4, z4);
-                } else {
-                    const float* scale = noiseScale_.data() + row + size_t(x);
-                    noise = _mm_mul_ps(_mm_mul_ps(LoadLanes(scale, lanes, 0.0f), sigma4), z4);
-                    gain4 = LoadLanes(gain_.data() + row + size_t(x), lanes, 0.0f);
-                    offset4 = LoadLanes(offset_.data() + row + size_t(x), lanes, 0.0f);
-                }
-                // The four lanes as doubles (one AVX vector, or two SSE2 ones).
-                const auto Doubles = [](__m128 v) {
-                    return __builtin_convertvector(Floats4(v), D4);
-                };
-                const D4 L = tau * Doubles(blurred);
-                D4 lagged = L;
-                if (!settled) {
-                    const D4 prev = Doubles(y4);
-                    lagged = prev + alpha * (L - prev);
-                }
-                const D4 E = kE * lagged;
-                const D4 signal = ideal ? E + Doubles(noise)
-                                        : (Doubles(gain4) * E + Doubles(offset4)) + Doubles(noise);
-                StoreLanes(rad + x, lanes, __m128(__builtin_convertvector(lagged, Floats4)));
-                StoreLanes(sig + x, lanes, __m128(__builtin_convertvector(signal, Floats4)));
-                // Quantize: NaN and v ≤ 0 → 0 (as maxpd(v, 0)), v ≥ 16383 → 16383 (minpd(v,
-                // 16383)), else ⌊v + ½⌋.
-                D4 v = adcGain * signal + adcOffset;
-                v = v > 0.0 ? v : D4{};
-                v = v < top ? v : D4{} + top;
-                const I4 q = __builtin_convertvector(v + 0.5, I4);
-                for (size_t k = 0; k < lanes; ++k) cnt[size_t(x) + k] = uint16_t(q[k]);
-            }
+            if (ideal)
+                chainRow(chain, w, z, nullptr, nullptr, nullptr, rad, sig, cnt);
+            else
+                chainRow(chain, w, z, gain_.data() + row, offset_.data() + row,
+                         noiseScale_.data() + row, rad, sig, cnt);
         }
     });
     display_.Update(counts_, dt_s);

@@ -174,6 +174,61 @@ TEST(OpticsKernel, WidePathEqualsTheFourLanePathBitForBit) {
         }
 }
 
+// The folded sum SampleKernelRow documents, in float, pixel by pixel: per folded row i (sample
+// rows i and K − 1 − i summed, the centre row of an odd K alone), per column pair p (columns p
+// and K − 1 − p of the folded row summed), acc += (0 + tap(i, p))·pair, then the centre column
+// of an odd K; edges clamp.
+Image FoldedSampling(const Image& s, const SamplingKernel& k) {
+    const int n = k.supersamples, K = k.size, o = (n - K) / 2;
+    Image out(s.width / n, s.height / n, 1);
+    for (int y = 0; y < out.height; ++y)
+        for (int x = 0; x < out.width; ++x) {
+            float acc = 0.0f;
+            for (int i = 0; i < (K + 1) / 2; ++i) {
+                const int ya = std::clamp(n * y + o + i, 0, s.height - 1);
+                const int yb = std::clamp(n * y + o + K - 1 - i, 0, s.height - 1);
+                const auto folded = [&](int j) {
+                    const int c = std::clamp(n * x + o + j, 0, s.width - 1);
+                    return 2 * i + 1 == K ? s.At(c, ya)[0] : s.At(c, ya)[0] + s.At(c, yb)[0];
+                };
+                const auto tap = [&](int j) { return 0.0f + k.taps[size_t(i * k.padded + j)]; };
+                for (int p = 0; p < K / 2; ++p)
+                    acc = acc + tap(p) * (folded(p) + folded(K - 1 - p));
+                if (K % 2 == 1) acc = acc + tap(K / 2) * folded(K / 2);
+            }
+            out.At(x, y)[0] = acc;
+        }
+    return out;
+}
+
+TEST(OpticsKernel, SamplingEqualsTheFoldedFloatSumBitForBit) {
+    // Both lane widths against the folded order written out pixel by pixel: odd and even K,
+    // widths below, at and between multiples of the 40- and 80-pixel steps, kernels wider than
+    // the image, so the steps, the partial last step and the clamped edges all agree bit for
+    // bit.
+    OpticsGeometry g;
+    g.fNumber = 1.0;
+    g.fillFactor = 0.8;
+    for (int n : {1, 2, 3})
+        for (int w : {3, 23, 40, 80, 81, 163}) {
+            const SamplingKernel k = BuildSamplingKernel(radiometry::Band::Lwir(), g, n, 4);
+            Image s(w * n, 6 * n, 1);
+            for (int y = 0; y < s.height; ++y)
+                for (int x = 0; x < s.width; ++x)
+                    s.At(x, y)[0] = float(25.0 + 12.0 * std::sin(0.37 * x + 0.81 * y) +
+                                          (x * 13 + y * 5) % 17 * 0.1);
+            const Image ref = FoldedSampling(s, k);
+            for (bool wide : {false, true}) {
+                const Image fast = ApplySamplingKernel(s, k, wide);
+                ASSERT_EQ(fast.pixels.size(), ref.pixels.size());
+                for (size_t i = 0; i < ref.pixels.size(); ++i)
+                    ASSERT_EQ(std::bit_cast<uint32_t>(fast.pixels[i]),
+                              std::bit_cast<uint32_t>(ref.pixels[i]))
+                        << "N " << n << " w " << w << " wide " << wide << " pixel " << i;
+            }
+        }
+}
+
 TEST(OpticsKernel, TapsAreEvenInBothAxesBitForBit) {
     OpticsGeometry g;
     g.fillFactor = 0.7;

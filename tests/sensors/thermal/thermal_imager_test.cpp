@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <numbers>
@@ -11,6 +13,9 @@
 
 #include "radiometry/planck/planck.h"
 #include "scene/core/error.h"
+#include "scene/core/rng.h"
+#include "sensors/thermal/normal_deviates.h"
+#include "sensors/thermal/optics_kernel.h"
 
 namespace seasense::sensors {
 namespace {
@@ -306,6 +311,107 @@ TEST(ThermalImager, RejectsBadSettings) {
     EXPECT_THROW(ThermalImager(s, radiometry::Band::Lwir(), 2), InputError);
     s = SmallSettings(0, 8);
     EXPECT_THROW(ThermalImager(s, radiometry::Band::Lwir(), 2), InputError);
+}
+
+// The per-pixel chain written out in scalars from its definition (ThermalImager::Process):
+// L = τ·blurred, lagged = y + α(L − y) (L when settled), E = kE·lagged, s = E + float(σ·z),
+// counts = clamp(⌊adcGain·s + adcOffset + ½⌋, 0, 16383) (NaN → 0), for an ideal response; the
+// deviates z of pixels (x, x + 1), x even, from one hash of (seed, frame, pixel pair).
+struct ChainReference {
+    std::vector<float> radiance, signal;
+    std::vector<uint16_t> counts;
+};
+ChainReference ReferenceChain(const ThermalImager& imager, const Image& samples,
+                              const std::vector<float>& previous, double alpha, int64_t frame) {
+    const ThermalImagerSettings& s = imager.Settings();
+    const double tau = s.opticsTransmission;
+    const double kE = FocalPlaneIrradiance(1.0, tau, s.fNumber) / tau;
+    const float sigma = float(imager.NoiseSigma());
+    const Image blurred = ApplySamplingKernel(samples, imager.Kernel());
+    ChainReference r;
+    for (int y = 0; y < s.height_px; ++y)
+        for (int x = 0; x < s.width_px; ++x) {
+            const size_t i = size_t(y) * size_t(s.width_px) + size_t(x);
+            float z[2];
+            NormalPair(scene::HashBits(s.seed, (uint64_t(1) << 40) + uint64_t(frame),
+                                       (uint64_t(y) << 32) | uint64_t(x / 2)),
+                       z[0], z[1]);
+            const double L = tau * double(blurred.pixels[i]);
+            const double lagged =
+                alpha == 1.0 ? L : double(previous[i]) + alpha * (L - double(previous[i]));
+            const double E = kE * lagged;
+            const double signal = E + double(sigma * z[x % 2]);
+            double v = imager.AdcGain() * signal + imager.AdcOffset();
+            v = v > 0.0 ? v : 0.0;
+            v = v < 16383.0 ? v : 16383.0;
+            r.radiance.push_back(float(lagged));
+            r.signal.push_back(float(signal));
+            r.counts.push_back(uint16_t(int(v + 0.5)));
+        }
+    return r;
+}
+
+TEST(ThermalImager, PixelChainEqualsItsScalarDefinitionBitForBit) {
+    // Radiance, signal and counts of a settled first frame and two lagged frames, noise on,
+    // a width that is not a multiple of four (the partial last pixel group), and scene values
+    // that clip the ADC at both ends.
+    const int w = 23, h = 5, n = 2;
+    ThermalImagerSettings s = SmallSettings(w, h);
+    s.netd_K = 0.05;
+    ThermalImager imager(s, radiometry::Band::Lwir(), n);
+    Image scene(w * n, h * n, 1);
+    std::vector<float> previous;
+    double t = 0.0;
+    for (int f = 0; f < 3; ++f) {
+        for (int y = 0; y < h * n; ++y)
+            for (int x = 0; x < w * n; ++x)
+                scene.At(x, y)[0] =
+                    float(LwirRadiance(220.0 + 5.0 * x + 30.0 * std::sin(0.7 * y + f)));
+        const double dt = f == 0 ? 0.0 : 0.004 * f;
+        const double alpha = f == 0 ? 1.0 : 1.0 - std::exp(-dt / s.timeConstant_s);
+        t += dt;
+        const ChainReference ref = ReferenceChain(imager, scene, previous, alpha, f);
+        imager.Process(scene, t);
+        for (size_t i = 0; i < ref.counts.size(); ++i) {
+            ASSERT_EQ(std::bit_cast<uint32_t>(imager.Radiance().pixels[i]),
+                      std::bit_cast<uint32_t>(ref.radiance[i]))
+                << "frame " << f << " pixel " << i;
+            ASSERT_EQ(std::bit_cast<uint32_t>(imager.Signal().pixels[i]),
+                      std::bit_cast<uint32_t>(ref.signal[i]))
+                << "frame " << f << " pixel " << i;
+            ASSERT_EQ(imager.Counts()[i], ref.counts[i]) << "frame " << f << " pixel " << i;
+        }
+        EXPECT_NE(std::count(ref.counts.begin(), ref.counts.end(), 0), 0);
+        EXPECT_NE(std::count(ref.counts.begin(), ref.counts.end(), 16383), 0);
+        previous = imager.Radiance().pixels;
+    }
+}
+
+TEST(ThermalImager, PixelChainOfACalibratedResponseEqualsTheIdealOneBitForBit) {
+    // A noiseless one-frame NUC of a pattern-free detector calibrates every pixel to gain 1 and
+    // offset 0 exactly, so the per-pixel response path (gain·E + offset + noise) must give the
+    // ideal path's bits: loads of the wrong arrays or a different order would not.
+    const int w = 23, h = 5, n = 2;
+    ThermalImagerSettings s = SmallSettings(w, h);
+    ThermalImager ideal(s, radiometry::Band::Lwir(), n);
+    s.nuc = true;
+    s.nucFrames = 1;
+    ThermalImager calibrated(s, radiometry::Band::Lwir(), n);
+    Image scene(w * n, h * n, 1);
+    for (int f = 0; f < 2; ++f) {
+        for (int y = 0; y < h * n; ++y)
+            for (int x = 0; x < w * n; ++x)
+                scene.At(x, y)[0] = float(LwirRadiance(250.0 + 2.0 * x + 9.0 * y + 7.0 * f));
+        ideal.Process(scene, 0.01 * f);
+        calibrated.Process(scene, 0.01 * f);
+        for (size_t i = 0; i < size_t(w * h); ++i) {
+            ASSERT_EQ(std::bit_cast<uint32_t>(calibrated.Radiance().pixels[i]),
+                      std::bit_cast<uint32_t>(ideal.Radiance().pixels[i]));
+            ASSERT_EQ(std::bit_cast<uint32_t>(calibrated.Signal().pixels[i]),
+                      std::bit_cast<uint32_t>(ideal.Signal().pixels[i]));
+            ASSERT_EQ(calibrated.Counts()[i], ideal.Counts()[i]);
+        }
+    }
 }
 
 TEST(ThermalImager, OneAndTwoThreadsGiveBitIdenticalFrames) {
