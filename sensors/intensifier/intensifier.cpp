@@ -435,6 +435,9 @@ void Intensifier::Process(const Image& samples, double time_s, int64_t frame) {
     struct RowScratch {
         std::vector<double> disc;   // disc sums of a row (whole blocks)
         std::vector<float> padded;  // the halo row with r clamped pixels either side
+        // Per disc row, the offsets in prefix_ of its run's ends for pixel 0: the prefix sum
+        // after the run (hi) and before it (lo).
+        std::vector<ptrdiff_t> hi, lo;
     };
     tbb::enumerable_thread_specific<RowScratch> scratch;
     tbb::parallel_for(0, h, [&](int y) {
@@ -450,17 +453,27 @@ void Intensifier::Process(const Image& samples, double time_s, int64_t frame) {
             s.disc.resize(size_t(blocks * kHaloBlock));
             const int dyLo = std::max(-R, -y), dyHi = std::min(R, h - 1 - y);
             const int blockA = a / kHaloBlock, blockB = (b + kHaloBlock - 1) / kHaloBlock;
+            // The run ends as offsets from the block's first pixel, so that each disc row's
+            // loads are two index registers and constant displacements.
+            const size_t rows = size_t(dyHi - dyLo + 1);
+            s.hi.resize(rows);
+            s.lo.resize(rows);
+            for (int dy = dyLo; dy <= dyHi; ++dy) {
+                const int hw = halfWidth[size_t(dy + R)];
+                const ptrdiff_t p = ptrdiff_t(size_t(y + dy) * stride) + R;
+                s.hi[size_t(dy - dyLo)] = p + hw + 1;
+                s.lo[size_t(dy - dyLo)] = p - hw;
+            }
+            const ptrdiff_t* hiEnd = s.hi.data() + rows;
             for (int block = blockA; block < blockB; ++block) {
                 const int x0 = block * kHaloBlock;
-                VD acc[kHaloBlock / 4] = {};
-                for (int dy = dyLo; dy <= dyHi; ++dy) {
-                    const int hw = halfWidth[size_t(dy + R)];
-                    const double* p = &prefix_[size_t(y + dy) * stride + size_t(R + x0)];
-                    const double* hi = p + hw + 1;
-                    const double* lo = p - hw;
+                const double* p = prefix_.data() + x0;
+                VD acc[kHaloBlock / 4];
+                for (int j = 0; j < kHaloBlock / 4; ++j) acc[j] = VD{};
+                const ptrdiff_t* lo = s.lo.data();
+                for (const ptrdiff_t* hi = s.hi.data(); hi != hiEnd; ++hi, ++lo)
                     for (int j = 0; j < kHaloBlock / 4; ++j)
-                        acc[j] += LoadVD(hi + 4 * j) - LoadVD(lo + 4 * j);
-                }
+                        acc[j] += LoadVD(p + *hi + 4 * j) - LoadVD(p + *lo + 4 * j);
                 for (int j = 0; j < kHaloBlock / 4; ++j)
                     std::memcpy(&s.disc[size_t(x0 + 4 * j)], &acc[j], sizeof(VD));
             }
