@@ -478,9 +478,11 @@ uint64_t FlirChannel::ShadeRows(const FrameShading& f, int y0, int y1, float* ou
     // time), model positions and normals.
     size_t skyCount = 0, seaCount = 0;
     TriangleCache tri;
-    // Mesh 0's primitives (all of them when there are no models).
+    // Mesh 0's primitives (all of them when there are no models); deep water from
+    // kSurfDeepColumn_m, where ShadeSea's SurfInfraredRadiance needs no attribute sums.
     const std::vector<uint32_t>& bases = f.vis.primitiveBase;
-    SeaGather sea(f.meshes[0], bases[0], (bases.size() > 1 ? bases[1] : kNoPrimitive) - bases[0]);
+    SeaGather sea(f.meshes[0], bases[0], (bases.size() > 1 ? bases[1] : kNoPrimitive) - bases[0],
+                  kSurfDeepColumn_m);
     for (int y = y0; y < y1; ++y) {
         const double ndcY = 1.0 - 2.0 * (y + 0.5) / f.sampleHeight;
         const glm::vec3 rowBase(f.forward + f.up * ndcY - f.right);

@@ -49,6 +49,14 @@ inline V SurfInfraredRadiance(const SurfInfrared& s, V epsWater, V seaB, V skyR,
     const V surface = water + (sand - water) * (one - film);
     return surface + (white - surface) * foam;
 }
+
+// The vertex column (m) from which the FLIR's SeaGather writes a sea sample's attributes as deep
+// water (kMaxVertexAttribute, 0, 0) instead of their sums (channels/view/surface_gather.h): the
+// sample's own column is then ≥ 2·kSwashFilm_m·(1 − 2^-22), so film = 1 and (sand − water)·0
+// adds ±0 for the finite wet sum, and its foam sum is ±0, adding ±0 again: SurfInfraredRadiance
+// is the water term for both, the same bits (water, a sum of non-negative products, is not −0).
+inline constexpr float kSurfDeepColumn_m = 2.0f * kSwashFilm_m;
+
 inline simd4::F4 SurfInfraredRadiance4(const SurfInfrared& s, simd4::F4 epsWater, simd4::F4 seaB,
                                        simd4::F4 skyR, simd4::F4 depth, simd4::F4 wet,
                                        simd4::F4 foam) {

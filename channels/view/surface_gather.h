@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstring>
 #include <glm/glm.hpp>
+#include <limits>
 #include <vector>
 
 #include "channels/raster/rasterizer.h"
@@ -105,11 +106,28 @@ struct SeaSamples {
 // row are sea, in runs of a few samples per triangle, so this is the shading pass's inner
 // loop: the sea mesh is known (no search for the mesh) and a run's samples are interpolated a
 // lane group at a time from its triangle's vertex components (each broadcast to the lanes).
+//
+// Deep water (optional): most sea triangles lie in open water, where a consumer that only asks
+// whether the column exceeds a film and whether there is foam needs no attribute sums. A triangle
+// is deep when each vertex's clamped attributes have depth ≥ deepDepth, foam 0 and a finite wet
+// value (|wet| ≤ kMaxVertexAttribute). A lane group on a deep triangle whose weights w0, b1, b2
+// are all ≥ 0 (so none is NaN or infinite, and each sum is a convex combination: within 2^-22
+// of the vertices' range) gets the records (kMaxVertexAttribute, 0, 0) instead of the sums:
+// its true sums have depth ≥ deepDepth·(1 − 2^-22), foam ±0 and a finite wet value.
 class SeaGather {
   public:
     // sea: mesh 0 of the visibility buffer, its primitives [seaBase, seaBase + seaPrimitives).
-    SeaGather(const MeshArrays& sea, uint32_t seaBase, uint32_t seaPrimitives)
-        : sea_(sea), base_(seaBase), count_(seaPrimitives) {}
+    // deepDepth: see above; +∞ (the default) makes no triangle deep.
+    SeaGather(const MeshArrays& sea, uint32_t seaBase, uint32_t seaPrimitives,
+              float deepDepth = std::numeric_limits<float>::infinity())
+        : sea_(sea),
+          base_(seaBase),
+          count_(seaPrimitives),
+          deepLow_(_mm_setr_ps(deepDepth, -kMaxVertexAttribute, 0.0f,
+                               -std::numeric_limits<float>::infinity())),
+          deepHigh_(_mm_setr_ps(std::numeric_limits<float>::infinity(),
+                                std::numeric_limits<float>::infinity(), 0.0f,
+                                std::numeric_limits<float>::infinity())) {}
 
     bool IsSea(uint32_t prim) const { return prim - base_ < count_; }
 
@@ -122,12 +140,16 @@ class SeaGather {
                SeaSamples<kCapacity>& out, size_t& records) {
         using simd::VF, simd::VI, simd::kLanes;
         const VF top = simd::Broadcast(kMaxVertexAttribute);
-        // The triangle's state in locals: the record stores could alias the members.
+        // The mesh and the triangle's state in locals: the record stores could alias the
+        // members. The triangle's vertices as float offsets 3·index into the positions and
+        // normals (three registers rather than six pointers).
+        const float* const positions = reinterpret_cast<const float*>(sea_.positions);
+        const float* const normals = reinterpret_cast<const float*>(sea_.normals);
+        const uint32_t* const indices = sea_.indices;
+        const glm::vec4* const attributes = sea_.attributes;
         uint32_t last = prim_;
-        const float* const* vertex = vertex_;
-        const float *p0 = vertex[0], *p1 = vertex[1], *p2 = vertex[2];
-        const float *n0 = vertex[3], *n1 = vertex[4], *n2 = vertex[5];
-        const float *a0 = vertex[6], *a1 = vertex[7], *a2 = vertex[8];
+        bool deep = deep_;
+        size_t o0 = offset_[0], o1 = offset_[1], o2 = offset_[2];
         size_t r = records;
         // A lane group of samples at a time: all lanes interpolated on the first sample's
         // triangle and stored, its leading lanes on that triangle (up to the row's end or a full
@@ -137,15 +159,10 @@ class SeaGather {
             if (!IsSea(prim)) break;
             if (prim != last) {
                 last = prim;
-                const uint32_t* i = sea_.indices + 3 * size_t(prim - base_);
-                p0 = &sea_.positions[i[0]].x, p1 = &sea_.positions[i[1]].x;
-                p2 = &sea_.positions[i[2]].x;
-                n0 = &sea_.normals[i[0]].x, n1 = &sea_.normals[i[1]].x;
-                n2 = &sea_.normals[i[2]].x;
-                if (sea_.attributes) {
-                    a0 = &sea_.attributes[i[0]].x, a1 = &sea_.attributes[i[1]].x;
-                    a2 = &sea_.attributes[i[2]].x;
-                }
+                const uint32_t* i = indices + 3 * size_t(prim - base_);
+                o0 = 3 * size_t(i[0]), o1 = 3 * size_t(i[1]), o2 = 3 * size_t(i[2]);
+                if (attributes)
+                    deep = Deep(attributes + i[0], attributes + i[1], attributes + i[2]);
             }
             const size_t inRow = std::min(kLanes, size_t(sw - x));
             VI p;
@@ -166,29 +183,58 @@ class SeaGather {
             // min(a, top) as TriangleCache's _mm_min_ps(a, top): top where a is NaN.
             const auto Clamped = [&](const float* c) { return simd::Min(top, B(c)); };
             for (int c = 0; c < 3; ++c) {
-                simd::Store(out.c[kSeaPx + c] + r, Sum(B(p0 + c), B(p1 + c), B(p2 + c)));
-                simd::Store(out.c[kSeaNx + c] + r, Sum(B(n0 + c), B(n1 + c), B(n2 + c)));
-                simd::Store(out.c[kSeaDepth + c] + r,
-                            Sum(Clamped(a0 + c), Clamped(a1 + c), Clamped(a2 + c)));
+                const float* const pc = positions + c;
+                const float* const nc = normals + c;
+                simd::Store(out.c[kSeaPx + c] + r, Sum(B(pc + o0), B(pc + o1), B(pc + o2)));
+                simd::Store(out.c[kSeaNx + c] + r, Sum(B(nc + o0), B(nc + o1), B(nc + o2)));
+            }
+            if (deep && simd::All((w0 >= 0.0f) & (u >= 0.0f) & (v >= 0.0f))) {
+                simd::Store(out.c[kSeaDepth] + r, top);
+                simd::Store(out.c[kSeaWet] + r, VF{});
+                simd::Store(out.c[kSeaFoam] + r, VF{});
+            } else {
+                // Zeros for a sea without attributes.
+                const float *a0 = kNone, *a1 = kNone, *a2 = kNone;
+                if (attributes) {
+                    const uint32_t* i = indices + 3 * size_t(last - base_);
+                    a0 = &attributes[i[0]].x, a1 = &attributes[i[1]].x, a2 = &attributes[i[2]].x;
+                }
+                for (int c = 0; c < 3; ++c)
+                    simd::Store(out.c[kSeaDepth + c] + r,
+                                Sum(Clamped(a0 + c), Clamped(a1 + c), Clamped(a2 + c)));
             }
             r += size_t(run);
             x += run;
         }
         prim_ = last;
-        const float* const now[9] = {p0, p1, p2, n0, n1, n2, a0, a1, a2};
-        std::copy_n(now, 9, vertex_);
+        deep_ = deep;
+        offset_[0] = o0, offset_[1] = o1, offset_[2] = o2;
         records = r;
         return x;
     }
 
   private:
+    // Whether the triangle with vertex attributes a0, a1, a2 (each x, y, z, w) is deep: the
+    // clamped attributes (_mm_min_ps(a, top) as the sums' clamp) of all three vertices within
+    // [deepLow_, deepHigh_] component by component (w unconstrained).
+    bool Deep(const glm::vec4* a0, const glm::vec4* a1, const glm::vec4* a2) const {
+        const simd4::F4 top = _mm_set1_ps(kMaxVertexAttribute);
+        const simd4::F4 c0 = _mm_min_ps(_mm_loadu_ps(&a0->x), top);
+        const simd4::F4 c1 = _mm_min_ps(_mm_loadu_ps(&a1->x), top);
+        const simd4::F4 c2 = _mm_min_ps(_mm_loadu_ps(&a2->x), top);
+        const simd4::F4 low = _mm_min_ps(c0, _mm_min_ps(c1, c2));
+        const simd4::F4 high = _mm_max_ps(c0, _mm_max_ps(c1, c2));
+        return _mm_movemask_ps(
+                   _mm_and_ps(_mm_cmpge_ps(low, deepLow_), _mm_cmple_ps(high, deepHigh_))) == 0xf;
+    }
+
     const MeshArrays& sea_;
     uint32_t base_, count_;
+    simd4::F4 deepLow_, deepHigh_;  // the deep bounds: (deepDepth, −top, 0, −∞), (∞, ∞, 0, ∞)
     uint32_t prim_ = kNoPrimitive;
-    // The last triangle's three vertices: positions, normals and attributes (each x, y, z);
-    // zeros for the attributes of a sea without them.
-    static constexpr float kNone[3] = {};
-    const float* vertex_[9] = {kNone, kNone, kNone, kNone, kNone, kNone, kNone, kNone, kNone};
+    bool deep_ = false;      // whether prim_ is deep
+    size_t offset_[3] = {};  // prim_'s vertices, 3·index (floats into positions and normals)
+    static constexpr float kNone[3] = {};  // the attributes of a sea without them
 };
 
 }  // namespace seasense::channels

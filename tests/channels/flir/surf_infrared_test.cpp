@@ -11,9 +11,14 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <memory>
+#include <random>
 #include <sstream>
+#include <vector>
 
 #include "channels/flir/flir_channel.h"
+#include "channels/view/surface_gather.h"
 #include "radiometry/materials/material_table.h"
 #include "radiometry/planck/planck.h"
 #include "scene/config/config.h"
@@ -230,6 +235,87 @@ TEST(FlirSurf, SurfZoneNeedsTheSandMaterials) {
         EXPECT_NE(std::string(e.what()).find("sand_dry"), std::string::npos) << e.what();
     }
     fs::remove_all(dir);
+}
+
+TEST(FlirSurf, DeepWaterRecordsShadeAsTheSumsTheyReplace) {
+    // A sea mesh whose vertex columns lie on both sides of kSurfDeepColumn_m and of the swash
+    // film (and at it, +∞, NaN), with foam mostly ±0 (else 1e-30, 0.3 or NaN) and wet values in
+    // [0, 1], NaN, 1e5 or −∞; barycentrics mostly inside the triangle, sometimes −0, NaN, +∞,
+    // slightly negative or far outside. Gathered with the FLIR's deep column and without deep
+    // records, the two radiances of every sample must be the same bits.
+    std::mt19937 rng(41);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    const float inf = std::numeric_limits<float>::infinity();
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    std::vector<glm::vec3> positions, normals;
+    std::vector<glm::vec4> attributes;
+    for (int i = 0; i < 60; ++i) {
+        positions.emplace_back(unit(rng), unit(rng), unit(rng));
+        normals.emplace_back(unit(rng), unit(rng), 1.0f);
+        const float columns[] = {inf,
+                                 nan,
+                                 1.0e5f,
+                                 kSurfDeepColumn_m,
+                                 3.0f * kSurfDeepColumn_m,
+                                 3.0f * kSurfDeepColumn_m * unit(rng)};
+        const float wets[] = {unit(rng), unit(rng), unit(rng), nan, 1.0e5f, -inf};
+        const float foams[] = {0.0f, -0.0f, 0.0f, -0.0f, 0.0f, 1.0e-30f, 0.3f, nan};
+        attributes.emplace_back(columns[rng() % 6], wets[rng() % 6], foams[rng() % 8], 0.0f);
+    }
+    constexpr uint32_t kTriangles = 40;
+    std::vector<uint32_t> indices;
+    for (uint32_t k = 0; k < 3 * kTriangles; ++k) indices.push_back(rng() % 60);
+    constexpr int kWidth = 20000;
+    std::vector<uint32_t> prims;
+    std::vector<float> b1, b2;
+    while (int(prims.size()) < kWidth) {
+        const uint32_t run = 1 + rng() % 11, prim = rng() % kTriangles;
+        for (uint32_t s = 0; s < run && int(prims.size()) < kWidth; ++s) {
+            float u = unit(rng), v = unit(rng) * (1.0f - u);
+            const uint32_t odd = rng() % 200;
+            if (odd == 0) u = -0.0f;
+            if (odd == 1) v = nan;
+            if (odd == 2) u = inf;
+            if (odd == 3) v = -1.0e-3f;
+            if (odd == 4) u = -30.0f, v = 20.0f;
+            prims.push_back(prim), b1.push_back(u), b2.push_back(v);
+        }
+    }
+    const MeshArrays mesh{positions.data(), normals.data(), indices.data(), attributes.data()};
+    SeaGather deep(mesh, 0, kTriangles, kSurfDeepColumn_m), summed(mesh, 0, kTriangles);
+    // Records of the whole row (on the heap: 720 kB each).
+    const auto samplesA = std::make_unique<SeaSamples<kWidth>>();
+    const auto samplesB = std::make_unique<SeaSamples<kWidth>>();
+    SeaSamples<kWidth>&a = *samplesA, &b = *samplesB;
+    size_t na = 0, nb = 0;
+    for (int x = 0; x < kWidth;) {
+        const int next = deep.Gather(prims.data(), b1.data(), b2.data(), x, kWidth, a, na);
+        ASSERT_EQ(summed.Gather(prims.data(), b1.data(), b2.data(), x, kWidth, b, nb), next);
+        x = next;
+    }
+    ASSERT_EQ(na, size_t(kWidth));
+    ASSERT_EQ(nb, size_t(kWidth));
+    SurfInfrared surf;
+    size_t replaced = 0;
+    for (size_t r = 0; r < na; ++r) {
+        surf.foamEmissivity = 0.95f + 0.05f * unit(rng);
+        surf.foamB = 1.0f + 20.0f * unit(rng);
+        surf.sandDry = 1.0f + 20.0f * unit(rng);
+        surf.sandWet = 1.0f + 20.0f * unit(rng);
+        const float eps = 0.9f + 0.1f * unit(rng), seaB = 1.0f + 20.0f * unit(rng);
+        const float skyR = 0.5f + 10.0f * unit(rng);
+        const auto L = [&](const SeaSamples<kWidth>& s) {
+            return SurfInfraredRadiance(surf, eps, seaB, skyR, s.c[kSeaDepth][r], s.c[kSeaWet][r],
+                                        s.c[kSeaFoam][r]);
+        };
+        const float la = L(a), lb = L(b);
+        replaced += std::memcmp(&a.c[kSeaDepth][r], &b.c[kSeaDepth][r], sizeof(float)) != 0;
+        EXPECT_TRUE(std::memcmp(&la, &lb, sizeof la) == 0 || (std::isnan(la) && std::isnan(lb)))
+            << "sample " << r << ": " << la << " against the sums' " << lb << " (column "
+            << b.c[kSeaDepth][r] << ", wet " << b.c[kSeaWet][r] << ", foam " << b.c[kSeaFoam][r]
+            << ")";
+    }
+    EXPECT_GT(replaced, 2000u);
 }
 
 }  // namespace
