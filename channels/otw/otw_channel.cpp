@@ -19,6 +19,7 @@
 #include "channels/otw/sea_glint.h"
 #include "channels/otw/shore_shading.h"
 #include "channels/otw/spray_overlay.h"
+#include "channels/otw/triangle_lanes.h"
 #include "channels/plume/plume_composite.h"
 #include "radiometry/sky/analytic_sky.h"
 #include "radiometry/surface/fresnel.h"
@@ -31,6 +32,7 @@ namespace seasense::channels {
 namespace {
 
 using namespace simd4;
+using namespace triangle_lanes;
 
 // Remote-sensing reflectance R_rs = L_w / E_d of clear oceanic (Case 1) water, sr⁻¹, at the
 // Rec.709 primaries' dominant wavelengths (≈ 610, 550, 465 nm); order of magnitude from
@@ -329,9 +331,23 @@ struct CachedTriangle {
     uint32_t prim = kNoPrimitive;
     int mesh = 0;
     uint64_t frame = 0;  // OtwChannel's frame count when gathered (0: never)
-    F4 p0 = _mm_setzero_ps(), p1 = p0, p2 = p0, n0 = p0, n1 = p0, n2 = p0;
-    F4 a0 = p0, a1 = p0, a2 = p0;  // sea vertex attributes (ViewGeometry::OceanAttributes)
-    bool shadowable = false;       // a shadow ray from some point of it may meet a caster
+    // Vertex v's position then its normal, adjacent: both are interpolated at once on eight
+    // lanes (PN), with the same operations per lane as on four.
+    F4 pn[3][2] = {};
+    F4 a[3] = {};  // sea vertex attributes (ViewGeometry::OceanAttributes)
+    // The normals' components x, y, z across the vertices, (c of n0, n1, n2, 0): their dot
+    // products with one vector at once.
+    F4 nT[3] = {};
+    bool shadowable = false;  // a shadow ray from some point of it may meet a caster
+
+    const F4& P(int v) const { return pn[v][0]; }
+    const F4& N(int v) const { return pn[v][1]; }
+    // Position in lanes 0–3, normal in lanes 4–7.
+    F8 PN(int v) const {
+        F8 r;
+        std::memcpy(&r, pn[v], sizeof r);
+        return r;
+    }
 };
 
 // Per-thread scratch of the shading pass. The pixels of a row block are sorted into sky, sea
@@ -390,12 +406,14 @@ glm::vec3 Store3(F4 v) {
     return {f[0], f[1], f[2]};
 }
 
-// a·b of (x, y, z, ·) vectors in glm::dot's order, (x + y) + z.
-float Dot3(F4 a, F4 b) {
+// a·b of (x, y, z, ·) vectors in glm::dot's order, (x + y) + z, in lane 0 (Dot3Lane) or as a
+// float.
+F4 Dot3Lane(F4 a, F4 b) {
     const F4 m = _mm_mul_ps(a, b);
     const F4 xy = _mm_add_ss(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(1, 1, 1, 1)));
-    return _mm_cvtss_f32(_mm_add_ss(xy, _mm_shuffle_ps(m, m, _MM_SHUFFLE(2, 2, 2, 2))));
+    return _mm_add_ss(xy, _mm_shuffle_ps(m, m, _MM_SHUFFLE(2, 2, 2, 2)));
 }
+float Dot3(F4 a, F4 b) { return _mm_cvtss_f32(Dot3Lane(a, b)); }
 
 // b0·a0 + b1·a1 + b2·a2 per component, in glm's order ((b0 a0 + b1 a1) + b2 a2).
 F4 Interpolate3(F4 b0, F4 b1, F4 b2, F4 a0, F4 a1, F4 a2) {
@@ -440,27 +458,30 @@ struct FrameGeometry {
         const uint32_t t = prim - vis.primitiveBase[size_t(mesh)];
         const uint32_t i0 = m.I[3 * t], i1 = m.I[3 * t + 1], i2 = m.I[3 * t + 2];
         tri.prim = prim, tri.mesh = mesh;
-        tri.p0 = Load3(m.P[i0]), tri.p1 = Load3(m.P[i1]), tri.p2 = Load3(m.P[i2]);
-        tri.n0 = Load3(m.N[i0]), tri.n1 = Load3(m.N[i1]), tri.n2 = Load3(m.N[i2]);
-        if (m.A) {
-            tri.a0 = _mm_loadu_ps(&m.A[i0].x), tri.a1 = _mm_loadu_ps(&m.A[i1].x);
-            tri.a2 = _mm_loadu_ps(&m.A[i2].x);
+        const uint32_t i[3] = {i0, i1, i2};
+        for (int v = 0; v < 3; ++v) {
+            tri.pn[v][0] = Load3(m.P[i[v]]), tri.pn[v][1] = Load3(m.N[i[v]]);
+            if (m.A) tri.a[v] = _mm_loadu_ps(&m.A[i[v]].x);
         }
+        F4 x = tri.N(0), y = tri.N(1), z = tri.N(2), unused = _mm_setzero_ps();
+        _MM_TRANSPOSE4_PS(x, y, z, unused);
+        tri.nT[0] = x, tri.nT[1] = y, tri.nT[2] = z;
     }
 };
 
 // Surface position and (unnormalized) interpolated normal at barycentrics (1 − b1 − b2, b1, b2)
 // of triangle tri.
 void Interpolate(const CachedTriangle& tri, float b1, float b2, F4& p, F4& nSum) {
-    const float b0 = 1.0f - b1 - b2;
-    const F4 w0 = Set4(b0), w1 = Set4(b1), w2 = Set4(b2);
-    p = Interpolate3(w0, w1, w2, tri.p0, tri.p1, tri.p2);
-    nSum = Interpolate3(w0, w1, w2, tri.n0, tri.n1, tri.n2);
+    const F8 pn =
+        Interpolate8(Set8(1.0f - b1 - b2), Set8(b1), Set8(b2), tri.PN(0), tri.PN(1), tri.PN(2));
+    p = Low(pn), nSum = High(pn);
 }
 
 // Vertex attributes at barycentrics (1 − b1 − b2, b1, b2) of triangle tri.
 F4 InterpolateAttributes(const CachedTriangle& tri, float b1, float b2) {
-    return Interpolate3(Set4(1.0f - b1 - b2), Set4(b1), Set4(b2), tri.a0, tri.a1, tri.a2);
+    // The weights as Interpolate broadcasts them (one broadcast each where both are made).
+    return Interpolate3(Low(Set8(1.0f - b1 - b2)), Low(Set8(b1)), Low(Set8(b2)), tri.a[0], tri.a[1],
+                        tri.a[2]);
 }
 
 // One frame's lighting and shading constants.
@@ -610,26 +631,31 @@ class BlockClassifier {
                 return;
             }
         }
-        const unsigned sky = LaneBits(q.sky), sea = LaneBits(q.allSea & q.depthsClose),
-                       same = LaneBits(q.same);
+        // Sky and sea pixels are disjoint (kNoPrimitive is not sea): the sea, most of the
+        // pixels here, is tested first.
+        const VI sea = q.allSea & q.depthsClose;
+        const unsigned sky = LaneBits(q.sky), seaSame = LaneBits(sea & q.same),
+                       seaMixed = LaneBits(sea & ~q.same);
         alignas(32) float b1Sum[kLanes], b2Sum[kLanes];
         Store(b1Sum, q.b1Sum), Store(b2Sum, q.b2Sum);
         for (size_t l = 0; l < kLanes; ++l) {
             const unsigned bit = 1u << l;
             const int x0 = 2 * px + int(2 * l);
             const uint32_t k = kRow + uint32_t(x0);
+            if (seaSame & bit) {
+                SeaTriangleClosePixel(x0, k, primitive_[i0 + 2 * l], b1Sum[l], b2Sum[l]);
+                continue;
+            }
+            if (seaMixed & bit) {
+                SeaClosePixel(x0, k);
+                continue;
+            }
             if (sky & bit) {
                 const glm::vec3 d = pixelRow + (float(x0) + 0.5f * float(kN)) * g_.colStep;
                 if (!f_.NearSun(d)) {
                     AddSky(k | kPixelEntry, d);
                     continue;
                 }
-            } else if (sea & bit) {
-                if (same & bit)
-                    SeaTriangleClosePixel(x0, k, primitive_[i0 + 2 * l], b1Sum[l], b2Sum[l]);
-                else
-                    SeaClosePixel(x0, k);
-                continue;
             }
             Samples(x0, k);
         }
@@ -651,8 +677,8 @@ class BlockClassifier {
             // largest ShadowRayOrigin offset (with as much again for rounding): a ray from the
             // box's centre that misses the caster box grown by that much cannot meet it from
             // any of them (Minkowski sum). This settles most triangles at once.
-            const F4 lo = _mm_min_ps(_mm_min_ps(tri.p0, tri.p1), tri.p2);
-            const F4 hi = _mm_max_ps(_mm_max_ps(tri.p0, tri.p1), tri.p2);
+            const F4 lo = _mm_min_ps(_mm_min_ps(tri.P(0), tri.P(1)), tri.P(2));
+            const F4 hi = _mm_max_ps(_mm_max_ps(tri.P(0), tri.P(1)), tri.P(2));
             const glm::vec3 l = Store3(lo), h = Store3(hi);
             const float far = std::max({std::abs(l.x), std::abs(l.y), std::abs(l.z), std::abs(h.x),
                                         std::abs(h.y), std::abs(h.z)});
@@ -729,26 +755,29 @@ class BlockClassifier {
         F4 p, nSum;
         Interpolate(tri, b1Sum * inv, b2Sum * inv, p, nSum);
         const F4 toEye = _mm_sub_ps(f_.eye4, p);
-        const float c0 = Dot3(tri.n0, toEye);
-        const float d1 = Dot3(tri.n1, toEye) - c0, d2 = Dot3(tri.n2, toEye) - c0;
-        float cMin = std::numeric_limits<float>::infinity(), cMax = -cMin;
+        // The vertex normals' n·toEye in lanes 0, 1, 2 (Dot3's operations), c0 and the
+        // differences d1, d2 from it.
+        const F4 dots = Dot4(tri.nT[0], tri.nT[1], tri.nT[2],
+                             _mm_shuffle_ps(toEye, toEye, _MM_SHUFFLE(0, 0, 0, 0)),
+                             _mm_shuffle_ps(toEye, toEye, _MM_SHUFFLE(1, 1, 1, 1)),
+                             _mm_shuffle_ps(toEye, toEye, _MM_SHUFFLE(2, 2, 2, 2)));
+        const F4 c0s = _mm_shuffle_ps(dots, dots, _MM_SHUFFLE(0, 0, 0, 0));
+        const F4 ds = _mm_sub_ps(dots, c0s);
+        const F4 d1s = _mm_shuffle_ps(ds, ds, _MM_SHUFFLE(1, 1, 1, 1)),
+                 d2s = _mm_shuffle_ps(ds, ds, _MM_SHUFFLE(2, 2, 2, 2));
+        const float c0 = _mm_cvtss_f32(c0s), d1 = _mm_cvtss_f32(d1s), d2 = _mm_cvtss_f32(d2s);
+        MinMax c;
         if constexpr (kN == 2) {
             // The four samples' c on lanes (the same operations), then min and max in order.
-            const F4 c =
-                _mm_add_ps(_mm_add_ps(Set4(c0), _mm_mul_ps(PixelSamples(b1[0], b1[1]), Set4(d1))),
-                           _mm_mul_ps(PixelSamples(b2[0], b2[1]), Set4(d2)));
-            alignas(16) float cs[4];
-            _mm_store_ps(cs, c);
-            for (const float ci : cs) cMin = std::min(cMin, ci), cMax = std::max(cMax, ci);
+            const F4 cs = _mm_add_ps(_mm_add_ps(c0s, _mm_mul_ps(PixelSamples(b1[0], b1[1]), d1s)),
+                                     _mm_mul_ps(PixelSamples(b2[0], b2[1]), d2s));
+            c.Take(cs), c.Take(_mm_shuffle_ps(cs, cs, _MM_SHUFFLE(1, 1, 1, 1)));
+            c.Take(_mm_movehl_ps(cs, cs)), c.Take(_mm_shuffle_ps(cs, cs, _MM_SHUFFLE(3, 3, 3, 3)));
         } else {
-            for (int j = 0; j < n; ++j) {
-                for (int i = 0; i < n; ++i) {
-                    const float c = c0 + b1[j][i] * d1 + b2[j][i] * d2;
-                    cMin = std::min(cMin, c), cMax = std::max(cMax, c);
-                }
-            }
+            for (int j = 0; j < n; ++j)
+                for (int i = 0; i < n; ++i) c.Take(Set4(c0 + b1[j][i] * d1 + b2[j][i] * d2));
         }
-        if (!CosSpreadSmall(cMin, cMax, std::sqrt(Dot3(toEye, toEye)))) {
+        if (!CosSpreadSmall(c.Min(), c.Max(), std::sqrt(Dot3(toEye, toEye)))) {
             if constexpr (kN == 2) {
                 if (!tri.shadowable) {
                     SeaSamplesOnTriangle(tri, b1[0], b1[1], b2[0], b2[1], k);
@@ -813,9 +842,9 @@ class BlockClassifier {
                 if constexpr (kN == 2) {
                     // The weights of the four samples at once, broadcast from their lanes.
                     const F4 w0 = Set4(w0s[s]), w1 = Set4(w1s[s]), w2 = Set4(w2s[s]);
-                    p[s] = Interpolate3(w0, w1, w2, tri.p0, tri.p1, tri.p2);
-                    nrm[s] = Interpolate3(w0, w1, w2, tri.n0, tri.n1, tri.n2);
-                    a[s] = Interpolate3(w0, w1, w2, tri.a0, tri.a1, tri.a2);
+                    p[s] = Interpolate3(w0, w1, w2, tri.P(0), tri.P(1), tri.P(2));
+                    nrm[s] = Interpolate3(w0, w1, w2, tri.N(0), tri.N(1), tri.N(2));
+                    a[s] = Interpolate3(w0, w1, w2, tri.a[0], tri.a[1], tri.a[2]);
                 } else {
                     const float b1 = b1_[index], b2 = b2_[index];
                     Interpolate(tri, b1, b2, p[s], nrm[s]);
@@ -830,12 +859,9 @@ class BlockClassifier {
         }
         const F4 mean = _mm_mul_ps(pSum, Set4(1.0f / float(count)));
         const F4 toEye = _mm_sub_ps(f_.eye4, mean);
-        float cMin = std::numeric_limits<float>::infinity(), cMax = -cMin;
-        for (int s = 0; s < count; ++s) {
-            const float c = Dot3(nrm[s], toEye);
-            cMin = std::min(cMin, c), cMax = std::max(cMax, c);
-        }
-        if (!CosSpreadSmall(cMin, cMax, std::sqrt(Dot3(toEye, toEye)))) {
+        MinMax c;
+        for (int s = 0; s < count; ++s) c.Take(Dot3Lane(nrm[s], toEye));
+        if (!CosSpreadSmall(c.Min(), c.Max(), std::sqrt(Dot3(toEye, toEye)))) {
             // The samples one by one, from the values just interpolated.
             if constexpr (kN == 2) {
                 if (!shadowable) {
@@ -907,18 +933,22 @@ class BlockClassifier {
                                                              const float* b10, const float* b11,
                                                              const float* b20, const float* b21,
                                                              uint32_t k) {
-        const F4 w1 = PixelSamples(b10, b11), w2 = PixelSamples(b20, b21);
-        const F4 w0 = _mm_sub_ps(_mm_sub_ps(Set4(1.0f), w1), w2);
-        // Component c of vertex attributes v0, v1, v2 interpolated.
-        const auto Component = [&](const F4& v0, const F4& v1, const F4& v2, int c) {
-            return Interpolate3(w0, w1, w2, Set4(v0[c]), Set4(v1[c]), Set4(v2[c]));
-        };
+        // The weights twice over: component c of the positions in lanes 0–3 and of the normals
+        // in lanes 4–7 at once.
+        const F8 w1 = Twice(PixelSamples(b10, b11)), w2 = Twice(PixelSamples(b20, b21));
+        const F8 w0 = (1.0f - w1) - w2;
+        const F8 pn0 = tri.PN(0), pn1 = tri.PN(1), pn2 = tri.PN(2);
         F4 p[3], nrm[3], a[3];
-        for (int c = 0; c < 3; ++c) {
-            p[c] = Component(tri.p0, tri.p1, tri.p2, c);
-            nrm[c] = Component(tri.n0, tri.n1, tri.n2, c);
-            a[c] = Component(tri.a0, tri.a1, tri.a2, c);
-        }
+        const auto PositionNormal = [&](F8 v, int c) { p[c] = Low(v), nrm[c] = High(v); };
+        PositionNormal(Interpolate8(w0, w1, w2, Spread<0>(pn0), Spread<0>(pn1), Spread<0>(pn2)), 0);
+        PositionNormal(Interpolate8(w0, w1, w2, Spread<1>(pn0), Spread<1>(pn1), Spread<1>(pn2)), 1);
+        PositionNormal(Interpolate8(w0, w1, w2, Spread<2>(pn0), Spread<2>(pn1), Spread<2>(pn2)), 2);
+        // The attributes' components x and y at once, then z.
+        const auto XY = [](F4 v) { return __builtin_shufflevector(v, v, 0, 0, 0, 0, 1, 1, 1, 1); };
+        const F8 axy = Interpolate8(w0, w1, w2, XY(tri.a[0]), XY(tri.a[1]), XY(tri.a[2]));
+        a[0] = Low(axy), a[1] = High(axy);
+        a[2] = Interpolate3(Low(w0), Low(w1), Low(w2), Set4(tri.a[0][2]), Set4(tri.a[1][2]),
+                            Set4(tri.a[2][2]));
         AddSeaSamples(k, p, nrm, a);
     }
 
@@ -927,18 +957,21 @@ class BlockClassifier {
     // attributes' components (x, y, z).
     __attribute__((always_inline)) void AddSeaSamples(uint32_t k, const F4 (&p)[3],
                                                       const F4 (&nrm)[3], const F4 (&a)[3]) {
-        const size_t e = sc_.seaCount;
-        sc_.seaCount += 4;
-        _mm_storeu_ps(&sc_.seaPx[e], p[0]), _mm_storeu_ps(&sc_.seaPy[e], p[1]);
-        _mm_storeu_ps(&sc_.seaPz[e], p[2]);
-        _mm_storeu_ps(&sc_.seaNx[e], nrm[0]), _mm_storeu_ps(&sc_.seaNy[e], nrm[1]);
-        _mm_storeu_ps(&sc_.seaNz[e], nrm[2]);
-        _mm_storeu_ps(&sc_.seaDepth[e], a[0]), _mm_storeu_ps(&sc_.seaWet[e], a[1]);
-        _mm_storeu_ps(&sc_.seaFoam[e], a[2]);
+        // The scratch by a local reference: a vector store may alias anything (__m128_u), this
+        // object's member sc_ too, which would be read again after each.
+        BlockScratch& sc = sc_;
+        const size_t e = sc.seaCount;
+        sc.seaCount += 4;
+        _mm_storeu_ps(&sc.seaPx[e], p[0]), _mm_storeu_ps(&sc.seaPy[e], p[1]);
+        _mm_storeu_ps(&sc.seaPz[e], p[2]);
+        _mm_storeu_ps(&sc.seaNx[e], nrm[0]), _mm_storeu_ps(&sc.seaNy[e], nrm[1]);
+        _mm_storeu_ps(&sc.seaNz[e], nrm[2]);
+        _mm_storeu_ps(&sc.seaDepth[e], a[0]), _mm_storeu_ps(&sc.seaWet[e], a[1]);
+        _mm_storeu_ps(&sc.seaFoam[e], a[2]);
         const uint32_t sw = uint32_t(g_.sampleWidth);
         const uint32_t keys[4] = {k, k + 1, k + sw, k + sw + 1};
-        std::memcpy(&sc_.seaK[e], keys, sizeof keys);
-        std::memset(&sc_.seaUnlit[e], 0, 4 * sizeof(uint16_t));
+        std::memcpy(&sc.seaK[e], keys, sizeof keys);
+        std::memset(&sc.seaUnlit[e], 0, 4 * sizeof(uint16_t));
     }
 
     // Sea sample k at barycentrics (1 − b1 − b2, b1, b2) of triangle tri, shaded on its own.
