@@ -61,11 +61,8 @@ constexpr uint32_t kClipMask =
 enum ClipPlane { kPlaneNear, kPlaneGuardXPos, kPlaneGuardXNeg, kPlaneGuardYPos, kPlaneGuardYNeg };
 constexpr int kNumClipPlanes = 5;
 
-struct ScreenVertex {
-    int32_t x, y;  // fixed point, valid when outcode has no clip or invalid bits
-    uint32_t outcode;
-    double invW;  // 1 / clip w, valid with x, y
-};
+using raster_detail::Context;
+using raster_detail::ScreenVertex;
 
 // One screen triangle ready for rasterization (64 bytes: one cache line).
 struct alignas(64) TriSetup {
@@ -110,20 +107,9 @@ struct alignas(64) Chunk {
     uint32_t badValue = 0;
 };
 
-struct Context {
-    int width = 0;
-    int height = 0;
-    double near = 0.0;
-    double halfWidth = 0.0;
-    double halfHeight = 0.0;
-    double guard = 0.0;  // guard band half-extent in NDC units
-    int tileShift = 6;
-    int tilesX = 0;
-    int tilesY = 0;
-};
-
 // Signed distance-like value of a clip-space point to a clip plane (>= 0 inside). The vertex
-// classification and the clipper both use this one function so they agree exactly.
+// classification and the clipper both use this one function so they agree exactly
+// (TransformVertices4 evaluates the same expressions on lanes, tested bit for bit).
 inline double PlaneDistance(int plane, double x, double y, double w, const Context& ctx) {
     switch (plane) {
         case kPlaneNear:
@@ -147,7 +133,8 @@ inline int32_t RoundToInt32(double v) {
 
 // Fixed-point screen position (1/256 sample, origin at the grid's top-left corner, y down)
 // of a clip-space point with w > 0. Every vertex, original or made by the clipper, goes
-// through this one function, so equal clip coordinates give equal fixed-point coordinates.
+// through this one function (or TransformVertices4's lane copy of it, tested bit for bit),
+// so equal clip coordinates give equal fixed-point coordinates.
 // Returns 1 / w.
 inline double SnapToFixed(double x, double y, double w, const Context& ctx, int32_t& fx,
                           int32_t& fy) {
@@ -743,6 +730,130 @@ bool AllFinite(const glm::mat4& m) {
 
 }  // namespace
 
+namespace raster_detail {
+
+void TransformVertex(const ClipRows& rows, const Context& ctx, const glm::vec3& p, glm::vec3& clip,
+                     ScreenVertex& screen) {
+    const glm::dvec4 ph(p.x, p.y, p.z, 1.0);
+    const float cx = float(glm::dot(rows.x, ph));
+    const float cy = float(glm::dot(rows.y, ph));
+    const float cw = float(glm::dot(rows.w, ph));
+    clip = glm::vec3(cx, cy, cw);
+    ScreenVertex s{0, 0, 0, 0.0};
+    if (!std::isfinite(cx) || !std::isfinite(cy) || !std::isfinite(cw)) {
+        s.outcode = kOutInvalid;
+    } else {
+        uint32_t oc = 0;
+        oc |= cx > cw ? kOutRight : 0u;
+        oc |= cx < -cw ? kOutLeft : 0u;
+        oc |= cy > cw ? kOutTop : 0u;
+        oc |= cy < -cw ? kOutBottom : 0u;
+        oc |= PlaneDistance(kPlaneNear, cx, cy, cw, ctx) < 0.0 ? kOutNear : 0u;
+        oc |= PlaneDistance(kPlaneGuardXPos, cx, cy, cw, ctx) < 0.0 ? kOutGuardXPos : 0u;
+        oc |= PlaneDistance(kPlaneGuardXNeg, cx, cy, cw, ctx) < 0.0 ? kOutGuardXNeg : 0u;
+        oc |= PlaneDistance(kPlaneGuardYPos, cx, cy, cw, ctx) < 0.0 ? kOutGuardYPos : 0u;
+        oc |= PlaneDistance(kPlaneGuardYNeg, cx, cy, cw, ctx) < 0.0 ? kOutGuardYNeg : 0u;
+        s.outcode = oc;
+        if (!(oc & kClipMask)) s.invW = SnapToFixed(cx, cy, cw, ctx, s.x, s.y);
+    }
+    screen = s;
+}
+
+namespace {
+
+using F4 = float __attribute__((vector_size(16)));
+using I4 = int32_t __attribute__((vector_size(16)));
+using D4 = double __attribute__((vector_size(32)));
+using L4 = int64_t __attribute__((vector_size(32)));
+
+// Lanes where v is finite: v − v is 0 exactly then, NaN for ±inf and NaN.
+inline I4 Finite(F4 v) { return v - v == F4{}; }
+inline bool AllSet(I4 mask) { return _mm_movemask_ps(__m128(mask)) == 0xf; }
+
+// Exact float to double, lane for lane (GCC's generic conversion takes two halves).
+inline D4 ToDouble(F4 v) {
+#if defined(__AVX__)
+    return _mm256_cvtps_pd(v);
+#else
+    return __builtin_convertvector(v, D4);
+#endif
+}
+
+}  // namespace
+
+bool TransformVertices4(const ClipRows& rows, const Context& ctx, const glm::vec3* p,
+                        glm::vec3* clip, ScreenVertex* screen) {
+    static_assert(sizeof(glm::vec3) == 12);
+    // Positions x0 y0 z0 x1 | y1 z1 x2 y2 | z2 x3 y3 z3, split into one vector per axis.
+    F4 a, b, c;
+    std::memcpy(&a, &p[0].x, sizeof a);
+    std::memcpy(&b, &p[1].y, sizeof b);
+    std::memcpy(&c, &p[2].z, sizeof c);
+    const F4 fx = __builtin_shufflevector(__builtin_shufflevector(a, b, 0, 3, 6, 0), c, 0, 1, 2, 5);
+    const F4 fy = __builtin_shufflevector(__builtin_shufflevector(a, b, 1, 4, 7, 0), c, 0, 1, 2, 6);
+    const F4 fz = __builtin_shufflevector(__builtin_shufflevector(a, b, 2, 5, 0, 0), c, 0, 1, 4, 7);
+    const I4 finite = Finite(fx) & Finite(fy) & Finite(fz);
+    if (!AllSet(finite)) return false;
+
+    // glm::dot's order, (x·x' + y·y') + (z·z' + w·w'), with w' = 1.
+    const D4 px = ToDouble(fx);
+    const D4 py = ToDouble(fy);
+    const D4 pz = ToDouble(fz);
+    const auto Dot = [&](const glm::dvec4& r) {
+        return (r.x * px + r.y * py) + (r.z * pz + r.w * 1.0);
+    };
+    const F4 cx = __builtin_convertvector(Dot(rows.x), F4);
+    const F4 cy = __builtin_convertvector(Dot(rows.y), F4);
+    const F4 cw = __builtin_convertvector(Dot(rows.w), F4);
+
+    // Back to x0 y0 z0 x1 | y1 z1 x2 y2 | z2 x3 y3 z3 order.
+    const F4 xy01 = __builtin_shufflevector(cx, cy, 0, 4, 1, 5);
+    const F4 xy23 = __builtin_shufflevector(cx, cy, 2, 6, 3, 7);
+    const F4 outA = __builtin_shufflevector(xy01, cw, 0, 1, 4, 2);
+    const F4 outB =
+        __builtin_shufflevector(__builtin_shufflevector(cy, cw, 1, 5, 0, 0), xy23, 0, 1, 4, 5);
+    const F4 outC = __builtin_shufflevector(xy23, cw, 6, 2, 3, 7);
+    std::memcpy(&clip[0].x, &outA, sizeof outA);
+    std::memcpy(&clip[1].y, &outB, sizeof outB);
+    std::memcpy(&clip[2].z, &outC, sizeof outC);
+
+    // The comparisons of TransformVertex, all in double: the frustum ones compare floats
+    // (cx > cw, cx < −cw), which their exact conversions to double order the same way.
+    const D4 x = ToDouble(cx);
+    const D4 y = ToDouble(cy);
+    const D4 w = ToDouble(cw);
+    const D4 gw = ctx.guard * w;
+    const L4 oc64 =
+        ((x > w) & int64_t(kOutRight)) | ((x < -w) & int64_t(kOutLeft)) |
+        ((y > w) & int64_t(kOutTop)) | ((y < -w) & int64_t(kOutBottom)) |
+        ((w - ctx.near < 0.0) & int64_t(kOutNear)) | ((gw - x < 0.0) & int64_t(kOutGuardXPos)) |
+        ((gw + x < 0.0) & int64_t(kOutGuardXNeg)) | ((gw - y < 0.0) & int64_t(kOutGuardYPos)) |
+        ((gw + y < 0.0) & int64_t(kOutGuardYNeg));
+    const I4 oc = __builtin_convertvector(oc64, I4);
+    const I4 valid = Finite(cx) & Finite(cy) & Finite(cw);
+    const I4 outcode = valid ? oc : I4{} + int32_t(kOutInvalid);
+    const I4 snap = valid & ((oc & int32_t(kClipMask)) == 0);
+    const L4 snap64 = __builtin_convertvector(snap, L4);
+
+    // SnapToFixed and RoundToInt32. In snapped lanes w >= near > 0 and |x|, |y| <= guard·w, so
+    // the sample coordinates times 256 stay within about ±2^27 and v + 0.5 + 2^30 lies in
+    // (0, 2^31): truncation to int32 then gives RoundToInt32's int64 result. Other lanes
+    // convert 0 (their values may be out of range) and are zeroed like TransformVertex's.
+    constexpr double kOffset = 1073741824.0;
+    const D4 invW = 1.0 / w;
+    const D4 sx = (x * invW + 1.0) * ctx.halfWidth;
+    const D4 sy = (1.0 - y * invW) * ctx.halfHeight;
+    const D4 rx = snap64 ? sx * double(kSubScale) + (0.5 + kOffset) : D4{};
+    const D4 ry = snap64 ? sy * double(kSubScale) + (0.5 + kOffset) : D4{};
+    const I4 ix = snap ? __builtin_convertvector(rx, I4) - int32_t(kOffset) : I4{};
+    const I4 iy = snap ? __builtin_convertvector(ry, I4) - int32_t(kOffset) : I4{};
+    const D4 iw = snap64 ? invW : D4{};
+    for (int l = 0; l < 4; ++l) screen[l] = ScreenVertex{ix[l], iy[l], uint32_t(outcode[l]), iw[l]};
+    return true;
+}
+
+}  // namespace raster_detail
+
 struct Rasterizer::Scratch {
     Context ctx;
     std::vector<uint32_t> vertexBase;  // per mesh, into screen / clip
@@ -829,9 +940,9 @@ void Rasterizer::Prepare(std::span<const RasterMesh> meshes, const RasterCamera&
     sc.screen.resize(totalVertices);
     sc.clip.resize(totalVertices);
     const glm::dmat4 m(camera.clipFromWorld);
-    const glm::dvec4 rowX(m[0][0], m[1][0], m[2][0], m[3][0]);
-    const glm::dvec4 rowY(m[0][1], m[1][1], m[2][1], m[3][1]);
-    const glm::dvec4 rowW(m[0][3], m[1][3], m[2][3], m[3][3]);
+    const raster_detail::ClipRows rows{glm::dvec4(m[0][0], m[1][0], m[2][0], m[3][0]),
+                                       glm::dvec4(m[0][1], m[1][1], m[2][1], m[3][1]),
+                                       glm::dvec4(m[0][3], m[1][3], m[2][3], m[3][3])};
     for (size_t mi = 0; mi < meshes.size(); ++mi) {
         const std::span<const glm::vec3> positions = meshes[mi].positions;
         const size_t base = sc.vertexBase[mi];
@@ -839,7 +950,12 @@ void Rasterizer::Prepare(std::span<const RasterMesh> meshes, const RasterCamera&
         tbb::parallel_for(
             tbb::blocked_range<size_t>(0, positions.size(), kVerticesPerTask),
             [&](const tbb::blocked_range<size_t>& r) {
-                for (size_t v = r.begin(); v < r.end(); ++v) {
+                size_t v = r.begin();
+                for (; v + 4 <= r.end(); v += 4)
+                    if (!TransformVertices4(rows, ctx, &positions[v], &sc.clip[base + v],
+                                            &sc.screen[base + v]))
+                        break;  // a non-finite position: the loop below reports it
+                for (; v < r.end(); ++v) {
                     const glm::vec3 p = positions[v];
                     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
                         size_t prev = firstBad.load();
@@ -847,33 +963,7 @@ void Rasterizer::Prepare(std::span<const RasterMesh> meshes, const RasterCamera&
                         }
                         continue;
                     }
-                    const glm::dvec4 ph(p.x, p.y, p.z, 1.0);
-                    const float cx = float(glm::dot(rowX, ph));
-                    const float cy = float(glm::dot(rowY, ph));
-                    const float cw = float(glm::dot(rowW, ph));
-                    sc.clip[base + v] = glm::vec3(cx, cy, cw);
-                    ScreenVertex s{0, 0, 0, 0.0};
-                    if (!std::isfinite(cx) || !std::isfinite(cy) || !std::isfinite(cw)) {
-                        s.outcode = kOutInvalid;
-                    } else {
-                        uint32_t oc = 0;
-                        oc |= cx > cw ? kOutRight : 0u;
-                        oc |= cx < -cw ? kOutLeft : 0u;
-                        oc |= cy > cw ? kOutTop : 0u;
-                        oc |= cy < -cw ? kOutBottom : 0u;
-                        oc |= PlaneDistance(kPlaneNear, cx, cy, cw, ctx) < 0.0 ? kOutNear : 0u;
-                        oc |= PlaneDistance(kPlaneGuardXPos, cx, cy, cw, ctx) < 0.0 ? kOutGuardXPos
-                                                                                    : 0u;
-                        oc |= PlaneDistance(kPlaneGuardXNeg, cx, cy, cw, ctx) < 0.0 ? kOutGuardXNeg
-                                                                                    : 0u;
-                        oc |= PlaneDistance(kPlaneGuardYPos, cx, cy, cw, ctx) < 0.0 ? kOutGuardYPos
-                                                                                    : 0u;
-                        oc |= PlaneDistance(kPlaneGuardYNeg, cx, cy, cw, ctx) < 0.0 ? kOutGuardYNeg
-                                                                                    : 0u;
-                        s.outcode = oc;
-                        if (!(oc & kClipMask)) s.invW = SnapToFixed(cx, cy, cw, ctx, s.x, s.y);
-                    }
-                    sc.screen[base + v] = s;
+                    TransformVertex(rows, ctx, p, sc.clip[base + v], sc.screen[base + v]);
                 }
             });
         if (firstBad.load() != std::numeric_limits<size_t>::max()) {

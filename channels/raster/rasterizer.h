@@ -71,6 +71,44 @@ struct RasterStats {
     uint64_t trianglesSetUp = 0;    // screen triangles after clipping that reached binning
 };
 
+namespace raster_detail {
+
+// Per-frame parameters of the rasterizer's stages.
+struct Context {
+    int width = 0;
+    int height = 0;
+    double near = 0.0;
+    double halfWidth = 0.0;
+    double halfHeight = 0.0;
+    double guard = 0.0;  // guard band half-extent in NDC units
+    int tileShift = 6;
+    int tilesX = 0;
+    int tilesY = 0;
+};
+
+struct ScreenVertex {
+    int32_t x, y;  // fixed point, valid when outcode has no clip or invalid bits
+    uint32_t outcode;
+    double invW;  // 1 / clip w, valid with x, y
+};
+
+// Rows 0, 1 and 3 of clipFromWorld: the clip coordinates x, y and w.
+struct ClipRows {
+    glm::dvec4 x, y, w;
+};
+
+// Vertex stage of one vertex with a finite position: clip coordinates (double arithmetic,
+// stored as float), outcode and, when no clipping is needed, the fixed-point position.
+void TransformVertex(const ClipRows& rows, const Context& ctx, const glm::vec3& p, glm::vec3& clip,
+                     ScreenVertex& screen);
+
+// TransformVertex on p[0..3], four vertices at a time on lanes with the same results bit for
+// bit. Writes nothing and returns false when a position is not finite.
+bool TransformVertices4(const ClipRows& rows, const Context& ctx, const glm::vec3* p,
+                        glm::vec3* clip, ScreenVertex* screen);
+
+}  // namespace raster_detail
+
 // Coverage rule: a sample belongs to a triangle when its centre is inside the triangle with
 // vertices snapped to 1/256 sample; centres exactly on an edge belong to the triangle for
 // which that edge is a top edge (horizontal, triangle below it on screen) or a left edge
