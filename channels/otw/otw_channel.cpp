@@ -380,9 +380,13 @@ struct BlockScratch {
     // gathered values depend only on the frame and the primitive, so whatever the cache holds
     // the shading is the same. 2048 entries (360 kB) keep more of the previous block's
     // triangles than 1024: otw-center at frames 120-121 gathered 32.3 k triangles, not 41.8 k
-    // (4096 entries: 30.1 k).
+    // (4096 entries: 30.1 k). A power of two (the slot is prim & (size − 1));
+    // OtwChannel::SetTriangleCacheEntries sets another for tests.
     static constexpr uint32_t kTriangleCacheSize = 2048;
     std::vector<CachedTriangle> triangles = std::vector<CachedTriangle>(kTriangleCacheSize);
+    // A pixel's triangles that could not take their slot in triangles (PixelGather).
+    std::vector<CachedTriangle> pixelTriangles =
+        std::vector<CachedTriangle>(kMaxSupersampling * kMaxSupersampling);
 
     // Empties the lists and makes the sky and sea lists hold at least n entries.
     void Reset(size_t n) {
@@ -534,8 +538,10 @@ class BlockClassifier {
           depth_(g.vis.depth.data()),
           b1_(g.vis.b1.data()),
           b2_(g.vis.b2.data()),
-          frame_(g.frame) {
+          frame_(g.frame),
+          triangleMask_(uint32_t(sc.triangles.size()) - 1) {
         CHECK(kN == 0 || kN == g.n);
+        CHECK(!sc.triangles.empty() && (sc.triangles.size() & triangleMask_) == 0);
     }
 
     // Classifies the pixels [pxBegin, pxEnd) of pixel row py.
@@ -663,7 +669,7 @@ class BlockClassifier {
 
     // The cached triangle prim. The hit, most calls, is inlined; the gathering is not.
     __attribute__((always_inline)) const CachedTriangle& Triangle(uint32_t prim) {
-        CachedTriangle& tri = sc_.triangles[prim % BlockScratch::kTriangleCacheSize];
+        CachedTriangle& tri = sc_.triangles[prim & triangleMask_];
         if (tri.prim == prim && tri.frame == frame_) [[likely]]
             return tri;
         return Gather(prim, tri);
@@ -686,6 +692,18 @@ class BlockClassifier {
                 f_.casters.MayHit(0.5f * (l + h), 0.5f * (h - l) + (8e-6f * far + 2e-3f));
         }
         return tri;
+    }
+
+    // Gather(prim, tri) for sample s of a pixel whose samples t < s hold tris[t]; but when
+    // tri, prim's cache slot, is one of them (two of the pixel's triangles with ids a multiple
+    // of the cache's size apart), prim is gathered into sc_.pixelTriangles[s] instead, so that
+    // the entry stays as the earlier sample read it.
+    __attribute__((noinline)) const CachedTriangle& PixelGather(uint32_t prim, CachedTriangle& tri,
+                                                                const CachedTriangle* const* tris,
+                                                                int s) {
+        for (int t = 0; t < s; ++t)
+            if (tris[t] == &tri) return Gather(prim, sc_.pixelTriangles[size_t(s)]);
+        return Gather(prim, tri);
     }
 
     // The values of a pixel's samples (N = 2) from its two rows, sample (j, i) in lane 2j + i.
@@ -826,11 +844,24 @@ class BlockClassifier {
             w1s = PixelSamples(b1_ + i0, b1_ + i1), w2s = PixelSamples(b2_ + i0, b2_ + i1);
             w0s = _mm_sub_ps(_mm_sub_ps(Set4(1.0f), w1s), w2s);
         }
+        // (Unrolled for N = 2: kept rolled by the call in it, the loop cost ~45 instructions more
+        // a pixel.)
+#pragma GCC unroll 4
         for (int j = 0; j < n; ++j) {
+#pragma GCC unroll 4
             for (int i = 0; i < n; ++i) {
                 const uint32_t prim = primitive_[rowIndex_[j] + size_t(x0 + i)];
                 const int s = j * n + i;
-                tris[s] = prim == lastPrim ? tris[s - 1] : &Triangle(prim);
+                if (prim == lastPrim) {
+                    tris[s] = tris[s - 1];
+                } else {
+                    // Triangle(prim), except that a miss must not replace an entry an earlier
+                    // sample of the pixel holds (PixelGather).
+                    CachedTriangle& tri = sc_.triangles[prim & triangleMask_];
+                    tris[s] = tri.prim == prim && tri.frame == frame_
+                                  ? &tri
+                                  : &PixelGather(prim, tri, tris, s);
+                }
                 lastPrim = prim;
             }
         }
@@ -1025,6 +1056,7 @@ class BlockClassifier {
     const uint32_t* const primitive_;
     const float *const depth_, *const b1_, *const b2_;
     const uint64_t frame_;
+    const uint32_t triangleMask_;             // triangle cache slots − 1
     glm::vec3 sampleRow_[kMaxSupersampling];  // RowBase of the pixel row's sample rows
     size_t rowIndex_[kMaxSupersampling];      // visibility index of their first sample
 };
@@ -1239,6 +1271,11 @@ struct OtwChannel::ShadeScratch {
 
 OtwChannel::~OtwChannel() = default;
 
+void OtwChannel::SetTriangleCacheEntries(uint32_t entries) {
+    CHECK(entries > 0 && (entries & (entries - 1)) == 0);
+    triangleCacheEntries_ = entries;
+}
+
 void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
     const scene::Scenario& sc = world_.GetScenario();
     const scene::EnvironmentSettings& env = sc.environment;
@@ -1429,6 +1466,10 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
         const int py1 = std::min(cam.height, py0 + pixelRowsPerBlock);
         BlockScratch& s = scratch.local();
         s.Reset(size_t(py1 - py0) * size_t(n) * size_t(sw));
+        if (const uint32_t entries = triangleCacheEntries_ > 0 ? triangleCacheEntries_
+                                                               : BlockScratch::kTriangleCacheSize;
+            s.triangles.size() != entries)
+            s.triangles.assign(entries, CachedTriangle{});
         const auto span = [&](int py) {
             return renderSpans_.empty() ? PixelSpan{0, cam.width} : renderSpans_[size_t(py)];
         };

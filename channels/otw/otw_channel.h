@@ -71,6 +71,9 @@ class OtwChannel {
     // the code for N = 2 (simd::kLanes pixels at a time, a pixel's samples on lanes) must
     // equal bit for bit.
     void SetClassifyPixelByPixel(bool on) { classifyPixelByPixel_ = on; }
+    // For tests: the number of entries of the shading pass's triangle cache (a power of two;
+    // default 2048). Whatever it holds, the images are the same bit for bit.
+    void SetTriangleCacheEntries(uint32_t entries);
 
     const OtwFrameStats& Stats() const { return stats_; }
     const ChannelCamera& Camera() const { return geometry_.Camera(); }
@@ -105,6 +108,7 @@ class OtwChannel {
     std::unique_ptr<BlackbodyGlowTable> basisGlow_;  // band basis: the flames' glow
     std::vector<PixelSpan> renderSpans_;             // per pixel row; empty: every pixel
     bool classifyPixelByPixel_ = false;              // SetClassifyPixelByPixel
+    uint32_t triangleCacheEntries_ = 0;              // SetTriangleCacheEntries; 0: the default
 };
 
 }  // namespace seasense::channels

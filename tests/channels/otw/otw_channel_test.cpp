@@ -18,6 +18,12 @@
 namespace seasense::channels {
 namespace {
 
+// The five-channel demo (surf zone, boats, plumes, dusk).
+scene::Scenario FiveChannelScenario() {
+    return scene::LoadScenario(std::filesystem::path(SEASENSE_SOURCE_DIR) / "configs" /
+                               "five-channel.yaml");
+}
+
 scene::Scenario CalmSeaScenario(double eyeHeight_m, double hfov_deg) {
     scene::Scenario sc;
     sc.world.start = *scene::ParseIso8601("2026-06-21T12:00:00Z");
@@ -442,8 +448,7 @@ TEST(OtwChannel, CloudsAreTheSameForOneAndTwoThreadsAndAnEmptyLayerChangesNothin
 // (surf zone, boats, plumes, dusk) gives the same frame bit for bit from a fresh channel and
 // from one that rendered other frames before, at 1, 2 and 3 threads.
 TEST(OtwChannel, AFrameDoesNotDependOnEarlierFramesOrTheThreadCount) {
-    scene::Scenario sc = scene::LoadScenario(std::filesystem::path(SEASENSE_SOURCE_DIR) /
-                                             "configs" / "five-channel.yaml");
+    const scene::Scenario sc = FiveChannelScenario();
     scene::ChannelSettings ch = *sc.FindChannel("otw-center");
     ch.width = 320;
     ch.height = 240;
@@ -470,8 +475,7 @@ TEST(OtwChannel, AFrameDoesNotDependOnEarlierFramesOrTheThreadCount) {
 // the five-channel demo's centre view early and late (sky, sea, boats, surf and exhaust), at
 // widths that leave a partial row segment.
 TEST(OtwChannel, ClassificationOnLanesEqualsPixelByPixel) {
-    scene::Scenario sc = scene::LoadScenario(std::filesystem::path(SEASENSE_SOURCE_DIR) /
-                                             "configs" / "five-channel.yaml");
+    const scene::Scenario sc = FiveChannelScenario();
     scene::ChannelSettings ch = *sc.FindChannel("otw-center");
     ASSERT_EQ(ch.supersampling, 2);
     const scene::World world(sc);
@@ -491,6 +495,39 @@ TEST(OtwChannel, ClassificationOnLanesEqualsPixelByPixel) {
             const Image lanes = render(false), reference = render(true);
             ASSERT_EQ(lanes.pixels.size(), reference.pixels.size());
             EXPECT_TRUE(lanes.pixels == reference.pixels) << width << " " << frame;
+        }
+    }
+}
+
+// The shading pass's triangle cache is direct-mapped by primitive id, and a pixel whose samples
+// see different sea triangles holds up to four of its entries at once. With one or two slots
+// nearly every such pixel has two triangles in one slot; the images must still be those of the
+// default cache bit for bit (the centre view early and late: sky, sea, surf, boats, exhaust).
+TEST(OtwChannel, ImagesDoNotDependOnTheTriangleCacheSize) {
+    const scene::Scenario sc = FiveChannelScenario();
+    scene::ChannelSettings ch = *sc.FindChannel("otw-center");
+    ch.width = 320;
+    ch.height = 240;
+    const scene::World world(sc);
+    for (const int64_t frame : {7, 130}) {
+        const auto render = [&](uint32_t entries, bool pixelByPixel) {
+            Image radiance;
+            tbb::task_arena(2).execute([&] {
+                OtwChannel otw(world, ch);
+                if (entries > 0) otw.SetTriangleCacheEntries(entries);
+                otw.SetClassifyPixelByPixel(pixelByPixel);
+                otw.Render(world.State(frame), radiance);
+            });
+            return radiance;
+        };
+        const Image reference = render(0, false);
+        for (const uint32_t entries : {1u, 2u}) {
+            for (const bool pixelByPixel : {false, true}) {
+                const Image small = render(entries, pixelByPixel);
+                ASSERT_EQ(small.pixels.size(), reference.pixels.size());
+                EXPECT_TRUE(small.pixels == reference.pixels)
+                    << frame << " " << entries << " " << pixelByPixel;
+            }
         }
     }
 }
