@@ -694,15 +694,17 @@ class BlockClassifier {
         return tri;
     }
 
-    // Gather(prim, tri) for sample s of a pixel whose samples t < s hold tris[t]; but when
-    // tri, prim's cache slot, is one of them (two of the pixel's triangles with ids a multiple
-    // of the cache's size apart), prim is gathered into sc_.pixelTriangles[s] instead, so that
-    // the entry stays as the earlier sample read it.
+    // Gather(prim, tri) for sample s (j·N + i) of the pixel with top-left sample x0; but when
+    // tri, prim's cache slot, holds the triangle of an earlier sample of the pixel (two of its
+    // triangles with ids a multiple of the cache's size apart), prim is gathered into
+    // sc_.pixelTriangles[s] instead, so that the entry stays as that sample read it.
     __attribute__((noinline)) const CachedTriangle& PixelGather(uint32_t prim, CachedTriangle& tri,
-                                                                const CachedTriangle* const* tris,
-                                                                int s) {
-        for (int t = 0; t < s; ++t)
-            if (tris[t] == &tri) return Gather(prim, sc_.pixelTriangles[size_t(s)]);
+                                                                int x0, int s) {
+        const int n = N();
+        if (tri.frame == frame_)
+            for (int t = 0; t < s; ++t)
+                if (tri.prim == primitive_[rowIndex_[t / n] + size_t(x0 + t % n)])
+                    return Gather(prim, sc_.pixelTriangles[size_t(s)]);
         return Gather(prim, tri);
     }
 
@@ -844,15 +846,15 @@ class BlockClassifier {
             w1s = PixelSamples(b1_ + i0, b1_ + i1), w2s = PixelSamples(b2_ + i0, b2_ + i1);
             w0s = _mm_sub_ps(_mm_sub_ps(Set4(1.0f), w1s), w2s);
         }
-        // (Unrolled for N = 2: kept rolled by the call in it, the loop cost ~45 instructions more
-        // a pixel.)
+        // (Unrolled for N = 2: kept rolled by the call in it, the loop cost ~45 instructions
+        // more a pixel.)
 #pragma GCC unroll 4
         for (int j = 0; j < n; ++j) {
 #pragma GCC unroll 4
             for (int i = 0; i < n; ++i) {
                 const uint32_t prim = primitive_[rowIndex_[j] + size_t(x0 + i)];
                 const int s = j * n + i;
-                if (prim == lastPrim) {
+                if (s > 0 && prim == lastPrim) {
                     tris[s] = tris[s - 1];
                 } else {
                     // Triangle(prim), except that a miss must not replace an entry an earlier
@@ -860,7 +862,7 @@ class BlockClassifier {
                     CachedTriangle& tri = sc_.triangles[prim & triangleMask_];
                     tris[s] = tri.prim == prim && tri.frame == frame_
                                   ? &tri
-                                  : &PixelGather(prim, tri, tris, s);
+                                  : &PixelGather(prim, tri, x0, s);
                 }
                 lastPrim = prim;
             }

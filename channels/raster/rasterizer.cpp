@@ -20,6 +20,7 @@
 
 #include "scene/core/check.h"
 #include "scene/core/error.h"
+#include "scene/core/simd4.h"
 #include "scene/core/simd_lanes.h"
 #include "scene/core/stream_store.h"
 
@@ -770,15 +771,6 @@ using L4 = int64_t __attribute__((vector_size(32)));
 inline I4 Finite(F4 v) { return v - v == F4{}; }
 inline bool AllSet(I4 mask) { return _mm_movemask_ps(__m128(mask)) == 0xf; }
 
-// Exact float to double, lane for lane (GCC's generic conversion takes two halves).
-inline D4 ToDouble(F4 v) {
-#if defined(__AVX__)
-    return _mm256_cvtps_pd(v);
-#else
-    return __builtin_convertvector(v, D4);
-#endif
-}
-
 }  // namespace
 
 bool TransformVertices4(const ClipRows& rows, const Context& ctx, const glm::vec3* p,
@@ -796,9 +788,9 @@ bool TransformVertices4(const ClipRows& rows, const Context& ctx, const glm::vec
     if (!AllSet(finite)) return false;
 
     // glm::dot's order, (x·x' + y·y') + (z·z' + w·w'), with w' = 1.
-    const D4 px = ToDouble(fx);
-    const D4 py = ToDouble(fy);
-    const D4 pz = ToDouble(fz);
+    const D4 px = simd4::ToDouble4(fx);
+    const D4 py = simd4::ToDouble4(fy);
+    const D4 pz = simd4::ToDouble4(fz);
     const auto Dot = [&](const glm::dvec4& r) {
         return (r.x * px + r.y * py) + (r.z * pz + r.w * 1.0);
     };
@@ -819,9 +811,9 @@ bool TransformVertices4(const ClipRows& rows, const Context& ctx, const glm::vec
 
     // The comparisons of TransformVertex, all in double: the frustum ones compare floats
     // (cx > cw, cx < −cw), which their exact conversions to double order the same way.
-    const D4 x = ToDouble(cx);
-    const D4 y = ToDouble(cy);
-    const D4 w = ToDouble(cw);
+    const D4 x = simd4::ToDouble4(cx);
+    const D4 y = simd4::ToDouble4(cy);
+    const D4 w = simd4::ToDouble4(cw);
     const D4 gw = ctx.guard * w;
     const L4 oc64 =
         ((x > w) & int64_t(kOutRight)) | ((x < -w) & int64_t(kOutLeft)) |

@@ -14,6 +14,19 @@ using F4 = __m128;
 using I4 = __m128i;
 
 inline F4 Set4(float v) { return _mm_set1_ps(v); }
+
+// Four doubles on lanes (a GCC vector type: one AVX register, or two SSE2 ones).
+typedef double Double4 __attribute__((vector_size(32)));
+// The four lanes of v as doubles (exact): one AVX conversion, where GCC's generic conversion
+// takes two halves.
+inline Double4 ToDouble4(F4 v) {
+#if defined(__AVX__)
+    return Double4(_mm256_cvtps_pd(v));
+#else
+    typedef float Float4 __attribute__((vector_size(16)));
+    return __builtin_convertvector(Float4(v), Double4);
+#endif
+}
 // |v|: the sign bit cleared.
 inline F4 Abs4(F4 v) { return _mm_andnot_ps(_mm_set1_ps(-0.0f), v); }
 // std::max(a, b): b when a < b, else a (same NaN and ±0 behaviour).

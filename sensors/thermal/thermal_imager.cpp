@@ -59,15 +59,6 @@ struct ChainConstants {
     float sigma;
 };
 
-// The four lanes as doubles, one AVX conversion (two SSE2 ones without AVX).
-inline D4 Doubles(__m128 v) {
-#if defined(__AVX__)
-    return D4(_mm256_cvtps_pd(v));
-#else
-    return __builtin_convertvector(Floats4(v), D4);
-#endif
-}
-
 // The per-pixel chain of one row in double, four pixels at a time, with the same operations in
 // the same order as the scalar definition:
 //   L = τ·blurred, lagged = y + α(L − y) (L on a settled frame), E = kE·lagged,
@@ -88,22 +79,22 @@ void ChainRow(const ChainConstants& c, int w, const float* z, const float* gain,
         const __m128 blurred = LoadLanes(sig + x, lanes, 0.0f);
         // float(noiseScale·σ·z), left to right as the scalar product.
         const __m128 z4 = LoadLanes(z + x, lanes, 0.0f);
-        const D4 L = tau * Doubles(blurred);
+        const D4 L = tau * simd4::ToDouble4(blurred);
         D4 lagged = L;
         if constexpr (!kSettled) {
-            const D4 prev = Doubles(LoadLanes(rad + x, lanes, 0.0f));
+            const D4 prev = simd4::ToDouble4(LoadLanes(rad + x, lanes, 0.0f));
             lagged = prev + alpha * (L - prev);
         }
         const D4 E = kE * lagged;
         D4 signal;
         if constexpr (kIdeal) {
-            signal = E + Doubles(_mm_mul_ps(sigma4, z4));
+            signal = E + simd4::ToDouble4(_mm_mul_ps(sigma4, z4));
         } else {
             const __m128 noise =
                 _mm_mul_ps(_mm_mul_ps(LoadLanes(noiseScale + x, lanes, 0.0f), sigma4), z4);
-            signal = (Doubles(LoadLanes(gain + x, lanes, 0.0f)) * E +
-                      Doubles(LoadLanes(offset + x, lanes, 0.0f))) +
-                     Doubles(noise);
+            signal = (simd4::ToDouble4(LoadLanes(gain + x, lanes, 0.0f)) * E +
+                      simd4::ToDouble4(LoadLanes(offset + x, lanes, 0.0f))) +
+                     simd4::ToDouble4(noise);
         }
         StoreLanes(rad + x, lanes, __m128(__builtin_convertvector(lagged, Floats4)));
         StoreLanes(sig + x, lanes, __m128(__builtin_convertvector(signal, Floats4)));
