@@ -28,7 +28,8 @@
 // shortcuts turns this off for the tests that compare): with a surf zone, rest positions
 // seaward of OceanSurfaceFrame::OpenSeaFrom_m (most of a view from deep water) add the deep
 // sea and the tide without the dry-land test, the surf terms or the seabed clamp's lookup; and
-// rings whose Gerstner footprint weights are all 0 sum no Gerstner wave.
+// rings whose Gerstner footprint weights are all 0 sum no Gerstner wave. Likewise the index
+// buffer's corners are stepped along the rings instead of looked up by column.
 #include "scene/ocean/ocean_mesh.h"
 
 #include <tbb/parallel_for.h>
@@ -405,6 +406,24 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
             3 * size_t(span / stride[size_t(j)] + span / stride[size_t(j) + 1]);
     }
     out.indices.resize(bandOffset.back());
+    // Where the shortcuts are on, a band's corners are stepped to along its two rings instead
+    // of looked up by column (vertex above) at every corner, which was most of the index
+    // buffer's cost: a ring's next column (its stride on) is its next vertex, wrapped to its
+    // first on a whole circle (vertex's remainder). A walk starts at vertex(j, lo) and must end
+    // at vertex(j, hi), the band's last corners.
+    struct RingWalk {
+        uint32_t start, i, n;
+        bool whole;
+        uint32_t Vertex() const { return start + i; }
+        void Step() {
+            if (++i == n && whole) i = 0;
+        }
+    };
+    const auto walk = [&](int j, int64_t c) {
+        const uint32_t start = ringStart[size_t(j)], n = ringStart[size_t(j) + 1] - start;
+        return RingWalk{start, vertex(j, c) - start, n,
+                        int64_t(n) << strideShift[size_t(j)] == circle};
+    };
     tbb::parallel_for(0, rings - 1, [&](int j) {
         const bool whole = bandHi[size_t(j)] - bandLo[size_t(j)] >= circle;
         const int64_t lo = whole ? 0 : bandLo[size_t(j)], hi = whole ? circle : bandHi[size_t(j)];
@@ -414,18 +433,48 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
             dst[0] = p, dst[1] = q, dst[2] = r;
             dst += 3;
         };
-        for (int64_t c = lo; c < hi; c += s) {
-            const uint32_t a = vertex(j, c), b = vertex(j, c + s);
-            // Azimuth increases clockwise seen from above and radius outward, so (a, b, o) and
-            // (x, o', o) with o' clockwise of o are counter-clockwise seen from above. Where the
-            // outer ring is finer (m > 1 columns per inner segment) its vertices are fanned to
-            // the nearer inner vertex: no T-junction, since every vertex of both rings on the
-            // segment is a corner of the band's triangles.
-            for (int64_t k = 0; k < m / 2; ++k)
-                emit(a, vertex(j + 1, c + (k + 1) * t), vertex(j + 1, c + k * t));
-            emit(a, b, vertex(j + 1, c + (m / 2) * t));
-            for (int64_t k = m / 2; k < m; ++k)
-                emit(b, vertex(j + 1, c + (k + 1) * t), vertex(j + 1, c + k * t));
+        // Azimuth increases clockwise seen from above and radius outward, so (a, b, o) and
+        // (x, o', o) with o' clockwise of o are counter-clockwise seen from above. Where the
+        // outer ring is finer (m > 1 columns per inner segment) its vertices are fanned to the
+        // nearer inner vertex: no T-junction, since every vertex of both rings on the segment
+        // is a corner of the band's triangles.
+        if (!req.shortcuts) {
+            for (int64_t c = lo; c < hi; c += s) {
+                const uint32_t a = vertex(j, c), b = vertex(j, c + s);
+                for (int64_t k = 0; k < m / 2; ++k)
+                    emit(a, vertex(j + 1, c + (k + 1) * t), vertex(j + 1, c + k * t));
+                emit(a, b, vertex(j + 1, c + (m / 2) * t));
+                for (int64_t k = m / 2; k < m; ++k)
+                    emit(b, vertex(j + 1, c + (k + 1) * t), vertex(j + 1, c + k * t));
+            }
+        } else {
+            // The same triangles in the same order.
+            RingWalk inner = walk(j, lo), outer = walk(j + 1, lo);
+            int64_t c = lo;
+            for (; c < hi; c += s) {
+                const uint32_t a = inner.Vertex();
+                inner.Step();
+                const uint32_t b = inner.Vertex();
+                uint32_t o = outer.Vertex();  // column c + k t, k = 0 … m
+                if (m == 1) {                 // most bands: one outer segment
+                    outer.Step();
+                    emit(a, b, o);
+                    emit(b, outer.Vertex(), o);
+                    continue;
+                }
+                for (int64_t k = 0; k < m / 2; ++k) {
+                    outer.Step();
+                    emit(a, outer.Vertex(), o);
+                    o = outer.Vertex();
+                }
+                emit(a, b, o);
+                for (int64_t k = m / 2; k < m; ++k) {
+                    outer.Step();
+                    emit(b, outer.Vertex(), o);
+                    o = outer.Vertex();
+                }
+            }
+            CHECK(inner.Vertex() == vertex(j, c) && outer.Vertex() == vertex(j + 1, c));
         }
         CHECK(dst == out.indices.data() + bandOffset[size_t(j) + 1]);
     });

@@ -51,7 +51,8 @@ struct OceanMeshRequest {
     // False (tests only): no shortcut that provably changes no bit (see ocean_mesh.cpp): every
     // vertex of a surf zone through the whole surf path, also where
     // OceanSurfaceFrame::OpenSeaFrom_m proves it the deep sea's, and the Gerstner waves summed
-    // also on rings where each wave's footprint weight is 0.
+    // also on rings where each wave's footprint weight is 0, and every triangle corner looked up
+    // by its column rather than stepped to along its ring.
     bool shortcuts = true;
 };
 

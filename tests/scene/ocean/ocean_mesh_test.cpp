@@ -600,6 +600,63 @@ void ExpectSameMesh(const OceanMesh& a, const OceanMesh& b) {
     ASSERT_EQ(bits(a.normals), bits(b.normals));
     ASSERT_EQ(bits(a.jacobian), bits(b.jacobian));
     ASSERT_EQ(bits(a.surfFoam), bits(b.surfFoam));
+    ASSERT_EQ(a.indices, b.indices);
+}
+
+// The index buffer steps each band's corners along its two rings; without the shortcuts every
+// corner is looked up by its column. The buffers must be equal for full circles, sectors
+// across north (negative columns, on rings stored whole, which wrap), a sector one column short
+// of the circle, column strides of 1 to 16 near the eye (widenByReach) and none, from eyes 0.3
+// to 40 m up, nearest ranges from 0 to 30 m.
+TEST(OceanMesh, SteppedIndexBufferIsTheColumnLookup) {
+    const OceanSurface sea(Beaufort5());
+    const auto frame = sea.At(3.0);
+    int views = 0, wholeInSector = 0, strided = 0, finerOutside = 0;
+    const auto compare = [&](const OceanMeshRequest& req) {
+        OceanMesh fast, lookup;
+        BuildOceanMesh(*frame, req, fast);
+        OceanMeshRequest whole = req;
+        whole.shortcuts = false;
+        BuildOceanMesh(*frame, whole, lookup);
+        ASSERT_EQ(fast.ringStart, lookup.ringStart);
+        ASSERT_FALSE(fast.indices.empty());
+        ASSERT_EQ(fast.indices, lookup.indices);
+        ++views;
+        for (int j = 0; j < fast.rings; ++j) {
+            const int64_t n = fast.ringStart[size_t(j) + 1] - fast.ringStart[size_t(j)];
+            const int sj = fast.ringStride[size_t(j)];
+            if (n * sj == fast.circleSegments &&
+                req.azimuthMax_rad - req.azimuthMin_rad < 2.0 * kPi)
+                ++wholeInSector;
+            if (sj > 1) ++strided;
+            if (j + 1 < fast.rings && fast.ringStride[size_t(j) + 1] < sj) ++finerOutside;
+        }
+    };
+    for (const double z : {0.3, 2.0, 12.0, 40.0})
+        for (const bool widen : {false, true})
+            for (const double minRange : {0.0, 30.0})
+                for (const double centre : {0.0, 0.3, -2.9, 3.1})
+                    for (const double half : {0.05, 0.6, 1.5, 2.9, 3.2}) {
+                        OceanMeshRequest req = View({1.0, -2.0, z}, centre, half);
+                        req.angularStep_rad = 0.02;
+                        req.widenByReach = widen;
+                        req.minRange_m = minRange;
+                        compare(req);
+                        ASSERT_FALSE(HasFatalFailure())
+                            << z << " " << widen << " " << minRange << " " << centre << " " << half;
+                    }
+    // Columns lo … hi − 1 with hi − lo = circle − 1 and lo < 0 (see
+    // ASectorOneColumnShortOfTheCircleAcrossNorthWrapsItsColumns).
+    OceanMeshRequest req = View({0.0, 0.0, 2.0}, 0.0, 1.0);
+    const int circle = int(std::ceil(2.0 * kPi / req.angularStep_rad));
+    const double dphi = 2.0 * kPi / circle;
+    req.azimuthMin_rad = -kPi + 0.5 * dphi;
+    req.azimuthMax_rad = kPi - 1.5 * dphi;
+    compare(req);
+    EXPECT_EQ(views, 321);
+    EXPECT_GT(wholeInSector, 500);
+    EXPECT_GT(strided, 1000);
+    EXPECT_GT(finerOutside, 100);
 }
 
 TEST(OceanMesh, ShortcutsAreTheWholePathBitForBit) {
