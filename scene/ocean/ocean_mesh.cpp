@@ -261,11 +261,16 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
             out.firstColumn = ringFirst[size_t(j)];
         }
     }
-    // The index buffer depends only on the grid's shape: rebuilt when that changes.
+    // The index buffer depends only on the grid's shape, the rings' columns and the bands'
+    // (a band may change while both its rings keep the columns a neighbouring band gives
+    // them): rebuilt when that changes.
     const bool sameShape = out.rings == rings && out.circleSegments == circle &&
                            out.ringStart == ringStart && out.ringFirstColumn == ringFirst &&
-                           out.ringStride == stride && !out.indices.empty();
+                           out.ringStride == stride && out.bandLo == bandLo &&
+                           out.bandHi == bandHi && !out.indices.empty();
     out.rings = rings;
+    out.bandLo = bandLo;
+    out.bandHi = bandHi;
     out.circleSegments = circle;
     out.ringStart = ringStart;
     out.ringFirstColumn = ringFirst;

@@ -89,6 +89,9 @@ struct OceanMesh {
     // near the eye, see ocean_mesh.cpp): vertex ringStart[j] + i is column ringFirstColumn[j]
     // + i · ringStride[j], and a whole circle has circleSegments / ringStride[j] vertices.
     std::vector<int> ringStride;
+    // Per band (between rings j and j + 1): the columns [bandLo[j], bandHi[j]) its triangles
+    // cover (a span of circleSegments or more: all round).
+    std::vector<int64_t> bandLo, bandHi;
     std::vector<double> radii_m;     // rest-position radius of each ring
     std::vector<float> footprint_m;  // per ring: the sampling footprint the surface is filtered to
 };

@@ -937,5 +937,40 @@ TEST(OceanMesh, SurfaceMovesContinuouslyWithTheEyeAndWithTime) {
     EXPECT_GT(worstMove, 0.0);
 }
 
+// A mesh built into an OceanMesh that held another view's mesh (the channels rebuild theirs
+// every frame into the same object) is the mesh built afresh: its index buffer is reused only
+// where every band's columns, not just every ring's, are the same. Over a surf zone the bands'
+// widening follows the waves' reach near the eye, which changes with time while the rings may
+// stay as they were.
+TEST(OceanMesh, ReusedMeshEqualsAFreshBuild) {
+    int sameRings = 0, builds = 0;
+    for (const bool surf : {false, true}) {
+        const OceanSurface sea(surf ? WithSurf(Beaufort5()) : Beaufort5());
+        for (const double z : {0.6, 2.0, 9.0}) {
+            for (const double centre : {-1.3, 0.4, 2.9}) {
+                OceanMesh reused;
+                std::vector<uint32_t> lastRingStart;
+                for (int step = 0; step < 60; ++step) {
+                    const double t = 0.02 * step;
+                    const auto frame = sea.At(t);
+                    OceanMeshRequest req = View({surf ? 250.0 : 0.0, 0.0, z}, centre, 0.45);
+                    req.angularStep_rad = 0.02;
+                    req.widenByReach = true;
+                    OceanMesh fresh;
+                    BuildOceanMesh(*frame, req, fresh);
+                    BuildOceanMesh(*frame, req, reused);
+                    ++builds;
+                    if (fresh.ringStart == lastRingStart) ++sameRings;
+                    lastRingStart = fresh.ringStart;
+                    ASSERT_EQ(reused.indices, fresh.indices) << surf << " " << z << " " << step;
+                    ASSERT_EQ(reused.positions, fresh.positions);
+                }
+            }
+        }
+    }
+    EXPECT_EQ(builds, 1080);
+    EXPECT_GE(sameRings, 10);  // builds whose rings are the previous build's
+}
+
 }  // namespace
 }  // namespace seasense::scene
