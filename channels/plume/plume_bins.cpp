@@ -10,6 +10,7 @@
 #include <iterator>
 #include <limits>
 #include <numbers>
+#include <utility>
 
 #include "scene/core/check.h"
 #include "scene/core/int_div.h"
@@ -24,18 +25,20 @@ namespace {
 constexpr size_t kPuffRecord = 16;
 
 // For each set of lanes (bit l for lane l), the indices of its lanes in increasing order,
-// then the other lanes': a shuffle that moves the set's values to the front, in order.
+// then the other lanes': a shuffle that moves the set's values to the front, in order. Stored
+// as 32-bit lanes, the shuffle's own index vector (one load; widening bytes to it took ~27
+// instructions, lane by lane, per use).
 struct CompressIndices {
-    uint8_t lanes[size_t(1) << simd::kLanes][simd::kLanes];
+    uint32_t lanes[size_t(1) << simd::kLanes][simd::kLanes];
 };
 constexpr CompressIndices MakeCompressIndices() {
     CompressIndices table{};
     for (size_t bits = 0; bits < (size_t(1) << simd::kLanes); ++bits) {
         size_t at = 0;
         for (size_t l = 0; l < simd::kLanes; ++l)
-            if ((bits >> l) & 1u) table.lanes[bits][at++] = uint8_t(l);
+            if ((bits >> l) & 1u) table.lanes[bits][at++] = uint32_t(l);
         for (size_t l = 0; l < simd::kLanes; ++l)
-            if (!((bits >> l) & 1u)) table.lanes[bits][at++] = uint8_t(l);
+            if (!((bits >> l) & 1u)) table.lanes[bits][at++] = uint32_t(l);
     }
     return table;
 }
@@ -46,10 +49,9 @@ constexpr CompressIndices kCompressIndices = MakeCompressIndices();
 // (AVX2's vpermd) instead of a test and a store per lane.
 using VU = uint32_t __attribute__((vector_size(sizeof(simd::VI))));
 inline size_t CompressStore(uint32_t* dst, VU values, unsigned bits) {
-    using Bytes = uint8_t __attribute__((vector_size(simd::kLanes)));
-    Bytes lanes;
+    VU lanes;
     std::memcpy(&lanes, kCompressIndices.lanes[bits], sizeof lanes);
-    const VU packed = __builtin_shuffle(values, __builtin_convertvector(lanes, VU));
+    const VU packed = __builtin_shuffle(values, lanes);
     std::memcpy(dst, &packed, sizeof packed);
     return size_t(__builtin_popcount(bits));
 }
@@ -584,7 +586,17 @@ void PlumeScreenBins::GatherRow(const RowSource& from, int x0, int y0, int y1, i
                 if (Reaches(k, cx0, y0, cx1, y1, HalfDiagonal(cx1 - cx0, y1 - y0)))
                     reach.edge |= uint64_t(1) << (c - edge0);
             }
-            if (reach.first <= reach.last || reach.edge != 0) reached.push_back(reach);
+            // The blocks among from's that hold rectangles the puff reaches: those of cells
+            // first … last and of its edge rectangles (the others would give it an empty mask).
+            uint64_t reachBlocks = 0;
+            if (reach.first <= reach.last) {
+                const int b0 = reach.first / cellsPerBlock, b1 = reach.last / cellsPerBlock;
+                reachBlocks = ((uint64_t(2) << b1) - 1) & ~((uint64_t(1) << b0) - 1);
+            }
+            for (uint64_t e = reach.edge; e != 0; e &= e - 1)
+                reachBlocks |= uint64_t(1) << ((edge0 + __builtin_ctzll(e)) / cellsPerBlock);
+            reach.blocks &= reachBlocks;
+            if (reach.blocks != 0) reached.push_back(reach);
         }
     }
     using simd::kLanes;
@@ -595,24 +607,41 @@ void PlumeScreenBins::GatherRow(const RowSource& from, int x0, int y0, int y1, i
     VI laneBit;
     for (size_t l = 0; l < kLanes; ++l) laneBit[l] = int32_t(1u << l);
     constexpr size_t kVectors = (kMaxRowCells + kLanes - 1) / kLanes;
-    std::vector<uint32_t>& blockPuffs = out.blockPuffs;
-    std::vector<uint32_t>& blockMasks = out.blockMasks;
-    for (int b = 0; b < blockCount; ++b) {
-        const int cb0 = b * cellsPerBlock, n = std::min(cellsPerBlock, cells - cb0);
-        // The block's rectangles' ranges, sums and counts, kLanes rectangles a vector, as Begin
-        // starts them.
-        VF nearV[kVectors], farV[kVectors], smallV[kVectors], halfSmallV[kVectors],
-            twiceSmallV[kVectors];
-        VI countV[kVectors];
-        for (size_t v = 0; v < kVectors; ++v) {
-            nearV[v] = simd::Splat(std::numeric_limits<float>::infinity());
-            farV[v] = smallV[v] = halfSmallV[v] = twiceSmallV[v] = simd::Splat(0.0f);
-            countV[v] = VI{};
+    // Each block's puffs (in from's order) and the masks of its rectangles they reach, in
+    // blockPuffs and blockMasks from b · stride on (room for every puff of the row, padded to
+    // whole lane groups): each puff written to the blocks it reaches, rather than every block
+    // passing over all the row's puffs. (The calling thread's scratch: a row's lists would
+    // keep blockCount times its puffs.)
+    thread_local std::vector<uint32_t> blockPuffs, blockMasks;
+    const size_t stride = (reached.size() + kLanes - 1) / kLanes * kLanes;
+    if (blockPuffs.size() < size_t(blockCount) * stride) {
+        blockPuffs.resize(size_t(blockCount) * stride);
+        blockMasks.resize(size_t(blockCount) * stride);
+    }
+    size_t fill[64];
+    std::fill(fill, fill + blockCount, size_t(0));
+    const auto Put = [&](int b, uint32_t k, uint32_t mask) {
+        const size_t at = size_t(b) * stride + fill[b]++;
+        blockPuffs[at] = k, blockMasks[at] = mask;
+    };
+    for (const ListRow::Reach& reach : reached) {
+        uint64_t bits = reach.blocks;
+        if (reach.edge == 0) {
+            // Blocks of cells first … last alone: the first from bit first − cb0 on, the last
+            // up to bit last − cb0, those between whole (they precede the last block, so they
+            // hold cellsPerBlock rectangles): the masks of the general form below.
+            const int b0 = reach.first / cellsPerBlock, b1 = reach.last / cellsPerBlock;
+            for (; bits != 0; bits &= bits - 1) {
+                const int b = __builtin_ctzll(bits), cb0 = b * cellsPerBlock;
+                const int lo = b == b0 ? reach.first - cb0 : 0;
+                const int hi = b == b1 ? reach.last - cb0 : cellsPerBlock - 1;
+                Put(b, reach.k, uint32_t((uint64_t(2) << hi) - (uint64_t(1) << lo)));
+            }
+            continue;
         }
-        blockPuffs.clear(), blockMasks.clear();
-        const uint32_t all = uint32_t((uint64_t(1) << n) - 1);
-        for (const ListRow::Reach& reach : reached) {
-            if (!((reach.blocks >> b) & 1u)) continue;
+        for (; bits != 0; bits &= bits - 1) {
+            const int b = __builtin_ctzll(bits);
+            const int cb0 = b * cellsPerBlock, n = std::min(cellsPerBlock, cells - cb0);
             // The block's rectangles among the puff's: bits first − cb0 … last − cb0, and its
             // edge rectangles.
             const int first = std::max(reach.first, cb0), last = std::min(reach.last, cb0 + n - 1);
@@ -620,27 +649,54 @@ void PlumeScreenBins::GatherRow(const RowSource& from, int x0, int y0, int y1, i
                 first <= last
                     ? uint32_t((uint64_t(2) << (last - cb0)) - (uint64_t(1) << (first - cb0)))
                     : 0u;
-            if (reach.edge != 0) {
-                const int shift = edge0 - cb0;
-                const uint64_t edge = shift >= 0    ? (shift < 64 ? reach.edge << shift : 0)
-                                      : shift > -64 ? reach.edge >> -shift
-                                                    : 0;
-                mask |= uint32_t(edge) & all;
-            }
-            if (mask == 0) continue;
-            blockPuffs.push_back(reach.k), blockMasks.push_back(mask);
+            const int shift = edge0 - cb0;
+            const uint64_t edge = shift >= 0    ? (shift < 64 ? reach.edge << shift : 0)
+                                  : shift > -64 ? reach.edge >> -shift
+                                                : 0;
+            mask |= uint32_t(edge) & uint32_t((uint64_t(1) << n) - 1);
+            Put(b, reach.k, mask);
+        }
+    }
+    // The row's lists' ranges, sums, counts and starts, written per block below (one resize
+    // each instead of a push_back per list).
+    const size_t base = out.count.size();
+    out.count.resize(base + size_t(cells));
+    out.start.resize(base + 1 + size_t(cells));
+    out.near_m.resize(base + size_t(cells)), out.far_m.resize(base + size_t(cells));
+    out.smallOpticalDepth.resize(base + size_t(cells));
+    out.halfSmallOpticalDepth.resize(base + size_t(cells));
+    out.twiceSmallOpticalDepth.resize(base + size_t(cells));
+    alignas(32) float nearA[kVectors * kLanes], farA[kVectors * kLanes];
+    alignas(32) float smallA[kVectors * kLanes], halfSmallA[kVectors * kLanes];
+    alignas(32) float twiceSmallA[kVectors * kLanes];
+    alignas(32) int32_t countA[kVectors * kLanes];
+    // The ranges, sums and counts of a block's n rectangles from its puffs and masks into the
+    // arrays above, on V vectors of kLanes rectangles (V = ⌈n / kLanes⌉, a constant: the
+    // vectors stay in registers). Every vector takes every puff: a lane whose rectangle the
+    // puff does not reach keeps its values (the selects), so the lanes hold what adding the
+    // puff to those it reaches alone gives.
+    const auto accumulate = [&]<size_t V>(const uint32_t* puffs, const uint32_t* masks,
+                                          size_t count) {
+        // As Begin starts them.
+        VF nearV[V], farV[V], smallV[V], halfSmallV[V], twiceSmallV[V];
+        VI countV[V];
+        for (size_t v = 0; v < V; ++v) {
+            nearV[v] = simd::Splat(std::numeric_limits<float>::infinity());
+            farV[v] = smallV[v] = halfSmallV[v] = twiceSmallV[v] = simd::Splat(0.0f);
+            countV[v] = VI{};
+        }
+        for (size_t j = 0; j < count; ++j) {
+            const uint32_t k = puffs[j], mask = masks[j];
             // The puff's ranges and sums into the rectangles it reaches, in from's order as Add
             // puts them in one list: std::min and std::max are simd::Min and Max lane for lane,
             // and a rectangle the puff does not reach keeps its values.
-            const Footprint& fp = footprint_[reach.k];
+            const Footprint& fp = footprint_[k];
             const VF nearK = simd::Splat(fp.near_m), farK = simd::Splat(fp.far_m);
             const bool small = fp.sigmaPixels < smallPixels;
             const bool halfSmall = fp.sigmaPixels < 0.5f * smallPixels;
             const bool twiceSmall = fp.sigmaPixels < 2.0f * smallPixels;
             const VF tau = simd::Splat(fp.tauMax);
-            const int hiBit = 31 - __builtin_clz(mask);
-            for (size_t v = size_t(__builtin_ctz(mask)) / kLanes; v <= size_t(hiBit) / kLanes;
-                 ++v) {
+            for (size_t v = 0; v < V; ++v) {
                 const VI in = ((VI{} + int32_t(mask >> (v * kLanes))) & laneBit) != 0;
                 nearV[v] = simd::Select(in, simd::Min(nearV[v], nearK), nearV[v]);
                 farV[v] = simd::Select(in, simd::Max(farV[v], farK), farV[v]);
@@ -651,13 +707,7 @@ void PlumeScreenBins::GatherRow(const RowSource& from, int x0, int y0, int y1, i
                     twiceSmallV[v] = simd::Select(in, twiceSmallV[v] + tau, twiceSmallV[v]);
             }
         }
-        // The block's lists, one after the other, each padded to a multiple of 4 with the
-        // inert puff.
-        alignas(32) float nearA[kVectors * kLanes], farA[kVectors * kLanes];
-        alignas(32) float smallA[kVectors * kLanes], halfSmallA[kVectors * kLanes];
-        alignas(32) float twiceSmallA[kVectors * kLanes];
-        alignas(32) int32_t countA[kVectors * kLanes];
-        for (size_t v = 0; v < kVectors; ++v) {
+        for (size_t v = 0; v < V; ++v) {
             simd::Store(nearA + v * kLanes, nearV[v]);
             simd::Store(farA + v * kLanes, farV[v]);
             simd::Store(smallA + v * kLanes, smallV[v]);
@@ -665,33 +715,53 @@ void PlumeScreenBins::GatherRow(const RowSource& from, int x0, int y0, int y1, i
             simd::Store(twiceSmallA + v * kLanes, twiceSmallV[v]);
             std::memcpy(countA + v * kLanes, &countV[v], sizeof(VI));
         }
+    };
+    // accumulate with V = vectors (1 … kVectors).
+    const auto accumulateOn = [&]<size_t... I>(std::index_sequence<I...>, size_t vectors,
+                                               const uint32_t* puffs, const uint32_t* masks,
+                                               size_t count) {
+        ((vectors == I + 1 ? (accumulate.template operator()<I + 1>(puffs, masks, count), true)
+                           : false) ||
+         ...);
+    };
+    for (int b = 0; b < blockCount; ++b) {
+        const int cb0 = b * cellsPerBlock, n = std::min(cellsPerBlock, cells - cb0);
+        uint32_t* puffs = blockPuffs.data() + size_t(b) * stride;
+        uint32_t* masks = blockMasks.data() + size_t(b) * stride;
+        accumulateOn(std::make_index_sequence<kVectors>{}, (size_t(n) + kLanes - 1) / kLanes, puffs,
+                     masks, fill[b]);
+        // The block's lists, one after the other, each padded to a multiple of 4 with the
+        // inert puff.
         size_t end = out.index.size();
         for (int c = 0; c < n; ++c) end += (size_t(countA[c]) + 3) & ~size_t(3);
         // kLanes − 1 slots more: CompressStore writes a whole lane group at the list's end.
         out.index.resize(end + kLanes);
         // Whole lane groups: the padding puffs reach no rectangle.
-        const size_t groups = (blockPuffs.size() + kLanes - 1) / kLanes * kLanes;
-        blockPuffs.resize(groups, inert_), blockMasks.resize(groups, 0u);
-        uint32_t* dst = out.index.data() + out.start.back();
+        const size_t groups = (fill[b] + kLanes - 1) / kLanes * kLanes;
+        std::fill(puffs + fill[b], puffs + groups, inert_);
+        std::fill(masks + fill[b], masks + groups, 0u);
+        const size_t list0 = base + size_t(cb0);
+        uint32_t* dst = out.index.data() + out.start[list0];
         for (int c = 0; c < n; ++c) {
             // The block's puffs whose masks hold bit c, in order, kLanes puffs at a time.
             size_t m = 0;
             for (size_t j = 0; j < groups; j += kLanes) {
-                VU puffs, masks;
-                std::memcpy(&puffs, blockPuffs.data() + j, sizeof puffs);
-                std::memcpy(&masks, blockMasks.data() + j, sizeof masks);
-                m += CompressStore(dst + m, puffs, simd::LaneBits(VI(masks << (31 - c))));
+                VU lanePuffs, laneMasks;
+                std::memcpy(&lanePuffs, puffs + j, sizeof lanePuffs);
+                std::memcpy(&laneMasks, masks + j, sizeof laneMasks);
+                m += CompressStore(dst + m, lanePuffs, simd::LaneBits(VI(laneMasks << (31 - c))));
             }
             const size_t padded = (m + 3) & ~size_t(3);
             std::fill(dst + m, dst + padded, inert_);
             dst += padded;
-            out.start.push_back(uint32_t(dst - out.index.data()));
-            out.count.push_back(uint32_t(m));
-            out.near_m.push_back(nearA[c]);
-            out.far_m.push_back(farA[c]);
-            out.smallOpticalDepth.push_back(smallA[c]);
-            out.halfSmallOpticalDepth.push_back(halfSmallA[c]);
-            out.twiceSmallOpticalDepth.push_back(twiceSmallA[c]);
+            const size_t list = list0 + size_t(c);
+            out.start[list + 1] = uint32_t(dst - out.index.data());
+            out.count[list] = uint32_t(m);
+            out.near_m[list] = nearA[c];
+            out.far_m[list] = farA[c];
+            out.smallOpticalDepth[list] = smallA[c];
+            out.halfSmallOpticalDepth[list] = halfSmallA[c];
+            out.twiceSmallOpticalDepth[list] = twiceSmallA[c];
         }
         out.index.resize(end);
     }

@@ -107,16 +107,14 @@ class PlumeScreenBins {
       private:
         friend class PlumeScreenBins;
         // GatherRow's scratch: the puffs reaching the row (their rectangles: an interval of
-        // full-width ones and a mask of those clipped at the bin area's edge), and those of
-        // one block with the masks of its rectangles they reach (two arrays, read a lane
-        // group at a time).
+        // full-width ones and a mask of those clipped at the bin area's edge; the blocks whose
+        // lists hold them and whose rectangles they reach).
         struct Reach {
             uint32_t k;
             int first, last;
             uint64_t edge, blocks;
         };
         std::vector<Reach> reached;
-        std::vector<uint32_t> blockPuffs, blockMasks;
     };
     // The puffs of a row of up to 64 blocks' lists (each in kept order): each puff once, in
     // kept order, with the blocks whose lists hold it (bit b for block b).

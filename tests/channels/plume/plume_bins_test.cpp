@@ -4,8 +4,8 @@
 // share the tolerance), lists holding every puff whose cutoff ellipsoid their rays meet (and
 // little more), lists taken from larger lists (one rectangle or a row of them) equal to
 // lists from the tiles, a row's lists taken from its blocks' merged lists equal to those
-// taken from each cell's block, eight-lane traces equal to four-lane ones, and the dropping
-// of puffs too thin to matter.
+// taken from each cell's block (blocks of any size up to 32 cells), eight-lane traces equal
+// to four-lane ones, and the dropping of puffs too thin to matter.
 #include "channels/plume/plume_bins.h"
 
 #include <gtest/gtest.h>
@@ -299,6 +299,71 @@ TEST(PlumeScreenBins, GatherRowOfBlocksEqualsGatherFromEachBlock) {
     }
     EXPECT_GT(nonEmpty, 1000u);
     EXPECT_GT(nonEmpty * 10, compared);
+}
+
+// The same for blocks of 1, 5, 13 and 32 cells (one to four lane groups of rectangles, the
+// last block of a row partial), rows starting 0 or 3 pixels in and running past the bin area's
+// right edge (rectangles clipped there fall in a block's middle), and block lists taken from
+// every kept puff: each puff's rectangles in a row, spread over the blocks whose lists hold
+// it, give every cell what Gather from its own block gives, bit for bit.
+TEST(PlumeScreenBins, GatherRowOfBlocksOfAnySizeEqualsGatherFromEachBlock) {
+    const scene::PlumeField field = CommittedPlumes();
+    const std::array<ChannelCamera, 2> cameras = WideAndFireCameras(200);
+    size_t nonEmpty = 0, compared = 0, multiBlock = 0;
+    for (const ChannelCamera& cam : cameras) {
+        for (const ObscurantBand band : {ObscurantBand::Visible, ObscurantBand::Lwir}) {
+            const PlumeScreenBins bins(field, cam, band);
+            PlumeScreenBins::List all;
+            for (uint32_t k = 0; k < bins.KeptPuffs(); ++k) all.index.push_back(k);
+            all.count = all.index.size();
+            const int areaW = cam.width + PlumeScreenBins::kMargin;
+            const int areaH = cam.height + PlumeScreenBins::kMargin;
+            for (const int cellsPerBlock : {1, 5, 13, PlumeScreenBins::kMaxRowCells}) {
+                for (const int x0 : {0, 3}) {
+                    const int cells = (areaW - x0) / 4 + 1;
+                    const int blocksX = (cells + cellsPerBlock - 1) / cellsPerBlock;
+                    ASSERT_LE(blocksX, 64);
+                    std::vector<PlumeScreenBins::List> blocks(static_cast<size_t>(blocksX));
+                    PlumeScreenBins::RowSource source;
+                    PlumeScreenBins::ListRow row;
+                    PlumeScreenBins::List single, l;
+                    // Blocks of 8 rows of cells (and the pixel beyond), as CompositePlumes'.
+                    for (int by = 0; by < areaH; by += 32) {
+                        for (int bx = 0; bx < blocksX; ++bx) {
+                            const int bx0 = x0 + bx * cellsPerBlock * 4;
+                            bins.Gather(all, bx0, by, bx0 + cellsPerBlock * 4 + 1, by + 33, 4.0f,
+                                        false, blocks[size_t(bx)]);
+                        }
+                        bins.MergeBlocks(blocks, source);
+                        for (int cy = by; cy < std::min(by + 32, areaH); cy += 4) {
+                            row.Clear();
+                            bins.GatherRow(source, x0, cy, cy + 5, 4, 5, cellsPerBlock, cells, 4.0f,
+                                           row);
+                            ASSERT_EQ(row.size(), size_t(cells));
+                            for (int c = 0; c < cells; ++c) {
+                                const int x = x0 + c * 4;
+                                bins.Gather(blocks[size_t(c / cellsPerBlock)], x, cy, x + 5, cy + 5,
+                                            4.0f, false, single);
+                                row.Take(size_t(c), l);
+                                ASSERT_NO_FATAL_FAILURE(ExpectSameList(
+                                    l, single,
+                                    std::to_string(cellsPerBlock) + " per block, cell " +
+                                        std::to_string(c) + ", " + std::to_string(cy)));
+                                nonEmpty += single.count > 0;
+                                ++compared;
+                            }
+                        }
+                        // Puffs whose rectangles span blocks (their masks split between them).
+                        for (size_t j = 0; j < source.index.size(); ++j)
+                            multiBlock += __builtin_popcountll(source.blocks[j]) > 1;
+                    }
+                }
+            }
+        }
+    }
+    EXPECT_GT(nonEmpty, 3000u);
+    EXPECT_GT(nonEmpty * 10, compared);
+    EXPECT_GT(multiBlock, 1000u);
 }
 
 // A cell's list holds every puff whose cutoff ellipsoid (τ_max e^(−r²/2) = ε) a ray through
