@@ -332,6 +332,45 @@ using D4 = double __attribute__((vector_size(32)));
 using F4 = float __attribute__((vector_size(16)));
 using I4 = int32_t __attribute__((vector_size(16)));
 using U4 = uint32_t __attribute__((vector_size(16)));
+using I8 = int32_t __attribute__((vector_size(32)));
+
+// Small triangles skip the span bounds (three divisions a row) and test their bounding box
+// instead, kBoxLanes samples of a row at a time on int32 lanes: up to kBoxOctets·kBoxLanes
+// samples wide (bounding box ∩ tile), as most of the sea's triangles are in every channel.
+inline constexpr int kBoxLanes = 8;
+inline constexpr int kBoxOctets = 2;
+// Edge function values stay exact in int32 lanes where every edge's ∂E/∂x and ∂E/∂y lie in
+// [−2^14, 2^14) (the triangle within 64 samples each way), see RasterTriangle.
+inline constexpr int64_t kBoxMaxDelta = int64_t(1) << 14;
+
+// Lanes whose sign bit is set, one bit each, lane 0 in bit 0.
+inline int SignBits(I8 v) {
+#if defined(__AVX__)
+    return _mm256_movemask_ps(__m256(v));
+#else
+    return _mm_movemask_ps(__m128(__builtin_shufflevector(v, v, 0, 1, 2, 3))) |
+           _mm_movemask_ps(__m128(__builtin_shufflevector(v, v, 4, 5, 6, 7))) << 4;
+#endif
+}
+inline I4 LowHalf(I8 v) { return __builtin_shufflevector(v, v, 0, 1, 2, 3); }
+inline I4 HighHalf(I8 v) { return __builtin_shufflevector(v, v, 4, 5, 6, 7); }
+// Lanes of a where mask's sign bit is set, else b's (only the sign bits of mask matter).
+template <class V>
+inline V SelectBySign(I4 mask, V a, V b) {
+#if defined(__SSE4_1__)
+    return V(_mm_blendv_ps(__m128(b), __m128(a), __m128(mask)));
+#else
+    return (mask >> 31) ? a : b;
+#endif
+}
+// Exact int32 to double, lane for lane (GCC's generic conversion converts two halves).
+inline D4 ToDouble(I4 v) {
+#if defined(__AVX__)
+    return _mm256_cvtepi32_pd(__m128i(v));
+#else
+    return __builtin_convertvector(v, D4);
+#endif
+}
 
 struct TileRect {
     int x0, y0, x1, y1;  // inclusive samples
@@ -355,12 +394,15 @@ template <bool kCount, bool kClipped>
     int64_t row[3], stepX[3], stepY[3], unbias[3];
     const int64_t px = int64_t(x0) * kSubScale + kHalfSample;
     const int64_t py = int64_t(y0) * kSubScale + kHalfSample;
+    // Below 2 kBoxMaxDelta when every edge's a, b lies in [−kBoxMaxDelta, kBoxMaxDelta).
+    uint64_t deltas = 0;
     for (int k = 0; k < 3; ++k) {
         int i = k == 2 ? 0 : k + 1, j = k == 0 ? 2 : k - 1;
         if (!positive) std::swap(i, j);
         const int64_t ax = s.x[i], ay = s.y[i], bx = s.x[j], by = s.y[j];
         const int64_t a = ay - by;  // ∂E/∂x
         const int64_t b = bx - ax;  // ∂E/∂y
+        deltas |= uint64_t(a + kBoxMaxDelta) | uint64_t(b + kBoxMaxDelta);
         // Top-left rule (Direct3D 11.3 functional specification, rasterization rules) for a
         // clockwise triangle on the y-down grid: a left edge runs upward (a > 0); a top edge
         // is horizontal and runs toward +x. Other edges exclude samples with E = 0.
@@ -387,14 +429,103 @@ template <bool kCount, bool kClipped>
         h1 = g[4] - g[3];
         h2 = g[5] - g[3];
     }
+    size_t rowBase = size_t(y0 - t.y0) * size_t(t.width);
+    const int64_t xo = t.x0;
+    // kSpanLanes samples of a row, starting at index i of its targets, whose E_1, E_2 are
+    // f1, f2 (exact integers): every operation is the one-sample form's, lane for lane.
+    // Lanes whose sign bit is set in `out` (past the span or outside the triangle), and
+    // samples failing the depth test, store back the values they loaded (the tile's targets
+    // are this thread's and padded past their last sample).
+    const I4 primV = I4{} + int32_t(prim);
+    const auto quad = [&](size_t i, D4 f1, D4 f2, I4 out) __attribute__((always_inline)) {
+        const D4 d = k0 + f1 * dc1 + f2 * dc2;
+        const F4 depth = __builtin_convertvector(d, F4);
+        F4 old, oldB1, oldB2;
+        I4 oldPrim;
+        std::memcpy(&old, t.depth + i, sizeof old);
+        std::memcpy(&oldPrim, t.primitive + i, sizeof oldPrim);
+        const I4 wins =
+            ~out & (depth > 0.0f) & ((depth > old) | ((depth == old) & (U4(primV) < U4(oldPrim))));
+        if (!_mm_movemask_ps(F4(wins))) return;
+        const D4 inv = 1.0 / d;
+        F4 nb1, nb2;
+        if constexpr (kClipped) {
+            nb1 = __builtin_convertvector((g0 + f1 * g1 + f2 * g2) * inv, F4);
+            nb2 = __builtin_convertvector((h0 + f1 * h1 + f2 * h2) * inv, F4);
+        } else {
+            nb1 = __builtin_convertvector(f1 * c1 * inv, F4);
+            nb2 = __builtin_convertvector(f2 * c2 * inv, F4);
+        }
+        std::memcpy(&oldB1, t.b1 + i, sizeof oldB1);
+        std::memcpy(&oldB2, t.b2 + i, sizeof oldB2);
+        const F4 outDepth = SelectBySign(wins, depth, old);
+        const I4 outPrim = SelectBySign(wins, primV, oldPrim);
+        const F4 outB1 = SelectBySign(wins, nb1, oldB1);
+        const F4 outB2 = SelectBySign(wins, nb2, oldB2);
+        std::memcpy(t.depth + i, &outDepth, sizeof outDepth);
+        std::memcpy(t.primitive + i, &outPrim, sizeof outPrim);
+        std::memcpy(t.b1 + i, &outB1, sizeof outB1);
+        std::memcpy(t.b2 + i, &outB2, sizeof outB2);
+    };
+
+    if constexpr (!kCount) {
+        // Small triangles (the coverage count keeps the spans): the box's samples kBoxLanes at
+        // a time, inside where all three E_k − unbias_k are >= 0 (the span's own condition,
+        // without its divisions). With every |a|, |b| <= 2^14 the box's sample centres, the
+        // lanes up to kBoxLanes − 1 past it and the row stepped to past the last lie within
+        // 2^14 + 2^11 of every vertex in x and 2^14 + 2^8 in y, so every E_k stays below 2^30 in
+        // magnitude: exact in int32 lanes, and its double the span's. Only lane groups with a
+        // sample in the box are loaded and stored, so they reach no further past the box than
+        // the span's.
+        const auto box = [&]<int kOctets>() __attribute__((always_inline)) {
+            const I8 lane8{0, 1, 2, 3, 4, 5, 6, 7};
+            I8 e0[kOctets], e1[kOctets], e2[kOctets];
+            for (int o = 0; o < kOctets; ++o) {
+                const I8 lane = lane8 + kBoxLanes * o;
+                e0[o] = int32_t(row[0]) + lane * int32_t(stepX[0]);
+                e1[o] = int32_t(row[1]) + lane * int32_t(stepX[1]);
+                e2[o] = int32_t(row[2]) + lane * int32_t(stepX[2]);
+            }
+            const I8 outBox = lane8 + kBoxLanes * (kOctets - 1) > x1 - x0;
+            const int32_t dy0 = int32_t(stepY[0]), dy1 = int32_t(stepY[1]), dy2 = int32_t(stepY[2]);
+            const int32_t unbias1 = int32_t(u1), unbias2 = int32_t(u2);
+            size_t i = rowBase + size_t(x0 - xo);
+            for (int y = y0; y <= y1; ++y, i += size_t(t.width)) {
+                for (int o = 0; o < kOctets; ++o) {
+                    // Sign bits: lanes outside the triangle or past the box (only the last
+                    // octet reaches past it).
+                    I8 signs = e0[o] | e1[o] | e2[o];
+                    if (o == kOctets - 1) signs |= outBox;
+                    const int outside = SignBits(signs);
+                    if (outside != 0xff) {
+                        const I8 f1 = e1[o] + unbias1, f2 = e2[o] + unbias2;
+                        const size_t at = i + size_t(kBoxLanes * o);
+                        if ((outside & 0xf) != 0xf)
+                            quad(at, ToDouble(LowHalf(f1)), ToDouble(LowHalf(f2)), LowHalf(signs));
+                        if ((outside >> 4) != 0xf)
+                            quad(at + size_t(kSpanLanes), ToDouble(HighHalf(f1)),
+                                 ToDouble(HighHalf(f2)), HighHalf(signs));
+                    }
+                    e0[o] += dy0;
+                    e1[o] += dy1;
+                    e2[o] += dy2;
+                }
+            }
+        };
+        if (deltas < uint64_t(2 * kBoxMaxDelta) && x1 - x0 < kBoxOctets * kBoxLanes) {
+            if (x1 - x0 < kBoxLanes)
+                box.template operator()<1>();
+            else
+                box.template operator()<2>();
+            return;
+        }
+    }
+
     // Inside the triangle every E_k lies in [0, |2·area|]: below 2^53 the samples' E_1, E_2
     // are exact in doubles, and so are their sums, so the span steps them in doubles, the
     // same values as converting each sample's integer.
     const bool exactInDoubles = absArea2 <= (int64_t(1) << 53);
     const double step1 = double(stepX[1]), step2 = double(stepX[2]);
-
-    size_t rowBase = size_t(y0 - t.y0) * size_t(t.width);
-    const int64_t xo = t.x0;
     for (int y = y0; y <= y1; ++y, rowBase += size_t(t.width)) {
         // The covered samples of a row form one span: each edge bounds it from one side,
         // found by exact integer division rather than by testing every sample of the box.
@@ -420,75 +551,41 @@ template <bool kCount, bool kClipped>
             uint32_t* __restrict hitsRow = t.hits + rowBase;
             for (int64_t x = lo; x <= hi; ++x) ++hitsRow[x - xo];
         } else {
-            float* __restrict depthRow = t.depth + rowBase;
-            uint32_t* __restrict primRow = t.primitive + rowBase;
-            float* __restrict b1Row = t.b1 + rowBase;
-            float* __restrict b2Row = t.b2 + rowBase;
-            const auto sample = [&](int64_t x, double f1, double f2)
-                __attribute__((always_inline)) {
-                const double d = k0 + f1 * dc1 + f2 * dc2;
-                const float depth = float(d);
-                const float old = depthRow[x];
-                if (depth > 0.0f && (depth > old || (depth == old && prim < primRow[x]))) {
-                    depthRow[x] = depth;
-                    primRow[x] = prim;
-                    const double inv = 1.0 / d;
-                    if constexpr (kClipped) {
-                        b1Row[x] = float((g0 + f1 * g1 + f2 * g2) * inv);
-                        b2Row[x] = float((h0 + f1 * h1 + f2 * h2) * inv);
-                    } else {
-                        b1Row[x] = float(f1 * c1 * inv);
-                        b2Row[x] = float(f2 * c2 * inv);
-                    }
-                }
-            };
+            const size_t i0 = rowBase + size_t(lo - xo);
             if (exactInDoubles) [[likely]] {
                 // kSpanLanes samples at a time: lane i holds the sample's E_1, E_2 as the scalar
-                // steps would (exact integers, so stepping by kSpanLanes steps is exact), and
-                // every operation is the scalar's, lane for lane. Lanes past the span, and
-                // samples failing the depth test, store back the values they loaded (the tile's
-                // targets are this thread's and padded past their last sample).
+                // steps would (exact integers, so stepping by kSpanLanes steps is exact).
                 const D4 lane{0.0, 1.0, 2.0, 3.0};
                 D4 f1 = double(e1) + lane * step1, f2 = double(e2) + lane * step2;
                 const double groupStep1 = double(kSpanLanes) * step1;
                 const double groupStep2 = double(kSpanLanes) * step2;
-                const I4 primV = I4{} + int32_t(prim);
                 const I4 laneI{0, 1, 2, 3};
-                for (int64_t x = lo; x <= hi; x += kSpanLanes, f1 += groupStep1, f2 += groupStep2) {
-                    const int64_t i = x - xo;
-                    const D4 d = k0 + f1 * dc1 + f2 * dc2;
-                    const F4 depth = __builtin_convertvector(d, F4);
-                    F4 old, oldB1, oldB2;
-                    I4 oldPrim;
-                    std::memcpy(&old, depthRow + i, sizeof old);
-                    std::memcpy(&oldPrim, primRow + i, sizeof oldPrim);
-                    const I4 inSpan = laneI <= int32_t(hi - x);
-                    const I4 wins = inSpan & (depth > 0.0f) &
-                                    ((depth > old) | ((depth == old) & (U4(primV) < U4(oldPrim))));
-                    if (!_mm_movemask_ps(F4(wins))) continue;
-                    const D4 inv = 1.0 / d;
-                    F4 nb1, nb2;
-                    if constexpr (kClipped) {
-                        nb1 = __builtin_convertvector((g0 + f1 * g1 + f2 * g2) * inv, F4);
-                        nb2 = __builtin_convertvector((h0 + f1 * h1 + f2 * h2) * inv, F4);
-                    } else {
-                        nb1 = __builtin_convertvector(f1 * c1 * inv, F4);
-                        nb2 = __builtin_convertvector(f2 * c2 * inv, F4);
-                    }
-                    std::memcpy(&oldB1, b1Row + i, sizeof oldB1);
-                    std::memcpy(&oldB2, b2Row + i, sizeof oldB2);
-                    const F4 outDepth = wins ? depth : old;
-                    const I4 outPrim = wins ? primV : oldPrim;
-                    const F4 outB1 = wins ? nb1 : oldB1;
-                    const F4 outB2 = wins ? nb2 : oldB2;
-                    std::memcpy(depthRow + i, &outDepth, sizeof outDepth);
-                    std::memcpy(primRow + i, &outPrim, sizeof outPrim);
-                    std::memcpy(b1Row + i, &outB1, sizeof outB1);
-                    std::memcpy(b2Row + i, &outB2, sizeof outB2);
-                }
+                for (int64_t x = lo; x <= hi; x += kSpanLanes, f1 += groupStep1, f2 += groupStep2)
+                    quad(i0 + size_t(x - lo), f1, f2, laneI > int32_t(hi - x));
             } else {
-                for (int64_t x = lo; x <= hi; ++x, e1 += stepX[1], e2 += stepX[2])
-                    sample(x - xo, double(e1), double(e2));
+                float* __restrict depthRow = t.depth + rowBase;
+                uint32_t* __restrict primRow = t.primitive + rowBase;
+                float* __restrict b1Row = t.b1 + rowBase;
+                float* __restrict b2Row = t.b2 + rowBase;
+                for (int64_t x = lo; x <= hi; ++x, e1 += stepX[1], e2 += stepX[2]) {
+                    const double f1 = double(e1), f2 = double(e2);
+                    const double d = k0 + f1 * dc1 + f2 * dc2;
+                    const float depth = float(d);
+                    const int64_t i = x - xo;
+                    const float old = depthRow[i];
+                    if (depth > 0.0f && (depth > old || (depth == old && prim < primRow[i]))) {
+                        depthRow[i] = depth;
+                        primRow[i] = prim;
+                        const double inv = 1.0 / d;
+                        if constexpr (kClipped) {
+                            b1Row[i] = float((g0 + f1 * g1 + f2 * g2) * inv);
+                            b2Row[i] = float((h0 + f1 * h1 + f2 * h2) * inv);
+                        } else {
+                            b1Row[i] = float(f1 * c1 * inv);
+                            b2Row[i] = float(f2 * c2 * inv);
+                        }
+                    }
+                }
             }
         }
     }
@@ -556,8 +653,8 @@ struct TileTargets {
     std::vector<float> depth, b1, b2;
     std::vector<uint32_t> primitive;
     // Samples [0, clear) are empty (depth, b1, b2 zero, primitive kNoPrimitive). A tile's
-    // triangles change only its first w·h samples (the span's lanes past them store back what
-    // they loaded).
+    // triangles change only its first w·h samples (lanes past a span or box row store back
+    // what they loaded).
     size_t clear = 0;
 };
 
@@ -578,7 +675,8 @@ void RasterTile(int tile, const Context& ctx, const std::vector<Chunk>& chunks, 
             std::fill_n(t.hits + size_t(y) * size_t(t.width) + size_t(r.x0), w, 0u);
         local = t;
     } else {
-        // Padded for the span's last lane group, and to whole simd::kLanes for the clear.
+        // Padded for a span's or box row's last lane group, and to whole simd::kLanes for the
+        // clear.
         const size_t padded =
             (w * h + size_t(kSpanLanes - 1) + simd::kLanes - 1) / simd::kLanes * simd::kLanes;
         if (scratch.depth.size() < padded) {
