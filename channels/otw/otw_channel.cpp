@@ -14,6 +14,7 @@
 #include "channels/occlusion/occlusion.h"
 #include "channels/otw/celestial.h"
 #include "channels/otw/cloud_layer.h"
+#include "channels/otw/entry_splat.h"
 #include "channels/otw/lightning_overlay.h"
 #include "channels/otw/quad_pixels.h"
 #include "channels/otw/sea_glint.h"
@@ -302,8 +303,8 @@ struct SeaShading {
 // edges between sky, sea and models, the sun's disc, depth jumps between waves — every
 // sample is shaded as before, and shadow edges keep per-sample sun visibility (the pixel
 // gets the lit fraction of its samples, which is exact because the sea's radiance is linear
-// in sun visibility).
-constexpr uint32_t kPixelEntry = 1u << 30;
+// in sun visibility). The tag kPixelEntry and the writing of entries' radiance to their
+// samples (SplatChunk): channels/otw/entry_splat.h.
 
 // Tag of shadow-ray owners that are sea entries (indices into the sea arrays).
 constexpr uint32_t kSeaOwner = 1u << 31;
@@ -1085,56 +1086,6 @@ uint64_t TraceSunVisibility(const FrameShading& f, int n, BlockScratch& sc) {
     return sc.origins.size();
 }
 
-// Writes radiance rgb to the sample(s) of entry k; out is the block's first sample row (the
-// default 2×2's pixel entries: SplatChunk).
-void Splat(float* out, uint32_t k, int sampleWidth, int n, float r, float g, float b) {
-    if (!(k & kPixelEntry)) {
-        float* o = out + 3 * size_t(k);
-        o[0] = r, o[1] = g, o[2] = b;
-        return;
-    }
-    k &= ~kPixelEntry;
-    for (int j = 0; j < n; ++j) {
-        float* o = out + 3 * (size_t(k) + size_t(j) * size_t(sampleWidth));
-        for (int i = 0; i < n; ++i) o[3 * i] = r, o[3 * i + 1] = g, o[3 * i + 2] = b;
-    }
-}
-
-// Splat of count entries keys[i] with radiance (r[i], g[i], b[i]): the chunk's arrays (kChunk
-// floats, 16-byte aligned) transposed four entries at a time to (r, g, b, 0) registers, written
-// from them (the same values as Splat writes).
-void SplatChunk(float* out, const uint32_t* keys, size_t count, const float* r, const float* g,
-                const float* b, int sampleWidth, int n) {
-    if (n != 2) {
-        for (size_t i = 0; i < count; ++i) Splat(out, keys[i], sampleWidth, n, r[i], g[i], b[i]);
-        return;
-    }
-    for (size_t i = 0; i < count; i += 4) {
-        F4 rgb[4] = {_mm_load_ps(r + i), _mm_load_ps(g + i), _mm_load_ps(b + i), _mm_setzero_ps()};
-        _MM_TRANSPOSE4_PS(rgb[0], rgb[1], rgb[2], rgb[3]);
-        const size_t lanes = std::min<size_t>(4, count - i);
-        for (size_t l = 0; l < lanes; ++l) {
-            uint32_t k = keys[i + l];
-            const F4 v = rgb[l];
-            if (!(k & kPixelEntry)) {
-                float* o = out + 3 * size_t(k);
-                _mm_storel_pi(reinterpret_cast<__m64*>(o), v);
-                _mm_store_ss(o + 2, _mm_movehl_ps(v, v));
-                continue;
-            }
-            // Each sample row's six floats (r g b r g b) in two stores.
-            k &= ~kPixelEntry;
-            const F4 rgbr = _mm_shuffle_ps(v, v, _MM_SHUFFLE(0, 2, 1, 0));
-            const F4 gb = _mm_shuffle_ps(v, v, _MM_SHUFFLE(3, 3, 2, 1));
-            for (int j = 0; j < 2; ++j) {
-                float* o = out + 3 * (size_t(k) + size_t(j) * size_t(sampleWidth));
-                _mm_storeu_ps(o, rgbr);
-                _mm_storel_pi(reinterpret_cast<__m64*>(o + 4), gb);
-            }
-        }
-    }
-}
-
 // Sky radiance of the block's sky entries, with the sun's disc.
 void ShadeSky(const FrameShading& f, const FrameGeometry& g, BlockScratch& sc, float* out) {
     for (size_t c = 0; c < sc.skyCount; c += kChunk) {
@@ -1204,7 +1155,7 @@ void ShadeModels(const FrameShading& f, const FrameGeometry& g, const BlockScrat
         const float t = std::exp(-f.beta * range);
         const glm::vec3 horizon = f.sky.HorizonLookUp(-v);
         L = L * t + horizon * (1.0f - t);
-        Splat(out, sc.modelK[i], g.sampleWidth, g.n, L.r, L.g, L.b);
+        SplatEntry(out, sc.modelK[i], g.sampleWidth, g.n, L.r, L.g, L.b);
     }
 }
 
