@@ -111,6 +111,14 @@ float InfraredSource(const BandTrace& t, const PlumeLighting& light);
 // blends simd::kLanes pixels at a time (the bits of the one-pixel forms: tested).
 void BlendedInfraredSources(const BandTrace* const t[4], const float* fx, const float* fy, int n,
                             const PlumeLighting& light, float* tau, float* S);
+// A pixel's 2 × 2 RGB samples composited through a plume of transmittance T and source S (RGB):
+// L_bg·T + (1 − T)·S per value, each sample row's six values (R G B R G B) at once (SSE2); o is
+// the pixel's first sample, sampleRow the floats from one sample row to the next.
+void CompositeRgb2x2(float* o, size_t sampleRow, float T, const float* S);
+// CompositeRgb2x2(o + 6 l, sampleRow, T[l], S + 3 l) for the pixels l = 0 … 3 of a row with
+// tau[l] > 0 and drop[l] == 0, all four at once where the build has AVX2 (the same bits: tested).
+void CompositeRgb2x2Row4(float* o, size_t sampleRow, const float* T, const float* S,
+                         const float* tau, const int32_t* drop);
 }  // namespace plume_detail
 
 struct PlumeCompositeStats {

@@ -10,7 +10,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <numbers>
+#include <random>
 #include <span>
 #include <thread>
 #include <utility>
@@ -724,6 +726,74 @@ TEST(PlumeComposite, SameImageAfterAnotherFrameOnTheSameThread) {
     EXPECT_EQ(std::memcmp(fresh.pixels.data(), after.pixels.data(), fresh.pixels.size() * 4), 0);
 }
 
+// Pass 2 reads the depths of a row of cells only where it uses them, not for the cells blended
+// from a smooth coarse cell's corners. A mast (a surface 450 m away, inside a haze centred at
+// 500 m) fills a band of columns between sky cells of a smooth haze in the same rows of cells:
+// its pixels must take the trace to their own surface (within the interpolation tolerance of the
+// exact line integral), not the sky's or one from depths left in the scratch by an earlier frame
+// whose every sample saw a surface 5 km away.
+TEST(PlumeComposite, CellsBesideSmoothCoarseCellsReadTheirOwnDepths) {
+    const glm::dvec3 eye{0.0, 0.0, 10.0};
+    const ChannelCamera cam = NorthCamera(eye, 160, 96, 2);
+    std::vector<scene::Puff> haze;
+    for (int i = -3; i <= 3; ++i)
+        for (int j = -2; j <= 2; ++j) {
+            scene::Puff p;
+            p.centre_m = {150.0 * i, 500.0, 10.0 + 120.0 * j};
+            p.sigmaH_m = 150.0;
+            p.sigmaZ_m = 120.0;
+            p.mass_kg = 2.0;
+            haze.push_back(p);
+        }
+    const scene::PlumeField field = OnePlume(scene::PlumeKind::Smoke, 0.3, haze);
+    const double alpha = scene::KindOptics(scene::PlumeKind::Smoke, 0.3).massExtinction_m2pkg[0];
+    // Samples seeing a surface at range_m along their own rays (depth = near / (range · d_y)).
+    const auto surface = [&](VisibilityBuffer& vis, int sx0, int sx1, double range_m) {
+        for (int y = 0; y < cam.SampleHeight(); ++y)
+            for (int x = sx0; x < sx1; ++x) {
+                const glm::dvec3 d = cam.SampleDirection(x, y);
+                vis.primitive[vis.Index(x, y)] = 0;
+                vis.depth[vis.Index(x, y)] = float(cam.near_m / (range_m * d.y));
+            }
+    };
+    VisibilityBuffer far = SkyOnly(cam);
+    surface(far, 0, cam.SampleWidth(), 5000.0);
+    // The mast: pixel columns [64, 96), whole cells.
+    constexpr int kMastX0 = 64, kMastX1 = 96;
+    constexpr double kMast_m = 450.0;
+    VisibilityBuffer vis = SkyOnly(cam);
+    surface(vis, 2 * kMastX0, 2 * kMastX1, kMast_m);
+    Image radiance(cam.SampleWidth(), cam.SampleHeight(), 3);
+    PlumeCompositeStats stats;
+    std::thread([&] {
+        tbb::task_arena arena(1);  // one thread: the scratch of the earlier frame is this one's
+        arena.execute([&] {
+            Image earlier(cam.SampleWidth(), cam.SampleHeight(), 3);
+            CompositePlumes(field, cam, far, Dark(), earlier);
+            std::fill(radiance.pixels.begin(), radiance.pixels.end(), 1.0f);
+            stats = CompositePlumes(field, cam, vis, Dark(), radiance);
+        });
+    }).join();
+    EXPECT_GT(stats.coarseSkyCells, 100u);
+    const auto exact = [&](int x, int y, double range_m) {
+        const double a = (2.0 * (x + 0.5) / cam.width - 1.0) * cam.TanHalfH();
+        const double b = (1.0 - 2.0 * (y + 0.5) / cam.height) * cam.TanHalfV();
+        const glm::dvec3 d = glm::normalize(glm::dvec3(a, 1.0, b));
+        double column = 0.0;
+        for (const scene::Puff& p : haze)
+            column += scene::GaussianPuffLineIntegral_kgpm2(p.centre_m, p.sigmaH_m, p.sigmaZ_m,
+                                                            p.mass_kg, eye, d, range_m);
+        return std::exp(-alpha * column);
+    };
+    for (int y = 1; y < cam.height; y += 5)
+        for (int x = kMastX0; x < kMastX1; x += 3) {
+            const double T = exact(x, y, kMast_m);
+            // The sky's trace (or one to 5 km) would err by more than the tolerance.
+            ASSERT_GT(T - exact(x, y, kPlumeSkyRange_m), 0.05) << x << ", " << y;
+            EXPECT_NEAR(radiance.At(2 * x, 2 * y)[0], T, 0.02) << "pixel " << x << ", " << y;
+        }
+}
+
 // Pixels whose trace comes from the interpolation grid stay within 0.02 in transmittance (the
 // grid's optical-depth tolerance) of the exact sum over the puffs along the pixel's own ray.
 TEST(PlumeComposite, InterpolatedPixelsMatchTheirOwnTraces) {
@@ -985,6 +1055,46 @@ TEST(PlumeComposite, BlendedInfraredSourcesMatchTheOnePixelForms) {
     }
     EXPECT_GT(compared, 3000);
     EXPECT_GT(positive, 2000);
+}
+
+// A row of four pixels' 2 × 2 RGB samples composited at once equals CompositeRgb2x2 pixel by
+// pixel bit for bit: random backgrounds (signed zeros, negatives), transmittances (0 and 1
+// included) and sources, with pixels left alone where τ is not positive (−0, NaN, negative) or
+// dropped, and nothing written beyond the row's 24 values of each sample row.
+TEST(PlumeComposite, RowOfFourPixelsCompositedAtOnceEqualsPixelByPixel) {
+    std::mt19937 rng(20261128);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f), wide(-50.0f, 500.0f);
+    constexpr size_t kRow = 31;  // floats from one sample row to the next
+    int changed = 0;
+    for (int trial = 0; trial < 3000; ++trial) {
+        std::vector<float> before(2 * kRow + 8);
+        for (float& v : before) {
+            const float u = unit(rng);
+            v = u < 0.05f ? 0.0f : u < 0.1f ? -0.0f : wide(rng);
+        }
+        float T[4], S[12], tau[4];
+        int32_t drop[4];
+        for (int l = 0; l < 4; ++l) {
+            const float u = unit(rng);
+            T[l] = u < 0.1f ? 0.0f : u < 0.2f ? 1.0f : unit(rng);
+            const float w = unit(rng);
+            tau[l] = w < 0.1f   ? -0.0f
+                     : w < 0.2f ? std::numeric_limits<float>::quiet_NaN()
+                     : w < 0.3f ? -1.0f
+                                : unit(rng) * 3.0f;
+            drop[l] = unit(rng) < 0.2f ? -1 : 0;
+        }
+        for (float& v : S) v = wide(rng);
+        std::vector<float> once = before, each = before;
+        plume_detail::CompositeRgb2x2Row4(once.data() + 1, kRow, T, S, tau, drop);
+        for (int l = 0; l < 4; ++l)
+            if (tau[l] > 0.0f && !drop[l])
+                plume_detail::CompositeRgb2x2(each.data() + 1 + 6 * l, kRow, T[l], S + 3 * l);
+        ASSERT_EQ(std::memcmp(once.data(), each.data(), once.size() * sizeof(float)), 0)
+            << "trial " << trial;
+        changed += std::memcmp(once.data(), before.data(), once.size() * sizeof(float)) != 0;
+    }
+    EXPECT_GT(changed, 2000);
 }
 
 // Luminance of a blackbody at the platinum freezing point, 2042 K: 60 cd/cm² (the candela's
