@@ -18,6 +18,7 @@
 #include <limits>
 #include <sstream>
 
+#include "channels/raster/depth_test.h"
 #include "scene/core/check.h"
 #include "scene/core/error.h"
 #include "scene/core/simd4.h"
@@ -437,6 +438,7 @@ template <bool kCount, bool kClipped>
     // samples failing the depth test, store back the values they loaded (the tile's targets
     // are this thread's and padded past their last sample).
     const I4 primV = I4{} + int32_t(prim);
+    const I4 primKey = raster_detail::DepthTestKey(primV);
     const auto quad = [&](size_t i, D4 f1, D4 f2, I4 out) __attribute__((always_inline)) {
         const D4 d = k0 + f1 * dc1 + f2 * dc2;
         const F4 depth = __builtin_convertvector(d, F4);
@@ -444,8 +446,9 @@ template <bool kCount, bool kClipped>
         I4 oldPrim;
         std::memcpy(&old, t.depth + i, sizeof old);
         std::memcpy(&oldPrim, t.primitive + i, sizeof oldPrim);
-        const I4 wins =
-            ~out & (depth > 0.0f) & ((depth > old) | ((depth == old) & (U4(primV) < U4(oldPrim))));
+        // Every tile target sample is empty or holds depth > 0 and a primitive id below
+        // kNoPrimitive (the test lets no depth <= 0 in), as DepthTestWins requires.
+        const I4 wins = ~out & raster_detail::DepthTestWins(depth, primKey, old, oldPrim);
         if (!_mm_movemask_ps(F4(wins))) return;
         const D4 inv = 1.0 / d;
         F4 nb1, nb2;

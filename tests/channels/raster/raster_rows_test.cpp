@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "channels/raster/depth_test.h"
 #include "channels/raster/rasterizer.h"
 #include "scene/core/rng.h"
 
@@ -298,6 +299,58 @@ TEST(RasterRows, EdgesAtTheLanesBoundEqualThePerSampleFormBitForBit) {
     int drawn = 0;
     for (int n : shown) drawn += n;
     EXPECT_GT(drawn, 5000);
+}
+
+// The lanes' depth test without its depth > 0 term against the straightforward one, on every
+// pairing of new depths (negative, ±0, subnormal, NaN, ties) and ids (0, around 2^31, the last
+// id below kNoPrimitive) with targets that are empty or hold depth > 0 and an id below
+// kNoPrimitive: the only targets the rasterizer's tiles hold.
+TEST(RasterRows, DepthTestWithoutItsPositiveTermEqualsTheStraightforwardOne) {
+    using raster_detail::DepthLanes;
+    using raster_detail::IdLanes;
+    const float inf = std::numeric_limits<float>::infinity();
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const float tiny = std::numeric_limits<float>::denorm_min();
+    const float depths[] = {-inf, -1.0f, -tiny, -0.0f, 0.0f, tiny, 1e-30f, 0.25f, 0.5f, 1.0f, nan};
+    const uint32_t ids[] = {0u,          1u,          2u,          0x7ffffffeu, 0x7fffffffu,
+                            0x80000000u, 0x80000001u, 0xfffffffdu, 0xfffffffeu};
+    // Targets: empty, or a positive depth with an id.
+    std::vector<std::pair<float, uint32_t>> targets = {{0.0f, kNoPrimitive}};
+    for (float d : depths)
+        if (d > 0.0f)
+            for (uint32_t id : ids) targets.push_back({d, id});
+    int checked = 0, won = 0, tiesWon = 0;
+    for (float depth : depths) {
+        for (uint32_t id : ids) {
+            for (size_t k = 0; k < targets.size(); k += 4) {
+                // Four targets on the lanes (the last group repeats its first where short).
+                DepthLanes old, newDepth;
+                IdLanes oldPrim, prim;
+                for (int l = 0; l < 4; ++l) {
+                    const auto& target = targets[k + l < targets.size() ? k + l : k];
+                    old[l] = target.first;
+                    oldPrim[l] = int32_t(target.second);
+                    newDepth[l] = depth;
+                    prim[l] = int32_t(id);
+                }
+                const IdLanes wins = raster_detail::DepthTestWins(
+                    newDepth, raster_detail::DepthTestKey(prim), old, oldPrim);
+                for (int l = 0; l < 4; ++l) {
+                    const float o = old[l];
+                    const uint32_t op = uint32_t(oldPrim[l]);
+                    const bool expected = depth > 0.0f && (depth > o || (depth == o && id < op));
+                    EXPECT_EQ(wins[l], expected ? -1 : 0)
+                        << "depth " << depth << " id " << id << " old " << o << " id " << op;
+                    ++checked;
+                    won += expected;
+                    tiesWon += expected && depth == o;
+                }
+            }
+        }
+    }
+    EXPECT_GT(checked, 3000);
+    EXPECT_GT(won, 300);
+    EXPECT_GT(tiesWon, 100);
 }
 
 }  // namespace
