@@ -443,6 +443,9 @@ void FlirChannel::ShadeSea(const FrameShading& f, ShadeBlock& sc, size_t count, 
     const SurfInfrared surf = f.surf;
     const VF airB = simd::Splat(f.airB), seaB = simd::Splat(f.seaB);
     const UniformTable::Lanes emissivity(seaEmissivity_), sky(skyTable_), path(pathTau_);
+    // Deep records alone (SeaGather, kSurfDeepColumn_m; sums false): their surf radiance is the
+    // water term's bits.
+    const bool sums = sc.sea.sums;
     for (size_t i = 0; i < count; i += simd::kLanes) {
         VF nx = Lanes(kSeaNx, i), ny = Lanes(kSeaNy, i), nz = Lanes(kSeaNz, i);
         const VF px = Lanes(kSeaPx, i), py = Lanes(kSeaPy, i), pz = Lanes(kSeaPz, i);
@@ -456,10 +459,12 @@ void FlirChannel::ShadeSea(const FrameShading& f, ShadeBlock& sc, size_t count, 
         const VF epsWater = emissivity(simd::Max(ndv, VF{}));  // at cos θ_view
         const VF skyR = sky(Abs(rz));                          // at the reflected cos θ_zenith
         const VF tau = path(simd::Sqrt(range));
-        const VF L = SurfInfraredRadiance(surf, epsWater, seaB, skyR, Lanes(kSeaDepth, i),
-                                          Lanes(kSeaWet, i), Lanes(kSeaFoam, i));
+        const VF L = sums ? SurfInfraredRadiance(surf, epsWater, seaB, skyR, Lanes(kSeaDepth, i),
+                                                 Lanes(kSeaWet, i), Lanes(kSeaFoam, i))
+                          : SurfWaterRadiance(epsWater, seaB, skyR);
         simd::Store(sc.b + i, tau * L + (1.0f - tau) * airB);
     }
+    sc.sea.sums = false;
     const float* L = sc.b;
     for (size_t r = 0; r < sc.seaRuns; L += sc.seaRunLength[r], ++r)
         std::copy_n(L, sc.seaRunLength[r], out + sc.seaRunK[r]);

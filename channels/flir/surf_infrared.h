@@ -36,11 +36,17 @@ struct SurfInfrared {
 // sand (film 1) and foam (c = 0) the result is the water term bit for bit.
 // V: a GCC float vector type (simd::VF of the shading loops, or simd4::F4), the same operations
 // per lane at any width.
+// The water term of SurfInfraredRadiance (below).
+template <class V>
+inline V SurfWaterRadiance(V epsWater, V seaB, V skyR) {
+    const V one = V{} + 1.0f;
+    return epsWater * seaB + (one - epsWater) * skyR;
+}
 template <class V>
 inline V SurfInfraredRadiance(const SurfInfrared& s, V epsWater, V seaB, V skyR, V depth, V wet,
                               V foam) {
     const V one = V{} + 1.0f;
-    const V water = epsWater * seaB + (one - epsWater) * skyR;
+    const V water = SurfWaterRadiance(epsWater, seaB, skyR);
     const V epsF = V{} + s.foamEmissivity;
     const V white = epsF * s.foamB + (one - epsF) * skyR;
     const V sand = s.sandDry + (s.sandWet - s.sandDry) * wet;
@@ -55,6 +61,8 @@ inline V SurfInfraredRadiance(const SurfInfrared& s, V epsWater, V seaB, V skyR,
 // sample's own column is then ≥ 2·kSwashFilm_m·(1 − 2^-22), so film = 1 and (sand − water)·0
 // adds ±0 for the finite wet sum, and its foam sum is ±0, adding ±0 again: SurfInfraredRadiance
 // is the water term for both, the same bits (water, a sum of non-negative products, is not −0).
+// So a lane group of deep records alone is SurfWaterRadiance's, which ShadeSea takes for a chunk
+// of them (SeaSamples::sums false).
 inline constexpr float kSurfDeepColumn_m = 2.0f * kSwashFilm_m;
 
 inline simd4::F4 SurfInfraredRadiance4(const SurfInfrared& s, simd4::F4 epsWater, simd4::F4 seaB,

@@ -98,6 +98,10 @@ enum SeaComponent {
 template <size_t kCapacity>
 struct SeaSamples {
     alignas(32) float c[kSeaComponents][kCapacity + simd::kLanes];
+    // Whether some record holds attribute sums rather than SeaGather's deep records: set by
+    // Gather, cleared by the consumer when it starts over, so that a chunk of deep records alone
+    // can skip what they make redundant.
+    bool sums = false;
 };
 
 // Sea-mesh samples of visibility-buffer rows gathered into SeaSamples: per sample each
@@ -193,6 +197,7 @@ class SeaGather {
                 simd::Store(out.c[kSeaWet] + r, VF{});
                 simd::Store(out.c[kSeaFoam] + r, VF{});
             } else {
+                out.sums = true;
                 // Zeros for a sea without attributes.
                 const float *a0 = kNone, *a1 = kNone, *a2 = kNone;
                 if (attributes) {

@@ -242,7 +242,8 @@ TEST(FlirSurf, DeepWaterRecordsShadeAsTheSumsTheyReplace) {
     // film (and at it, +∞, NaN), with foam mostly ±0 (else 1e-30, 0.3 or NaN) and wet values in
     // [0, 1], NaN, 1e5 or −∞; barycentrics mostly inside the triangle, sometimes −0, NaN, +∞,
     // slightly negative or far outside. Gathered with the FLIR's deep column and without deep
-    // records, the two radiances of every sample must be the same bits.
+    // records, the two radiances of every sample must be the same bits, and a deep record's must
+    // be the water term's.
     std::mt19937 rng(41);
     std::uniform_real_distribution<float> unit(0.0f, 1.0f);
     const float inf = std::numeric_limits<float>::infinity();
@@ -310,6 +311,13 @@ TEST(FlirSurf, DeepWaterRecordsShadeAsTheSumsTheyReplace) {
         };
         const float la = L(a), lb = L(b);
         replaced += std::memcmp(&a.c[kSeaDepth][r], &b.c[kSeaDepth][r], sizeof(float)) != 0;
+        // ShadeSea takes a chunk of deep records alone as the water term: the same bits.
+        if (a.c[kSeaDepth][r] == kMaxVertexAttribute && a.c[kSeaWet][r] == 0.0f &&
+            a.c[kSeaFoam][r] == 0.0f) {
+            const float water = SurfWaterRadiance(eps, seaB, skyR);
+            EXPECT_EQ(std::memcmp(&la, &water, sizeof la), 0)
+                << "sample " << r << ": " << la << " against the water term's " << water;
+        }
         EXPECT_TRUE(std::memcmp(&la, &lb, sizeof la) == 0 || (std::isnan(la) && std::isnan(lb)))
             << "sample " << r << ": " << la << " against the sums' " << lb << " (column "
             << b.c[kSeaDepth][r] << ", wet " << b.c[kSeaWet][r] << ", foam " << b.c[kSeaFoam][r]

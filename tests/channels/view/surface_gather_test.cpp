@@ -271,5 +271,42 @@ TEST(SeaGather, DeepRecordsOnlyWhereTheTriangleIsDeepAndTheWeightsAreNonNegative
     EXPECT_GT(summed, 1000u);
 }
 
+TEST(SeaGather, SumsFlagIsClearOnlyWhereEveryRecordIsTheDeepRecord) {
+    // Chunks of 8 records over DeepSea's row, the flag cleared after each as ShadeSea does: a
+    // chunk whose flag stays clear must hold the deep record (kMaxVertexAttribute, +0, +0) in
+    // every record, since its consumer then reads none of them; both kinds of chunk occur.
+    constexpr int kWidth = 6000;
+    const DeepSea sea(kWidth);
+    const MeshArrays mesh = sea.Mesh();
+    constexpr size_t kCapacity = 8;
+    SeaSamples<kCapacity> out;
+    SeaGather gather(mesh, DeepSea::kBase, DeepSea::kTriangles, DeepSea::kDeep);
+    size_t records = 0, deepChunks = 0, summedChunks = 0;
+    const auto Check = [&] {
+        if (out.sums) {
+            ++summedChunks;
+        } else {
+            ++deepChunks;
+            for (size_t r = 0; r < records; ++r)
+                EXPECT_TRUE(Same(out.c[kSeaDepth][r], kMaxVertexAttribute) &&
+                            Same(out.c[kSeaWet][r], 0.0f) && Same(out.c[kSeaFoam][r], 0.0f))
+                    << "chunk " << deepChunks + summedChunks << " record " << r;
+        }
+        out.sums = false;
+        records = 0;
+    };
+    for (int x = 0; x < kWidth;) {
+        if (!gather.IsSea(sea.prims[size_t(x)])) {
+            ++x;
+            continue;
+        }
+        x = gather.Gather(sea.prims.data(), sea.b1.data(), sea.b2.data(), x, kWidth, out, records);
+        if (records == kCapacity) Check();
+    }
+    if (records > 0) Check();
+    EXPECT_GT(deepChunks, 20u) << summedChunks;
+    EXPECT_GT(summedChunks, 20u) << deepChunks;
+}
+
 }  // namespace
 }  // namespace seasense::channels
