@@ -22,6 +22,13 @@ struct SurfInfrared {
     float sandDry = 0.0f, sandWet = 0.0f;
 };
 
+// The water term of SurfInfraredRadiance (below), per lane of a GCC float vector type V.
+template <class V>
+inline V SurfWaterRadiance(V epsWater, V seaB, V skyR) {
+    const V one = V{} + 1.0f;
+    return epsWater * seaB + (one - epsWater) * skyR;
+}
+
 // Surface-leaving band radiance of a sea-mesh sample:
 //   water   = ε_w B(T_sea) + (1 − ε_w) L_sky,r      (ε_w at the view angle, L_sky,r the sky about
 //                                                   the resolved normal)
@@ -36,12 +43,6 @@ struct SurfInfrared {
 // sand (film 1) and foam (c = 0) the result is the water term bit for bit.
 // V: a GCC float vector type (simd::VF of the shading loops, or simd4::F4), the same operations
 // per lane at any width.
-// The water term of SurfInfraredRadiance (below).
-template <class V>
-inline V SurfWaterRadiance(V epsWater, V seaB, V skyR) {
-    const V one = V{} + 1.0f;
-    return epsWater * seaB + (one - epsWater) * skyR;
-}
 template <class V>
 inline V SurfInfraredRadiance(const SurfInfrared& s, V epsWater, V seaB, V skyR, V depth, V wet,
                               V foam) {
