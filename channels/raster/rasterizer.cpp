@@ -863,9 +863,7 @@ void TransformVertex(const ClipRows& rows, const Context& ctx, const glm::vec3& 
 
 namespace {
 
-using F4 = float __attribute__((vector_size(16)));
-using I4 = int32_t __attribute__((vector_size(16)));
-using D4 = double __attribute__((vector_size(32)));
+// (F4, I4 and D4: the lane types of the raster loops above.)
 using L4 = int64_t __attribute__((vector_size(32)));
 
 // Lanes where v is finite: v − v is 0 exactly then, NaN for ±inf and NaN.
