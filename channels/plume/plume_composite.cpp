@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "channels/flir/flir_channel.h"
+#include "channels/plume/cell_flags.h"
 #include "channels/plume/plume_bins.h"
 #include "radiometry/atmosphere/atmosphere.h"
 #include "radiometry/bands/builtin_bands.h"
@@ -441,6 +442,7 @@ struct FrameBuffers {
     std::vector<BandTrace> surfaceNodes;
     std::vector<float> surfaceNodeRange, surfaceNodeT;
     std::vector<uint8_t> coarse, nodeDone;
+    plume_detail::CellFlags usedCells, readCells;
     std::vector<PlumeScreenBins::List> blocks;
     std::vector<PlumeScreenBins::RowSource> bandSources;
     bool busy = false;
@@ -940,11 +942,16 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     // pixels apart), then the coarse cells (2 × 2 cells) tested as cells are, then the other
     // nodes that a cell outside the smooth coarse cells reads.
     std::vector<uint64_t> nodeRowTraces(size_t(nodesY), 0), nodeRowTests(size_t(nodesY), 0);
-    const auto Used = [&](int cx, int cy) {
-        if (cx < 0 || cy < 0 || cx >= cellsX || cy >= cellsY) return false;
+    // Whether cell (cx, cy) has puffs and is not skipped (false beyond the grid's edges): made
+    // once per cell here, since the nodes ask it of their four cells.
+    plume_detail::CellFlags& usedCells = lease.buffers->usedCells;
+    usedCells.Reset(cellsX, cellsY);
+    for (int cy = 0; cy < cellsY; ++cy) {
         const CellRow& row = cellRows[size_t(cy)];
-        return row.lists.count[size_t(cx)] != 0 && !row.inFront[size_t(cx)];
-    };
+        for (int cx = 0; cx < cellsX; ++cx)
+            usedCells.Set(cx, cy, row.lists.count[size_t(cx)] != 0 && !row.inFront[size_t(cx)]);
+    }
+    const auto Used = [&](int cx, int cy) { return usedCells(cx, cy); };
     // The coarse cells: (sx, sy) holds cells 2sx, 2sx + 1 × 2sy, 2sy + 1 (whole ones only), its
     // corners the nodes (2sx, 2sy) … (2sx + 2, 2sy + 2).
     const int coarseX = cellsX / 2, coarseY = cellsY / 2;
@@ -957,7 +964,9 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
         return sx < coarseX && sy < coarseY &&
                coarse[size_t(sy) * size_t(coarseX) + size_t(sx)] != kCoarseNone;
     };
-    const auto Reads = [&](int cx, int cy) { return Used(cx, cy) && !InSmoothCoarse(cx, cy); };
+    // Used(cx, cy) && !InSmoothCoarse(cx, cy), made once per cell after the coarse cells.
+    plume_detail::CellFlags& readCells = lease.buffers->readCells;
+    const auto Reads = [&](int cx, int cy) { return readCells(cx, cy); };
     std::vector<uint8_t>& nodeDone = lease.buffers->nodeDone;
     nodeDone.assign(nodes.size(), 0);
     // Traces node (nx, ny) (and its pixel's surface trace) with list as scratch.
@@ -1008,27 +1017,29 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
         tests += list.size();
     };
     // The nodes of one phase: those with coarse (both indices even) equal to `even`, read by one
-    // of the cells around them (used: Used or Reads).
-    const auto TraceNodes = [&](bool even, const auto& used) {
+    // of the cells around them (reading: Used or Reads of every cell).
+    const auto TraceNodes = [&](bool even, const plume_detail::CellFlags& reading) {
         tbb::parallel_for(
             tbb::blocked_range<int>(0, nodesY, 1),
             [&](const tbb::blocked_range<int>& r) {
                 PlumeScreenBins::List& list = LocalScratch().list;
                 for (int ny = r.begin(); ny != r.end(); ++ny) {
+                    // The coarse grid's nodes are every other one of the even rows.
+                    if (even && ny % 2 != 0) continue;
                     // The row's counts, kept in registers (the rows' slots share cache lines).
                     uint64_t traces = 0, tests = 0;
                     const CellRow& row = cellRows[size_t(std::min(ny, cellsY - 1))];
-                    for (int nx = 0; nx < nodesX; ++nx) {
-                        if ((nx % 2 == 0 && ny % 2 == 0) != even) continue;
+                    for (int nx = 0; nx < nodesX; nx += even ? 2 : 1) {
+                        if (!even && nx % 2 == 0 && ny % 2 == 0) continue;
+                        // A node that no cell reads is left as it is (its values are never
+                        // looked at).
+                        if (!reading.AroundNode(nx, ny)) continue;
                         const size_t n = size_t(ny) * size_t(nodesX) + size_t(nx);
                         if (nodeDone[n]) continue;
                         // No puff reaches the node's cell, so none reaches the node: a clear
                         // sky (the buffers are reused from frame to frame, so this is written).
                         if (row.lists.count[size_t(std::min(nx, cellsX - 1))] == 0)
                             nodes[n] = BandTrace{}, nodeT[n] = 1.0f;
-                        if (!used(nx - 1, ny - 1) && !used(nx, ny - 1) && !used(nx - 1, ny) &&
-                            !used(nx, ny))
-                            continue;
                         TraceNode(nx, ny, list, traces, tests);
                     }
                     nodeRowTraces[size_t(ny)] += traces, nodeRowTests[size_t(ny)] += tests;
@@ -1037,7 +1048,7 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             tbb::simple_partitioner());
     };
     std::fill(surfaceNodeRange.begin(), surfaceNodeRange.end(), -1.0f);
-    TraceNodes(true, Used);
+    TraceNodes(true, usedCells);
     // The coarse cells whose four cells all see only the sky through puffs that can matter
     // there, with no puff smaller than a coarse cell adding more than kInterpolationTolerance
     // (the sum of the cells' sums, an upper bound), and whose corners are Smooth or match the
@@ -1085,7 +1096,11 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
             }
         },
         tbb::simple_partitioner());
-    TraceNodes(false, Reads);
+    readCells.Reset(cellsX, cellsY);
+    for (int cy = 0; cy < cellsY; ++cy)
+        for (int cx = 0; cx < cellsX; ++cx)
+            readCells.Set(cx, cy, Used(cx, cy) && !InSmoothCoarse(cx, cy));
+    TraceNodes(false, readCells);
 
     // Pass 2, cells in parallel (a row of cells each); each pixel depends only on its own rays
     // and the cell's corner nodes. The rows' costs differ by orders of magnitude, so they are
