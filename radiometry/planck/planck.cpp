@@ -2,6 +2,8 @@
 // the cubic Hermite lookup table.
 #include "radiometry/planck/planck.h"
 
+#include <immintrin.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -268,18 +270,66 @@ double BandRadianceTable::Radiance(double T_K) const {
 
 void BandRadianceTable::Radiances(size_t n, const double* T_K, double* out) const {
     // Radiance's steps for each value, split at the exponential, the first loop without a
-    // branch (the compiler's vector code): u = (T − min) / step and the cell i = min(⌊u⌋, last)
-    // as Radiance makes them where T lies in the range (u ≥ 0 there, so the signed conversion
-    // is the unsigned one), u = 0 elsewhere (its polynomial then dropped).
+    // branch: u = (T − min) / step and the cell i = min(⌊u⌋, last) as Radiance makes them where
+    // T lies in the range (u ≥ 0 there, so the signed conversion is the unsigned one), u = 0
+    // elsewhere (its polynomial then dropped).
     const double lo = minT_K_, hi = maxT_K_, step = step_K_;
     const auto last = int64_t(cells_.size()) - 1;
-    for (size_t k = 0; k < n; ++k) {
+    size_t k = 0;
+    bool allIn = true;  // every value in the range (the usual case): the exponentials alone
+#if defined(__AVX2__)
+    // Four values at a time (GCC leaves the loop below scalar): the same double operations per
+    // value. u ≤ (hi − lo)/step ≈ the cell count, so ⌊u⌋ fits the 32-bit conversion; each
+    // value's cell (lnL, m0, c2, c3) is one 32-byte load, transposed into one vector per
+    // coefficient.
+    if (last <= INT32_MAX / 2) {
+        const __m256d vlo = _mm256_set1_pd(lo), vhi = _mm256_set1_pd(hi);
+        const __m256d vstep = _mm256_set1_pd(step);
+        const __m128i vlast = _mm_set1_epi32(int32_t(last));
+        const double* const cells = &cells_.data()->lnL;
+        for (; k + 4 <= n; k += 4) {
+            const __m256d T = _mm256_loadu_pd(T_K + k);
+            // T − lo where lo ≤ T ≤ hi, else +0 (the mask's and), as the branch-free form below.
+            const __m256d in =
+                _mm256_and_pd(_mm256_cmp_pd(T, vlo, _CMP_GE_OQ), _mm256_cmp_pd(T, vhi, _CMP_LE_OQ));
+            allIn &= _mm256_movemask_pd(in) == 0xf;
+            const __m256d u = _mm256_div_pd(_mm256_and_pd(in, _mm256_sub_pd(T, vlo)), vstep);
+            const __m128i i = _mm_min_epi32(_mm256_cvttpd_epi32(u), vlast);
+            const __m256d t = _mm256_sub_pd(u, _mm256_cvtepi32_pd(i));
+            static_assert(sizeof(Cell) == 4 * sizeof(double));
+            const auto Row = [&](int cell) {
+                return _mm256_loadu_pd(cells + 4 * size_t(uint32_t(cell)));
+            };
+            const __m256d a0 = Row(_mm_cvtsi128_si32(i)), a1 = Row(_mm_extract_epi32(i, 1));
+            const __m256d a2 = Row(_mm_extract_epi32(i, 2)), a3 = Row(_mm_extract_epi32(i, 3));
+            const __m256d lo01 = _mm256_unpacklo_pd(a0, a1), hi01 = _mm256_unpackhi_pd(a0, a1);
+            const __m256d lo23 = _mm256_unpacklo_pd(a2, a3), hi23 = _mm256_unpackhi_pd(a2, a3);
+            const __m256d lnL = _mm256_permute2f128_pd(lo01, lo23, 0x20);
+            const __m256d c2 = _mm256_permute2f128_pd(lo01, lo23, 0x31);
+            const __m256d m0 = _mm256_permute2f128_pd(hi01, hi23, 0x20);
+            const __m256d c3 = _mm256_permute2f128_pd(hi01, hi23, 0x31);
+            // Interpolate's lnL + t (m0 + t (c2 + t c3)).
+            const __m256d p = _mm256_add_pd(
+                lnL, _mm256_mul_pd(
+                         t, _mm256_add_pd(
+                                m0, _mm256_mul_pd(t, _mm256_add_pd(c2, _mm256_mul_pd(t, c3))))));
+            _mm256_storeu_pd(out + k, p);
+        }
+    }
+#endif
+    for (; k < n; ++k) {
         const double T = T_K[k];
-        const double u = (T >= lo && T <= hi ? T - lo : 0.0) / step;
+        const bool in = T >= lo && T <= hi;
+        allIn &= in;
+        const double u = (in ? T - lo : 0.0) / step;
         const int64_t i = std::min(int64_t(u), last);
         out[k] = Interpolate(size_t(i), u - double(i), nullptr);
     }
-    for (size_t k = 0; k < n; ++k) {
+    if (allIn) {
+        for (k = 0; k < n; ++k) out[k] = std::exp(out[k]);
+        return;
+    }
+    for (k = 0; k < n; ++k) {
         const double T = T_K[k];
         out[k] = T >= lo && T <= hi ? std::exp(out[k]) : BandRadiance(band_, T);
     }

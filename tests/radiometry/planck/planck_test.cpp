@@ -9,6 +9,7 @@
 #include <cstring>
 #include <functional>
 #include <limits>
+#include <random>
 #include <vector>
 
 #include "scene/core/error.h"
@@ -299,6 +300,30 @@ TEST(BandRadianceTable, RadiancesEqualRadianceBitForBit) {
                 << band.Name() << " " << T[k];
         }
     }
+}
+
+// Every count and every position within a group of four values (the batch is made four values
+// at a time where the build has AVX2, the rest one by one): each value in or out of the range,
+// at its ends, on a node, in the last cell and just past it, gets its own Radiance's bits.
+TEST(BandRadianceTable, RadiancesOfAnyCountAndLaneEqualRadiance) {
+    const BandRadianceTable table(Band::Lwir(), 200.0, 1200.0, 2.0);
+    const std::vector<double> pool = {200.0, 1200.0,      1199.999,  1198.0, 1199.0,    202.0,
+                                      201.0, 50.0,        199.9999,  1200.5, 3000.0,    733.25,
+                                      640.0, 1000.000001, 300.30303, 455.5,  1198.9999, 900.1};
+    std::mt19937 rng(3);
+    for (size_t n = 0; n <= 13; ++n)
+        for (int trial = 0; trial < 40; ++trial) {
+            std::vector<double> T(n);
+            for (double& t : T) t = pool[rng() % pool.size()];
+            std::vector<double> out(n + 1, -1.0);
+            table.Radiances(n, T.data(), out.data());
+            for (size_t k = 0; k < n; ++k) {
+                const double expected = table.Radiance(T[k]);
+                ASSERT_EQ(std::memcmp(&out[k], &expected, sizeof(double)), 0)
+                    << "n " << n << " k " << k << " T " << T[k];
+            }
+            EXPECT_EQ(out[n], -1.0) << "n " << n;  // nothing past the count
+        }
 }
 
 TEST(BandRadianceTable, InverseRoundTripsTo10mK) {
