@@ -333,6 +333,8 @@ struct FlirChannel::FrameShading {
     const VisibilityBuffer& vis;
     const OcclusionScene& occlusion;
     std::vector<MeshArrays> meshes;  // mesh 0 the sea
+    // SeaGather::DeepVertices' flags of the sea's vertices at kSurfDeepColumn_m.
+    const uint8_t* deepVertices = nullptr;
     int sampleWidth = 0, sampleHeight = 0;
     glm::vec3 eye{0.0f}, sunDir{0.0f};
     bool shadows = false;
@@ -370,6 +372,7 @@ struct FlirChannel::ShadeBlock {
 };
 struct FlirChannel::ShadeScratch {
     tbb::enumerable_thread_specific<ShadeBlock> perThread;
+    std::vector<uint8_t> deepVertices;  // FrameShading::deepVertices
 };
 
 namespace {
@@ -487,7 +490,7 @@ uint64_t FlirChannel::ShadeRows(const FrameShading& f, int y0, int y1, float* ou
     // kSurfDeepColumn_m, where ShadeSea's SurfInfraredRadiance needs no attribute sums.
     const std::vector<uint32_t>& bases = f.vis.primitiveBase;
     SeaGather sea(f.meshes[0], bases[0], (bases.size() > 1 ? bases[1] : kNoPrimitive) - bases[0],
-                  kSurfDeepColumn_m);
+                  kSurfDeepColumn_m, f.deepVertices);
     for (int y = y0; y < y1; ++y) {
         const double ndcY = 1.0 - 2.0 * (y + 0.5) / f.sampleHeight;
         const glm::vec3 rowBase(f.forward + f.up * ndcY - f.right);
@@ -627,6 +630,12 @@ void FlirChannel::Render(const scene::SceneState& state, Image& radiance) {
     frame.up = R * glm::dvec3(0.0, 0.0, tanV);
 
     if (!scratch_) scratch_ = std::make_unique<ShadeScratch>();
+    // The sea's deep vertices once for the frame, rather than each triangle's test in every
+    // row block and sample row that meets it.
+    scratch_->deepVertices.resize(ocean.positions.size());
+    SeaGather::DeepVertices(geometry_.OceanAttributes().data(), ocean.positions.size(),
+                            kSurfDeepColumn_m, scratch_->deepVertices.data());
+    frame.deepVertices = scratch_->deepVertices.data();
     const int blocks = (sh + kRowsPerBlock - 1) / kRowsPerBlock;
     std::vector<uint64_t> blockRays(size_t(blocks), 0);
     tbb::parallel_for(0, blocks, [&](int block) {

@@ -117,21 +117,37 @@ struct SeaSamples {
 // value (|wet| ≤ kMaxVertexAttribute). A lane group on a deep triangle whose weights w0, b1, b2
 // are all ≥ 0 (so none is NaN or infinite, and each sum is a convex combination: within 2^-22
 // of the vertices' range) gets the records (kMaxVertexAttribute, 0, 0) instead of the sums:
-// its true sums have depth ≥ deepDepth·(1 − 2^-22), foam ±0 and a finite wet value.
+// its true sums have depth ≥ deepDepth·(1 − 2^-22), foam ±0 and a finite wet value. The test
+// may be made once per vertex instead (DeepVertices): a gather meets each triangle again in
+// every row it crosses, and the per-vertex flags make its test three loads.
 class SeaGather {
   public:
     // sea: mesh 0 of the visibility buffer, its primitives [seaBase, seaBase + seaPrimitives).
-    // deepDepth: see above; +∞ (the default) makes no triangle deep.
+    // deepDepth: see above; +∞ (the default) makes no triangle deep. deepVertices: optional,
+    // DeepVertices' flags of the sea's vertices for the same deepDepth.
     SeaGather(const MeshArrays& sea, uint32_t seaBase, uint32_t seaPrimitives,
-              float deepDepth = std::numeric_limits<float>::infinity())
+              float deepDepth = std::numeric_limits<float>::infinity(),
+              const uint8_t* deepVertices = nullptr)
         : sea_(sea),
           base_(seaBase),
           count_(seaPrimitives),
-          deepLow_(_mm_setr_ps(deepDepth, -kMaxVertexAttribute, 0.0f,
-                               -std::numeric_limits<float>::infinity())),
-          deepHigh_(_mm_setr_ps(std::numeric_limits<float>::infinity(),
-                                std::numeric_limits<float>::infinity(), 0.0f,
-                                std::numeric_limits<float>::infinity())) {}
+          deepVertices_(deepVertices),
+          deepLow_(DeepLow(deepDepth)),
+          deepHigh_(DeepHigh()) {}
+
+    // flags[v] = whether vertex v's clamped attributes lie within the deep bounds, for v <
+    // count. A triangle is deep exactly where its three vertices are: the clamped values are
+    // never NaN, so their minimum and maximum lie within bounds where each value does.
+    static void DeepVertices(const glm::vec4* attributes, size_t count, float deepDepth,
+                             uint8_t* flags) {
+        const simd4::F4 top = _mm_set1_ps(kMaxVertexAttribute);
+        const simd4::F4 low = DeepLow(deepDepth), high = DeepHigh();
+        for (size_t v = 0; v < count; ++v) {
+            const simd4::F4 c = _mm_min_ps(_mm_loadu_ps(&attributes[v].x), top);
+            flags[v] =
+                _mm_movemask_ps(_mm_and_ps(_mm_cmpge_ps(c, low), _mm_cmple_ps(c, high))) == 0xf;
+        }
+    }
 
     bool IsSea(uint32_t prim) const { return prim - base_ < count_; }
 
@@ -151,6 +167,7 @@ class SeaGather {
         const float* const normals = reinterpret_cast<const float*>(sea_.normals);
         const uint32_t* const indices = sea_.indices;
         const glm::vec4* const attributes = sea_.attributes;
+        const uint8_t* const deepVertices = deepVertices_;
         uint32_t last = prim_;
         bool deep = deep_;
         size_t o0 = offset_[0], o1 = offset_[1], o2 = offset_[2];
@@ -165,7 +182,9 @@ class SeaGather {
                 last = prim;
                 const uint32_t* i = indices + 3 * size_t(prim - base_);
                 o0 = 3 * size_t(i[0]), o1 = 3 * size_t(i[1]), o2 = 3 * size_t(i[2]);
-                if (attributes)
+                if (deepVertices)
+                    deep = deepVertices[i[0]] & deepVertices[i[1]] & deepVertices[i[2]];
+                else if (attributes)
                     deep = Deep(attributes + i[0], attributes + i[1], attributes + i[2]);
             }
             const size_t inRow = std::min(kLanes, size_t(sw - x));
@@ -219,6 +238,16 @@ class SeaGather {
     }
 
   private:
+    // The deep bounds: (deepDepth, −top, 0, −∞) and (∞, ∞, 0, ∞).
+    static simd4::F4 DeepLow(float deepDepth) {
+        return _mm_setr_ps(deepDepth, -kMaxVertexAttribute, 0.0f,
+                           -std::numeric_limits<float>::infinity());
+    }
+    static simd4::F4 DeepHigh() {
+        return _mm_setr_ps(std::numeric_limits<float>::infinity(),
+                           std::numeric_limits<float>::infinity(), 0.0f,
+                           std::numeric_limits<float>::infinity());
+    }
     // Whether the triangle with vertex attributes a0, a1, a2 (each x, y, z, w) is deep: the
     // clamped attributes (_mm_min_ps(a, top) as the sums' clamp) of all three vertices within
     // [deepLow_, deepHigh_] component by component (w unconstrained).
@@ -235,7 +264,8 @@ class SeaGather {
 
     const MeshArrays& sea_;
     uint32_t base_, count_;
-    simd4::F4 deepLow_, deepHigh_;  // the deep bounds: (deepDepth, −top, 0, −∞), (∞, ∞, 0, ∞)
+    const uint8_t* deepVertices_;   // DeepVertices' flags, or none
+    simd4::F4 deepLow_, deepHigh_;  // DeepLow(deepDepth), DeepHigh()
     uint32_t prim_ = kNoPrimitive;
     bool deep_ = false;      // whether prim_ is deep
     size_t offset_[3] = {};  // prim_'s vertices, 3·index (floats into positions and normals)

@@ -308,5 +308,58 @@ TEST(SeaGather, SumsFlagIsClearOnlyWhereEveryRecordIsTheDeepRecord) {
     EXPECT_GT(summedChunks, 20u) << deepChunks;
 }
 
+TEST(SeaGather, DeepVertexFlagsGiveEachTrianglesTestAndTheSameRecords) {
+    // DeepSea's vertices flagged once: the three flags of a triangle are its deep test, and a
+    // gather given the flags writes the records (and the sums flag) of one that tests each
+    // triangle's attributes, bit for bit.
+    constexpr int kWidth = 6000;
+    const DeepSea sea(kWidth);
+    const MeshArrays mesh = sea.Mesh();
+    std::vector<uint8_t> flags(sea.attributes.size(), 2);
+    SeaGather::DeepVertices(sea.attributes.data(), flags.size(), DeepSea::kDeep, flags.data());
+    size_t deepTriangles = 0;
+    for (uint32_t t = 0; t < DeepSea::kTriangles; ++t) {
+        const uint32_t* i = sea.indices.data() + 3 * t;
+        const bool flagged = flags[i[0]] && flags[i[1]] && flags[i[2]];
+        EXPECT_EQ(flagged, sea.Deep(DeepSea::kBase + t)) << "triangle " << t;
+        deepTriangles += flagged;
+    }
+    EXPECT_GT(deepTriangles, 2u);
+    EXPECT_LT(deepTriangles, DeepSea::kTriangles - 2);
+    for (uint8_t f : flags) EXPECT_LE(f, 1);
+
+    constexpr size_t kCapacity = 29;
+    SeaSamples<kCapacity> tested, flagged;
+    SeaGather byTriangle(mesh, DeepSea::kBase, DeepSea::kTriangles, DeepSea::kDeep);
+    SeaGather byVertex(mesh, DeepSea::kBase, DeepSea::kTriangles, DeepSea::kDeep, flags.data());
+    size_t records = 0, recordsFlagged = 0, compared = 0;
+    const auto Compare = [&] {
+        ASSERT_EQ(records, recordsFlagged);
+        EXPECT_EQ(tested.sums, flagged.sums);
+        for (int c = 0; c < kSeaComponents; ++c)
+            for (size_t r = 0; r < records; ++r)
+                EXPECT_EQ(std::memcmp(&tested.c[c][r], &flagged.c[c][r], sizeof(float)), 0)
+                    << "component " << c << " record " << r;
+        compared += records;
+        records = recordsFlagged = 0;
+        tested.sums = flagged.sums = false;
+    };
+    for (int x = 0; x < kWidth;) {
+        if (!byTriangle.IsSea(sea.prims[size_t(x)])) {
+            ++x;
+            continue;
+        }
+        const int next = byTriangle.Gather(sea.prims.data(), sea.b1.data(), sea.b2.data(), x,
+                                           kWidth, tested, records);
+        ASSERT_EQ(byVertex.Gather(sea.prims.data(), sea.b1.data(), sea.b2.data(), x, kWidth,
+                                  flagged, recordsFlagged),
+                  next);
+        x = next;
+        if (records == kCapacity) Compare();
+    }
+    Compare();
+    EXPECT_GT(compared, 4000u);
+}
+
 }  // namespace
 }  // namespace seasense::channels
