@@ -232,6 +232,7 @@ SurfWaves::SurfWaves(const Bathymetry& bathymetry, std::vector<SurfComponent> co
         cascadeVariance_m2_ += c.variance_m2;
         fadeDeep_m_ = std::max(fadeDeep_m_, 0.5 * c.wavelength_m);
     }
+    cascadeFade_ = !cascades_.empty() && cascadeVariance_m2_ > 0.0;
     for (const SurfComponent& c : components_)
         (c.spectral ? spectralVariance_m2_ : gerstnerVariance_m2_) +=
             0.5 * c.amplitude_m * c.amplitude_m;
@@ -383,6 +384,7 @@ SurfWaves::SurfWaves(const Bathymetry& bathymetry, std::vector<SurfComponent> co
             breakTime_s_[size_t(i)] = time;
         }
     }
+    breakingLine_ = !breakTime_s_.empty() && std::isfinite(sBreak_m_);
     BuildShelters();
     BuildSwash();
     // The interval bounds' parts with the surf weights at each interval's shallow end, as the
@@ -573,18 +575,18 @@ double SurfWaves::DepthTable(const std::vector<double>& t, double h) const {
 }
 
 // Inlined into Terms (a surf point's one call): the call and the copy of its result cost as much
-// as the all-deep case's whole work.
-[[gnu::always_inline]] inline SurfWeights SurfWaves::WeightsAt(double depth_m) const {
-    SurfWeights w;
+// as the all-deep case's whole work. Written into w in place (Terms hands its point
+// information's weights, just reset): a copy of the struct cost ~20 instructions a mesh vertex.
+[[gnu::always_inline]] inline void SurfWaves::WeightsInto(double depth_m, SurfWeights& w) const {
     // At or below the deepest fade every Fade below is 1, so the defaults are exactly what the
     // sums give: gerstnerSurf = √(1 − 1) = 0, lost = Σ var (1 − 1) = 0, spectralSurf = 0. Most
     // of a view mesh's vertices lie there.
-    if (depth_m >= fadeDeep_m_) return w;
+    if (depth_m >= fadeDeep_m_) return;
     w.gerstner = Fade(depth_m, peakFadeDeep_m_);
     w.gerstnerSurf = std::sqrt(std::max(0.0, 1.0 - w.gerstner * w.gerstner));
-    if (cascades_.empty() || !(cascadeVariance_m2_ > 0.0)) {
+    if (!cascadeFade_) {
         w.spectralSurf = w.gerstnerSurf;  // no cascades given: the spectral sea fades as a whole
-        return w;
+        return;
     }
     double lost = 0.0;
     for (size_t c = 0; c < cascades_.size(); ++c) {
@@ -595,10 +597,13 @@ double SurfWaves::DepthTable(const std::vector<double>& t, double h) const {
         lost += cascades_[c].variance_m2 * (1.0 - f * f);
     }
     w.spectralSurf = std::sqrt(std::clamp(lost / cascadeVariance_m2_, 0.0, 1.0));
-    return w;
 }
 
-SurfWeights SurfWaves::Weights(double depth_m) const { return WeightsAt(depth_m); }
+SurfWeights SurfWaves::Weights(double depth_m) const {
+    SurfWeights w;
+    WeightsInto(depth_m, w);
+    return w;
+}
 
 namespace {
 
@@ -894,14 +899,31 @@ SurfWaves::Bound SurfWaves::BoundAtDepths(double minDepth_m, const BoundTable& t
     return out;
 }
 
+namespace {
+
+// Terms (wide or not) into a scratch point information, for callers that want none: out of
+// line, so that Terms itself, whose callers hand theirs (the mesh), needs no stack frame for one
+// (a scratch made on every call cost ~12 instructions a mesh vertex).
+[[gnu::noinline]] SurfaceTerms TermsIntoScratch(const SurfWaves& waves, double x0, double y0,
+                                                double t, const SurfWaves::TermsOptions& options,
+                                                bool wide) {
+    SurfPointInfo scratch;
+    return wide ? waves.Terms(x0, y0, t, &scratch, options)
+                : waves.TermsFourLanes(x0, y0, t, &scratch, options);
+}
+
+}  // namespace
+
 SurfaceTerms SurfWaves::Terms(double x0, double y0, double t, SurfPointInfo* info,
                               const TermsOptions& options) const {
+    if (!info) return TermsIntoScratch(*this, x0, y0, t, options, true);
     return options.velocity ? TermsImpl<true, true>(x0, y0, t, info, options)
                             : TermsImpl<false, true>(x0, y0, t, info, options);
 }
 
 SurfaceTerms SurfWaves::TermsFourLanes(double x0, double y0, double t, SurfPointInfo* info,
                                        const TermsOptions& options) const {
+    if (!info) return TermsIntoScratch(*this, x0, y0, t, options, false);
     return options.velocity ? TermsImpl<true, false>(x0, y0, t, info, options)
                             : TermsImpl<false, false>(x0, y0, t, info, options);
 }
@@ -914,15 +936,14 @@ SurfaceTerms SurfWaves::TermsImpl(double x0, double y0, double t, SurfPointInfo*
     const double zBed =
         std::isnan(options.seabedZ_m) ? bathy_.SeabedZAtShore_m(p.s_m, p.u_m) : options.seabedZ_m;
     const double h = bathy_.Tide_m() - zBed;
-    const SurfWeights weights = WeightsAt(h);
-    // The point's information is written where the caller wants it (a copy of the whole struct
-    // at the end cost ~30 instructions a mesh vertex), else into a scratch copy.
-    SurfPointInfo scratch;
-    SurfPointInfo& local = info ? *info : scratch;
+    // The point's information is written in place (a copy of the whole struct at the end cost
+    // ~30 instructions a mesh vertex); info is never null here (Terms hands a scratch one).
+    SurfPointInfo& local = *info;
     local = SurfPointInfo{};
     local.depth_m = h;
     local.seabedZ_m = zBed;
-    local.weights = weights;
+    WeightsInto(h, local.weights);
+    const SurfWeights& weights = local.weights;
     const double variance = spectralVariance_m2_ + gerstnerVariance_m2_;
     // All deep: surfShare is 0 / variance = 0, so the weights are exactly 0 and 1 (the defaults).
     if (options.shareWeights && variance > 0.0 && !weights.AllDeep()) {
@@ -934,7 +955,7 @@ SurfaceTerms SurfWaves::TermsImpl(double x0, double y0, double t, SurfPointInfo*
         local.deepWeight = std::sqrt(std::clamp(1.0 - surfShare, 0.0, 1.0));
     }
     const double tableIndex = (sRef_m_ - p.s_m) / ds_m_;
-    if (!breakTime_s_.empty() && std::isfinite(sBreak_m_)) {
+    if (breakingLine_) {
         local.breaking.broken = p.s_m <= sBreak_m_;
         // (Dominant::kWhereBroken: seaward of the line left −1, as the foam reads it only
         // where broken; most of a mesh's surf vertices lie there.)
@@ -1073,7 +1094,7 @@ SurfaceTerms SurfWaves::TermsImpl(double x0, double y0, double t, SurfPointInfo*
         out.velocity_mps.x = f * horizontalVelocity.x;
         out.velocity_mps.y = f * horizontalVelocity.y;
     }
-    if (n > 0 && info && (options.dominant == Dominant::kEverywhere || local.breaking.broken)) {
+    if (n > 0 && (options.dominant == Dominant::kEverywhere || local.breaking.broken)) {
         // The dominant component: the largest local amplitude (the first of equals).
         size_t best = 0;
         for (size_t m = 1; m < n; ++m)

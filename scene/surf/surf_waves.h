@@ -326,7 +326,8 @@ class SurfWaves {
     double FluxProxy(double h) const;
     double Shelter(double s_m, double u_m, double h) const;
     double ShelterBehindBar(double s_m, double u_m, double h) const;  // Shelter's lookup
-    SurfWeights WeightsAt(double depth_m) const;                      // Weights, inlined into Terms
+    // Weights into w, which holds SurfWeights' defaults (inlined into Terms).
+    void WeightsInto(double depth_m, SurfWeights& w) const;
     std::vector<int> shelterOfRegion_;  // index into shelters_ or −1
     std::vector<BarShelter> shelters_;
     size_t dominant_ = 0;
@@ -338,6 +339,7 @@ class SurfWaves {
     SurfWaveSettings settings_;
     double fadeDeep_m_ = 0.0, peakFadeDeep_m_ = 0.0, peakFadeShallow_m_ = 0.0;
     double cascadeVariance_m2_ = 0.0;
+    bool cascadeFade_ = false;  // cascades given with variance: each fades with its own depth
     double spectralVariance_m2_ = 0.0, gerstnerVariance_m2_ = 0.0;  // of the components
     double sRef_m_ = 0.0, sShore_m_ = 0.0, ds_m_ = 0.5;
     size_t phaseSamples_ = 0;  // cross-shore samples of lanePhase_ (lanePhase_.size() / lanes_)
@@ -366,6 +368,7 @@ class SurfWaves {
     double sBreak_m_ = 0.0;
     double maxBreakDepth_m_ = 0.0;
     std::vector<double> breakTime_s_;  // group travel time from the breaker line, per s sample
+    bool breakingLine_ = false;        // a finite breaker line with its travel times
 };
 
 }  // namespace seasense::scene

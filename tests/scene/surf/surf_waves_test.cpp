@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cmath>
@@ -525,6 +526,99 @@ TEST(SurfWaves, WideLanesGiveTheFourLaneBits) {
         }
         EXPECT_GT(surfPoints, 1000u) << count;  // the sums ran, not only the early returns
     }
+}
+
+// Terms writes the point's information in place (the mesh hands its own, reused vertex after
+// vertex): reset first, the weights filled in where they lie, so it must be the information of
+// a fresh struct whatever the struct held, the weights must be Weights(depth) with the spectral
+// weight the cascades' lost variance, the breaking state the breaker line's, and the terms the
+// same bits with and without the information. Points on land, through the surf and both fades
+// and past them; a struct filled with junk before each call.
+TEST(SurfWaves, PointInformationInPlaceIsAFreshPointsWeightsAndBreaking) {
+    const Bathymetry b(Beach(0.05), 10.0);
+    std::vector<SurfComponent> components;
+    for (size_t j = 0; j < 13; ++j) {
+        SurfComponent c = Wave(0.1 + 0.02 * double(j % 4), 4.0 + 0.6 * double(j),
+                               270.0 + 30.0 * std::sin(1.7 * double(j)));
+        c.phase_rad = 0.5 * double(j);
+        c.spectral = j != 0;
+        components.push_back(c);
+    }
+    const std::vector<SurfCascade> cascades{{0.4, 16.0}, {0.1, 6.0}};
+    const SurfWaves w(b, components, 16.0, cascades);
+    ASSERT_TRUE(std::isfinite(w.BreakerLine_m()));
+    const auto bits = [](double v) { return std::bit_cast<uint64_t>(v); };
+    const auto sameInfo = [&](const SurfPointInfo& a, const SurfPointInfo& c) {
+        for (const auto field : {&SurfPointInfo::depth_m, &SurfPointInfo::seabedZ_m,
+                                 &SurfPointInfo::deepWeight, &SurfPointInfo::surfWeight,
+                                 &SurfPointInfo::envelope_m, &SurfPointInfo::unbrokenHeight_m,
+                                 &SurfPointInfo::direction_rad, &SurfPointInfo::phaseSpeed_mps,
+                                 &SurfPointInfo::groupSpeed_mps, &SurfPointInfo::phase_rad})
+            if (bits(a.*field) != bits(c.*field)) return false;
+        for (size_t k = 0; k < kMaxSurfCascades; ++k)
+            if (bits(a.weights.cascade[k]) != bits(c.weights.cascade[k])) return false;
+        return bits(a.weights.gerstner) == bits(c.weights.gerstner) &&
+               bits(a.weights.spectralSurf) == bits(c.weights.spectralSurf) &&
+               bits(a.weights.gerstnerSurf) == bits(c.weights.gerstnerSurf) &&
+               bits(a.breaking.intensity) == bits(c.breaking.intensity) &&
+               a.breaking.broken == c.breaking.broken &&
+               bits(a.breaking.timeSinceBreaking_s) == bits(c.breaking.timeSinceBreaking_s);
+    };
+    SurfPointInfo junk;
+    junk.depth_m = junk.seabedZ_m = junk.deepWeight = junk.surfWeight = 7.0;
+    junk.weights.cascade.fill(-3.0);
+    junk.weights.gerstner = junk.weights.spectralSurf = junk.weights.gerstnerSurf = 5.0;
+    junk.envelope_m = junk.unbrokenHeight_m = junk.direction_rad = 9.0;
+    junk.phaseSpeed_mps = junk.groupSpeed_mps = junk.phase_rad = 11.0;
+    junk.breaking = {0.5, true, 42.0};
+    size_t inFade = 0, broken = 0, deep = 0;
+    for (int i = 0; i < 3000; ++i) {
+        const double x = -20.0 + 0.1 * i, y = 30.0 * std::sin(0.13 * i), t = 0.37 * i;
+        for (const auto dominant :
+             {SurfWaves::Dominant::kEverywhere, SurfWaves::Dominant::kWhereBroken}) {
+            for (const bool share : {true, false}) {
+                SurfWaves::TermsOptions options;
+                options.velocity = i % 2 == 0;
+                options.dominant = dominant;
+                options.shareWeights = share;
+                SurfPointInfo fresh, reused = junk;
+                const SurfaceTerms a = w.Terms(x, y, t, &fresh, options);
+                const SurfaceTerms c = w.Terms(x, y, t, &reused, options);
+                const SurfaceTerms none = w.Terms(x, y, t, nullptr, options);
+                ASSERT_EQ(std::memcmp(&a, &c, sizeof a), 0) << x;
+                ASSERT_EQ(std::memcmp(&a, &none, sizeof a), 0) << x;
+                ASSERT_TRUE(sameInfo(fresh, reused)) << x;
+                const SurfWeights expected = w.Weights(fresh.depth_m);
+                for (size_t k = 0; k < cascades.size(); ++k)
+                    ASSERT_EQ(bits(fresh.weights.cascade[k]), bits(expected.cascade[k])) << x;
+                ASSERT_EQ(bits(fresh.weights.gerstner), bits(expected.gerstner)) << x;
+                ASSERT_EQ(bits(fresh.weights.gerstnerSurf), bits(expected.gerstnerSurf)) << x;
+                ASSERT_EQ(bits(fresh.weights.spectralSurf), bits(expected.spectralSurf)) << x;
+                // The spectral surf weight carries the variance the cascades give up (not the
+                // Gerstner waves' weight, as without cascades).
+                double lost = 0.0, total = 0.0;
+                for (size_t k = 0; k < cascades.size(); ++k) {
+                    const double f = fresh.weights.cascade[k];
+                    lost += cascades[k].variance_m2 * (1.0 - f * f);
+                    total += cascades[k].variance_m2;
+                }
+                ASSERT_EQ(bits(fresh.weights.spectralSurf),
+                          bits(std::sqrt(std::clamp(lost / total, 0.0, 1.0))))
+                    << x;
+                const double s = b.Frame().ShoreFromWorld(x, y).s_m;
+                ASSERT_EQ(fresh.breaking.broken, s <= w.BreakerLine_m()) << x;
+                if (fresh.breaking.broken) {
+                    ASSERT_GE(fresh.breaking.timeSinceBreaking_s, 0.0) << x;
+                    ++broken;
+                }
+                if (fresh.weights.cascade[1] > 0.0 && fresh.weights.cascade[1] < 1.0) ++inFade;
+                if (fresh.weights.AllDeep()) ++deep;
+            }
+        }
+    }
+    EXPECT_GT(inFade, 100u);
+    EXPECT_GT(broken, 100u);
+    EXPECT_GT(deep, 100u);
 }
 
 }  // namespace
