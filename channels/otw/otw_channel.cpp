@@ -116,6 +116,9 @@ struct DirectionalLight {
     glm::vec3 E{0.0f};
 };
 
+// Most fill lights of a frame: the dimmer of sun and moon, and lightning (OtwChannel::Render).
+constexpr size_t kMaxFillLights = 2;
+
 // Samples per shading chunk: the chunk's arrays stay in L1.
 constexpr size_t kChunk = 256;
 
@@ -175,6 +178,16 @@ struct SeaShading {
         CHECK(tan2Limit < 1e5f);  // GlintPossible's bound
         const VF glintLimit = Splat(tan2Limit);
         const float glintCos2 = GlintCos2Bound(tan2Limit);
+        // The key and fill lights' lane broadcasts, made once here: in the loop GCC made them
+        // again for every lane group (an addition and a broadcast per component).
+        const VF keyX = Splat(keyDir.x), keyY = Splat(keyDir.y), keyZ = Splat(keyDir.z);
+        LightLanes fills[kMaxFillLights];
+        const size_t fillCount = fill->size();
+        CHECK(fillCount <= kMaxFillLights);
+        for (size_t l = 0; l < fillCount; ++l) {
+            const DirectionalLight& d = (*fill)[l];
+            fills[l] = MakeLightLanes(d.dir.x, d.dir.y, d.dir.z, d.E.r, d.E.g, d.E.b);
+        }
         for (size_t i = 0; i < count; i += kLanes) {
             const size_t lanes = std::min(kLanes, count - i);
             VF Nx = Load(nx + i, lanes, 0.0f), Ny = Load(ny + i, lanes, 0.0f),
@@ -200,7 +213,7 @@ struct SeaShading {
             const VF cosV = Max(ndv, Splat(1e-3f));
             Store(ch.cosV + i, cosV);
             Store(ch.F + i, fresnel(cosV));
-            const VF cosS = Dot(Nx, Ny, Nz, Splat(keyDir.x), Splat(keyDir.y), Splat(keyDir.z));
+            const VF cosS = Dot(Nx, Ny, Nz, keyX, keyY, keyZ);
             Store(ch.cosS + i, cosS);
             // The glint facet's tilt only where a lane of the group may glint (GlintPossible):
             // a group without one skips a square root, two divisions and a Fresnel look-up, as
@@ -220,13 +233,7 @@ struct SeaShading {
             // (1 + n_z)/2 of the level-surface sky irradiance, and the fill lights.
             const VF skyView = 0.5f * (1.0f + Nz);
             VF aR = skyE.r * skyView, aG = skyE.g * skyView, aB = skyE.b * skyView;
-            for (const DirectionalLight& l : *fill) {
-                const VF c = Max(Dot(Nx, Ny, Nz, Splat(l.dir.x), Splat(l.dir.y), Splat(l.dir.z)),
-                                 Splat(0.0f));
-                aR = aR + l.E.r * c;
-                aG = aG + l.E.g * c;
-                aB = aB + l.E.b * c;
-            }
+            AddLambertianLights(fills, fillCount, Nx, Ny, Nz, aR, aG, aB);
             Store(ch.ambR + i, aR);
             Store(ch.ambG + i, aG);
             Store(ch.ambB + i, aB);
@@ -327,8 +334,9 @@ constexpr float kMaxSeaPixelRelativeCosSpread = 0.1f;
 constexpr float kMaxSeaPixelDepthRatio = 1.1f;
 
 // Vertex positions and normals of a triangle as SSE (x, y, z, 0), gathered once for the many
-// samples that see it.
-struct CachedTriangle {
+// samples that see it. 256 bytes (209 used): a cache slot's address is then the slot index
+// shifted, where 224 took a multiplication of three instructions per look-up.
+struct alignas(256) CachedTriangle {
     uint32_t prim = kNoPrimitive;
     int mesh = 0;
     uint64_t frame = 0;  // OtwChannel's frame count when gathered (0: never)
@@ -350,6 +358,7 @@ struct CachedTriangle {
         return r;
     }
 };
+static_assert(sizeof(CachedTriangle) == 256);
 
 // Per-thread scratch of the shading pass. The pixels of a row block are sorted into sky, sea
 // and model entries so that each kind is shaded in a tight loop: sky and sea four lanes at a
@@ -379,7 +388,7 @@ struct BlockScratch {
     // pixel rows the same ones again (sea vertices are ~6 pixels apart), so each is gathered
     // about once per block. Entries of another frame or primitive are gathered anew; the
     // gathered values depend only on the frame and the primitive, so whatever the cache holds
-    // the shading is the same. 2048 entries (360 kB) keep more of the previous block's
+    // the shading is the same. 2048 entries (512 kB) keep more of the previous block's
     // triangles than 1024: otw-center at frames 120-121 gathered 32.3 k triangles, not 41.8 k
     // (4096 entries: 30.1 k). A power of two (the slot is prim & (size − 1));
     // OtwChannel::SetTriangleCacheEntries sets another for tests.

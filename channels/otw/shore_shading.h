@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstddef>
 
 #include "scene/core/simd_lanes.h"
 
@@ -68,6 +69,31 @@ inline bool BottomUnseenInEveryLane(const ShoreChannel (&c)[3], simd::VF depth) 
     const VF d = depth * kMinWaterPathFactor;
     return All((-c[0].K_perm * d < -87.0f) & (-c[1].K_perm * d < -87.0f) &
                (-c[2].K_perm * d < -87.0f));
+}
+
+// A distant light on lanes: its direction as the operands of a dot product (Splat, as
+// Splat(d.x) in the dot product per lane group made them) and its illuminance (lx, one value a
+// colour channel) bit for bit. Made once for the many lane groups a chunk shades.
+struct LightLanes {
+    simd::VF x, y, z, r, g, b;
+};
+inline LightLanes MakeLightLanes(float dx, float dy, float dz, float Er, float Eg, float Eb) {
+    using namespace simd;
+    return {Splat(dx), Splat(dy), Splat(dz), Broadcast(Er), Broadcast(Eg), Broadcast(Eb)};
+}
+
+// Adds the Lambertian irradiance E·max(n·l, 0) of lights[0, count) on normals (nx, ny, nz) to
+// (aR, aG, aB), light by light in order, n·l in glm::dot's order.
+inline void AddLambertianLights(const LightLanes* lights, size_t count, simd::VF nx, simd::VF ny,
+                                simd::VF nz, simd::VF& aR, simd::VF& aG, simd::VF& aB) {
+    using namespace simd;
+    for (size_t l = 0; l < count; ++l) {
+        const LightLanes& light = lights[l];
+        const VF c = Max(Dot(nx, ny, nz, light.x, light.y, light.z), Splat(0.0f));
+        aR = aR + light.r * c;
+        aG = aG + light.g * c;
+        aB = aB + light.b * c;
+    }
 }
 
 // Radiance (cd/m², one channel) of a surf-zone point before fog:
