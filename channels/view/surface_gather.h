@@ -140,13 +140,8 @@ class SeaGather {
     // never NaN, so their minimum and maximum lie within bounds where each value does.
     static void DeepVertices(const glm::vec4* attributes, size_t count, float deepDepth,
                              uint8_t* flags) {
-        const simd4::F4 top = _mm_set1_ps(kMaxVertexAttribute);
         const simd4::F4 low = DeepLow(deepDepth), high = DeepHigh();
-        for (size_t v = 0; v < count; ++v) {
-            const simd4::F4 c = _mm_min_ps(_mm_loadu_ps(&attributes[v].x), top);
-            flags[v] =
-                _mm_movemask_ps(_mm_and_ps(_mm_cmpge_ps(c, low), _mm_cmple_ps(c, high))) == 0xf;
-        }
+        for (size_t v = 0; v < count; ++v) flags[v] = DeepVertex(attributes[v], low, high);
     }
 
     bool IsSea(uint32_t prim) const { return prim - base_ < count_; }
@@ -248,18 +243,17 @@ class SeaGather {
                            std::numeric_limits<float>::infinity(), 0.0f,
                            std::numeric_limits<float>::infinity());
     }
-    // Whether the triangle with vertex attributes a0, a1, a2 (each x, y, z, w) is deep: the
-    // clamped attributes (_mm_min_ps(a, top) as the sums' clamp) of all three vertices within
-    // [deepLow_, deepHigh_] component by component (w unconstrained).
+    // Whether a vertex with attributes a (x, y, z, w) is deep: its clamped attributes
+    // (_mm_min_ps(a, top) as the sums' clamp) within [low, high] component by component (w
+    // unconstrained). The one definition behind both Deep and DeepVertices.
+    static bool DeepVertex(const glm::vec4& a, simd4::F4 low, simd4::F4 high) {
+        const simd4::F4 c = _mm_min_ps(_mm_loadu_ps(&a.x), _mm_set1_ps(kMaxVertexAttribute));
+        return _mm_movemask_ps(_mm_and_ps(_mm_cmpge_ps(c, low), _mm_cmple_ps(c, high))) == 0xf;
+    }
+    // Whether the triangle with vertex attributes a0, a1, a2 is deep: all three vertices are.
     bool Deep(const glm::vec4* a0, const glm::vec4* a1, const glm::vec4* a2) const {
-        const simd4::F4 top = _mm_set1_ps(kMaxVertexAttribute);
-        const simd4::F4 c0 = _mm_min_ps(_mm_loadu_ps(&a0->x), top);
-        const simd4::F4 c1 = _mm_min_ps(_mm_loadu_ps(&a1->x), top);
-        const simd4::F4 c2 = _mm_min_ps(_mm_loadu_ps(&a2->x), top);
-        const simd4::F4 low = _mm_min_ps(c0, _mm_min_ps(c1, c2));
-        const simd4::F4 high = _mm_max_ps(c0, _mm_max_ps(c1, c2));
-        return _mm_movemask_ps(
-                   _mm_and_ps(_mm_cmpge_ps(low, deepLow_), _mm_cmple_ps(high, deepHigh_))) == 0xf;
+        return DeepVertex(*a0, deepLow_, deepHigh_) && DeepVertex(*a1, deepLow_, deepHigh_) &&
+               DeepVertex(*a2, deepLow_, deepHigh_);
     }
 
     const MeshArrays& sea_;
