@@ -84,6 +84,9 @@ sensors::ImageMetadata FrameMetadata(const scene::World& world, const scene::Cha
         md.Set("seasense:exposure_ev", float(ev));
         md.Set("seasense:exposure_mode", std::string(ToString(ch.exposure.mode)));
         md.Set("seasense:ocio_view", ch.ocioView);
+        // How the display images (png, tiff) applied that view.
+        md.Set("seasense:display",
+               std::string(ch.display == scene::ChannelSettings::Display::Lut ? "lut" : "exact"));
         md.Set("oiio:ColorSpace", std::string("Linear Rec.709 (sRGB)"));
     }
     if (ch.kind == scene::ChannelKind::Nvg)
@@ -259,6 +262,8 @@ const std::vector<uint8_t>& ChannelPipeline::DisplayRgb8() {
                 for (; i < d.size(); ++i)
                     display8_[3 * i] = display8_[3 * i + 1] = display8_[3 * i + 2] = d[i];
             }
+        } else if (channel_.display == scene::ChannelSettings::Display::Lut) {
+            display8_ = Lut().ToDisplay8(pixels_, float(std::exp2(ev_)));
         } else {
             display8_ = display_->ToDisplay8(pixels_, float(std::exp2(ev_)));
         }
@@ -279,9 +284,8 @@ std::vector<uint8_t> ChannelPipeline::PreviewRgb8(int width, int height) {
         cv::resize(src, dst, dst.size(), 0, 0, cv::INTER_AREA);
         return small;
     }
-    if (!previewLut_) previewLut_ = std::make_unique<sensors::DisplayLut>(*display_);
     if (width == pixels_.width && height == pixels_.height)
-        return previewLut_->ToDisplay8(pixels_, float(std::exp2(ev_)));
+        return Lut().ToDisplay8(pixels_, float(std::exp2(ev_)));
     // Kept between frames: a fresh 0.9 MB image each frame is zero-filled (and page-faulted)
     // only to be overwritten by the resize.
     Image& small = previewSmall_;
@@ -296,7 +300,13 @@ std::vector<uint8_t> ChannelPipeline::PreviewRgb8(int width, int height) {
         cv::resize(src, dst, dst.size(), 0, 0, cv::INTER_AREA);
         CHECK(dst.data == reinterpret_cast<uchar*>(small.pixels.data()));  // written in place
     }
-    return previewLut_->ToDisplay8(small, float(std::exp2(ev_)));
+    return Lut().ToDisplay8(small, float(std::exp2(ev_)));
+}
+
+const sensors::DisplayLut& ChannelPipeline::Lut() {
+    CHECK(display_);
+    if (!lut_) lut_ = std::make_unique<sensors::DisplayLut>(*display_);
+    return *lut_;
 }
 
 void ChannelPipeline::WriteThermal(const sensors::ImageMetadata& md, const std::string& base,

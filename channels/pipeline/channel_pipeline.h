@@ -67,6 +67,8 @@ class ChannelPipeline {
     // of a pipeline that never warmed up.
     void WarmUp(const scene::FrameState& frame);
     // The display image of the last rendered frame: 8-bit RGB, Width()×Height(), row 0 on top.
+    // Otw: the channel's OCIO display transform, exact or through its 3-D LUT
+    // (ChannelSettings::display).
     const std::vector<uint8_t>& DisplayRgb8();
     // The last frame at a reduced size for previews (the run's mosaic), 8-bit RGB. Visible:
     // the linear sensor image area-averaged to width×height, then displayed through a 3-D LUT
@@ -110,7 +112,10 @@ class ChannelPipeline {
     double ev_ = 0.0;                // the last frame's exposure
     std::vector<uint8_t> display8_;  // display transform of pixels_, when asked for
     bool displayValid_ = false;
-    std::unique_ptr<sensors::DisplayLut> previewLut_;  // built on the first preview
+    // Otw: the 3-D LUT of display_, built on first use (a preview, or display images with
+    // ChannelSettings::Display::Lut).
+    const sensors::DisplayLut& Lut();
+    std::unique_ptr<sensors::DisplayLut> lut_;
     Image previewSmall_;  // otw: pixels_ scaled to the preview size (kept between frames)
 };
 

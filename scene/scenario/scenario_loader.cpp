@@ -36,6 +36,8 @@ const std::vector<std::string> kExposureModes = {"auto", "manual", "adapted"};
 const std::vector<std::string> kOutputFormats = {"exr", "png", "tiff"};
 // Flir channels also write the imager's 16-bit raw ADC counts.
 const std::vector<std::string> kFlirOutputFormats = {"exr", "png", "tiff", "raw_png", "raw_tiff"};
+// ChannelSettings::Display, in its order.
+const std::vector<std::string> kDisplays = {"exact", "lut"};
 const std::vector<std::string> kModelExtensions = {".obj", ".gltf", ".glb"};
 
 // Names that end up in file names and command lines: [A-Za-z0-9_-]+.
@@ -357,6 +359,14 @@ ChannelSettings ReadChannel(const ConfigValue& value) {
                         channel.formats.end())
                         format.Fail("each format at most once", "'" + name + "' again");
                     channel.formats.push_back(name);
+                }
+                if (std::optional<ConfigValue> display = o.Find("display")) {
+                    if (channel.kind != ChannelKind::Otw)
+                        display->Fail(
+                            "no display key: only otw channels display through "
+                            "OpenColorIO (flir and nvg have their own display chains)",
+                            "display on a " + kChannelKinds[size_t(channel.kind)] + " channel");
+                    channel.display = ChannelSettings::Display(display->AsEnum(kDisplays));
                 }
             });
         }

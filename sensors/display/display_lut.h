@@ -1,5 +1,6 @@
 // A 3-D lookup table of an OCIO display transform over log2-encoded scene-linear RGB: a fast
-// approximation for previews (the run's mosaic), never for the channel's image files.
+// approximation for previews (the run's mosaic), and for the display images of channels that
+// ask for it (output.display: lut).
 #pragma once
 
 #include <cstdint>

@@ -365,6 +365,25 @@ TEST_F(ScenarioLoaderTest, FlirChannelTakesAnImagerRawFormatsAndMayLeaveOutTheFo
         << error;
 }
 
+TEST_F(ScenarioLoaderTest, OtwDisplayImagesAreExactUnlessTheLutIsAskedFor) {
+    using Display = ChannelSettings::Display;
+    EXPECT_EQ(LoadScenario(Write(valid_)).channels[0].display, Display::Exact);
+    const std::string lut =
+        Replace(valid_, "formats: [exr, png]", "formats: [exr, png], display: lut");
+    EXPECT_EQ(LoadScenario(Write(lut)).channels[0].display, Display::Lut);
+    const std::string exact = Replace(lut, "display: lut", "display: exact");
+    EXPECT_EQ(LoadScenario(Write(exact)).channels[0].display, Display::Exact);
+    const std::string fast = Replace(lut, "display: lut", "display: fast");
+    EXPECT_EQ(ErrorFor(fast), At(fast, "display: fast", "fast", "channels[0].output.display") +
+                                  "one of exact, lut, found 'fast'");
+    // The flir channel's display is its imager's (palette or polarity), not OCIO.
+    const std::string flir = Replace(valid_, "formats: [tiff]", "formats: [tiff], display: lut");
+    EXPECT_EQ(ErrorFor(flir), At(flir, "display: lut", "lut", "channels[1].output.display") +
+                                  "no display key: only otw channels display through OpenColorIO "
+                                  "(flir and nvg have their own display chains), found display "
+                                  "on a flir channel");
+}
+
 TEST_F(ScenarioLoaderTest, WrongNodeTypeIsNamed) {
     const std::string sun = Replace(
         valid_, "sun: {azimuth_deg: 240, elevation_deg: 25, illuminance_lux: 90000}", "sun: 25");

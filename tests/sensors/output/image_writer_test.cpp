@@ -6,6 +6,7 @@
 #include <signal.h>
 #include <sys/resource.h>
 #include <unistd.h>
+#include <zlib.h>
 
 #include <cmath>
 #include <cstring>
@@ -212,6 +213,53 @@ TEST_F(ImageWriterTest, PngAndTiffRoundTrip8And16Bit) {
     EXPECT_EQ(ReadPixels<std::uint8_t>(greyPath, spec), grey);
     EXPECT_EQ(spec.nchannels, 1);
     EXPECT_EQ(spec.get_string_attribute("ImageDescription"), "seasense nvg");
+}
+
+// The scanlines of a PNG as stored: the zlib stream of its IDAT chunks inflated, each row its
+// filter-type byte followed by the filtered bytes (PNG specification, ISO/IEC 15948 §5.3 chunk
+// layout, §7.3 and §9.2 filtering).
+std::vector<std::uint8_t> StoredScanlines(const fs::path& path, size_t rowBytes, size_t rows) {
+    const std::string bytes = ReadBytes(path);
+    const auto be32 = [&](size_t at) {
+        return (uint32_t(uint8_t(bytes[at])) << 24) | (uint32_t(uint8_t(bytes[at + 1])) << 16) |
+               (uint32_t(uint8_t(bytes[at + 2])) << 8) | uint32_t(uint8_t(bytes[at + 3]));
+    };
+    std::string idat;
+    for (size_t at = 8; at + 12 <= bytes.size();) {  // after the 8-byte signature
+        const size_t length = be32(at);
+        if (bytes.compare(at + 4, 4, "IDAT") == 0) idat.append(bytes, at + 8, length);
+        at += 12 + length;  // length, type, data, CRC
+    }
+    std::vector<std::uint8_t> raw(rows * (1 + rowBytes));
+    uLongf size = raw.size();
+    EXPECT_EQ(uncompress(raw.data(), &size, reinterpret_cast<const Bytef*>(idat.data()),
+                         uLong(idat.size())),
+              Z_OK);
+    EXPECT_EQ(size, raw.size());
+    return raw;
+}
+
+TEST_F(ImageWriterTest, PngRowsAreStoredThroughTheSubFilter) {
+    const int width = 29, height = 11;
+    for (const int channels : {1, 3}) {
+        std::vector<std::uint8_t> codes(size_t(width) * height * size_t(channels));
+        for (size_t i = 0; i < codes.size(); ++i) codes[i] = std::uint8_t(scene::HashBits(4, 0, i));
+        const fs::path path = folder_ / ("sub" + std::to_string(channels) + ".png");
+        WriteDisplayImage8(path, codes, width, height, channels);
+        const size_t rowBytes = size_t(width) * size_t(channels);
+        const std::vector<std::uint8_t> stored = StoredScanlines(path, rowBytes, size_t(height));
+        for (int y = 0; y < height; ++y) {
+            const std::uint8_t* row = &stored[size_t(y) * (1 + rowBytes)];
+            EXPECT_EQ(row[0], 1) << "row " << y << ": filter type 1 is Sub";
+            // Undoing Sub: Raw(x) = Sub(x) + Raw(x − bpp) mod 256, Raw(x) = 0 left of the row.
+            for (size_t x = 0; x < rowBytes; ++x) {
+                const std::uint8_t left =
+                    x >= size_t(channels) ? codes[size_t(y) * rowBytes + x - size_t(channels)] : 0;
+                EXPECT_EQ(std::uint8_t(row[1 + x] + left), codes[size_t(y) * rowBytes + x])
+                    << "row " << y << " byte " << x;
+            }
+        }
+    }
 }
 
 TEST_F(ImageWriterTest, RejectsUnknownExtensionAndBadSizes) {
