@@ -337,9 +337,8 @@ constexpr float kMaxSeaPixelDepthRatio = 1.1f;
 // samples that see it. 256 bytes (209 used): a cache slot's address is then the slot index
 // shifted, where 224 took a multiplication of three instructions per look-up.
 struct alignas(256) CachedTriangle {
-    uint32_t prim = kNoPrimitive;
+    uint32_t prim = kNoPrimitive;  // kNoPrimitive: empty
     int mesh = 0;
-    uint64_t frame = 0;  // OtwChannel's frame count when gathered (0: never)
     // Vertex v's position then its normal, adjacent: both are interpolated at once on eight
     // lanes (PN), with the same operations per lane as on four.
     F4 pn[3][2] = {};
@@ -383,17 +382,19 @@ struct BlockScratch {
     std::vector<uint8_t> vis;
     size_t skyCount = 0, seaCount = 0;
     SeaChunk chunk{};  // zeroed: lanes past a chunk's end are computed, then dropped
-    // Triangles met, direct-mapped by primitive id and tagged with the frame: neighbouring
-    // samples mostly see the same few triangles (a strip's ids are consecutive), and the next
-    // pixel rows the same ones again (sea vertices are ~6 pixels apart), so each is gathered
-    // about once per block. Entries of another frame or primitive are gathered anew; the
-    // gathered values depend only on the frame and the primitive, so whatever the cache holds
-    // the shading is the same. 2048 entries (512 kB) keep more of the previous block's
+    // Triangles met, direct-mapped by primitive id: neighbouring samples mostly see the same
+    // few triangles (a strip's ids are consecutive), and the next pixel rows the same ones
+    // again (sea vertices are ~6 pixels apart), so each is gathered about once per block.
+    // Entries of another primitive are gathered anew. The cache is emptied when the thread's
+    // first block of a frame starts (trianglesFrame), so that a look-up compares no frame tag.
+    // The gathered values depend only on the frame and the primitive, so whatever the cache
+    // holds the shading is the same. 2048 entries (512 kB) keep more of the previous block's
     // triangles than 1024: otw-center at frames 120-121 gathered 32.3 k triangles, not 41.8 k
     // (4096 entries: 30.1 k). A power of two (the slot is prim & (size − 1));
     // OtwChannel::SetTriangleCacheEntries sets another for tests.
     static constexpr uint32_t kTriangleCacheSize = 2048;
     std::vector<CachedTriangle> triangles = std::vector<CachedTriangle>(kTriangleCacheSize);
+    uint64_t trianglesFrame = 0;  // the frame whose triangles the cache holds (FrameGeometry)
     // A pixel's triangles that could not take their slot in triangles (PixelGather).
     std::vector<CachedTriangle> pixelTriangles =
         std::vector<CachedTriangle>(kMaxSupersampling * kMaxSupersampling);
@@ -454,7 +455,7 @@ struct FrameGeometry {
     glm::dvec3 forward;
     double tanH, tanV;
     glm::vec3 colStep;
-    uint64_t frame = 0;  // OtwChannel's frame count, from 1 (CachedTriangle::frame)
+    uint64_t frame = 0;  // OtwChannel's frame count, from 1 (BlockScratch::trianglesFrame)
 
     glm::vec3 RowBase(double ndcY) const {
         return glm::vec3(forward + R * glm::dvec3(-tanH, 0.0, ndcY * tanV));
@@ -548,10 +549,10 @@ class BlockClassifier {
           depth_(g.vis.depth.data()),
           b1_(g.vis.b1.data()),
           b2_(g.vis.b2.data()),
-          frame_(g.frame),
           triangleMask_(uint32_t(sc.triangles.size()) - 1) {
         CHECK(kN == 0 || kN == g.n);
         CHECK(!sc.triangles.empty() && (sc.triangles.size() & triangleMask_) == 0);
+        CHECK(sc.trianglesFrame == g.frame);
     }
 
     // Classifies the pixels [pxBegin, pxEnd) of pixel row py.
@@ -680,13 +681,12 @@ class BlockClassifier {
     // The cached triangle prim. The hit, most calls, is inlined; the gathering is not.
     __attribute__((always_inline)) const CachedTriangle& Triangle(uint32_t prim) {
         CachedTriangle& tri = sc_.triangles[prim & triangleMask_];
-        if (tri.prim == prim && tri.frame == frame_) [[likely]]
+        if (tri.prim == prim) [[likely]]
             return tri;
         return Gather(prim, tri);
     }
     __attribute__((noinline)) const CachedTriangle& Gather(uint32_t prim, CachedTriangle& tri) {
         g_.Fetch(prim, tri);
-        tri.frame = frame_;
         tri.shadowable = false;
         if (f_.shadows) {
             // Every shadow-ray origin on the triangle lies in its bounding box grown by the
@@ -711,10 +711,9 @@ class BlockClassifier {
     __attribute__((noinline)) const CachedTriangle& PixelGather(uint32_t prim, CachedTriangle& tri,
                                                                 int x0, int s) {
         const int n = N();
-        if (tri.frame == frame_)
-            for (int t = 0; t < s; ++t)
-                if (tri.prim == primitive_[rowIndex_[t / n] + size_t(x0 + t % n)])
-                    return Gather(prim, sc_.pixelTriangles[size_t(s)]);
+        for (int t = 0; t < s; ++t)
+            if (tri.prim == primitive_[rowIndex_[t / n] + size_t(x0 + t % n)])
+                return Gather(prim, sc_.pixelTriangles[size_t(s)]);
         return Gather(prim, tri);
     }
 
@@ -870,9 +869,7 @@ class BlockClassifier {
                     // Triangle(prim), except that a miss must not replace an entry an earlier
                     // sample of the pixel holds (PixelGather).
                     CachedTriangle& tri = sc_.triangles[prim & triangleMask_];
-                    tris[s] = tri.prim == prim && tri.frame == frame_
-                                  ? &tri
-                                  : &PixelGather(prim, tri, x0, s);
+                    tris[s] = tri.prim == prim ? &tri : &PixelGather(prim, tri, x0, s);
                 }
                 lastPrim = prim;
             }
@@ -1063,11 +1060,9 @@ class BlockClassifier {
     const FrameShading& f_;
     BlockScratch& sc_;
     const int y0_;  // first sample row of the block
-    // The visibility buffer's arrays and the frame count, read per sample: one load away here,
-    // not three through g_.
+    // The visibility buffer's arrays, read per sample: one load away here, not three through g_.
     const uint32_t* const primitive_;
     const float *const depth_, *const b1_, *const b2_;
-    const uint64_t frame_;
     const uint32_t triangleMask_;             // triangle cache slots − 1
     glm::vec3 sampleRow_[kMaxSupersampling];  // RowBase of the pixel row's sample rows
     size_t rowIndex_[kMaxSupersampling];      // visibility index of their first sample
@@ -1432,6 +1427,10 @@ void OtwChannel::Render(const scene::SceneState& state, Image& radiance) {
                                                                : BlockScratch::kTriangleCacheSize;
             s.triangles.size() != entries)
             s.triangles.assign(entries, CachedTriangle{});
+        if (s.trianglesFrame != g.frame) {
+            for (CachedTriangle& t : s.triangles) t.prim = kNoPrimitive;
+            s.trianglesFrame = g.frame;
+        }
         const auto span = [&](int py) {
             return renderSpans_.empty() ? PixelSpan{0, cam.width} : renderSpans_[size_t(py)];
         };

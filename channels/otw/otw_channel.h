@@ -101,7 +101,7 @@ class OtwChannel {
     std::unique_ptr<ChannelPlumes> plumes_;  // scenario plumes (channels/plume)
     std::unique_ptr<CloudSky> clouds_;       // cloud pass scratch (environment.clouds)
     OtwFrameStats stats_;
-    uint64_t frames_ = 0;  // frames rendered (tags the shading pass's triangle cache)
+    uint64_t frames_ = 0;  // frames rendered (empties the shading pass's triangle cache)
     std::unique_ptr<OtwBandBasis> basis_;            // null: Rec.709
     Image overlay_;                                  // band basis: grey overlays before conversion
     std::vector<uint8_t> overlayRows_;               // band basis: sample rows overlay_ drew on

@@ -532,5 +532,27 @@ TEST(OtwChannel, ImagesDoNotDependOnTheTriangleCacheSize) {
     }
 }
 
+// The triangle cache outlives a frame (each thread keeps its scratch), but the sea mesh moves:
+// a channel that rendered earlier frames must give the images of a new channel bit for bit
+// (one thread, so every block reads the cache the earlier frames filled; and two).
+TEST(OtwChannel, ImagesDoNotDependOnEarlierFrames) {
+    const scene::Scenario sc = FiveChannelScenario();
+    scene::ChannelSettings ch = *sc.FindChannel("otw-center");
+    ch.width = 320;
+    ch.height = 240;
+    const scene::World world(sc);
+    for (const int threads : {1, 2}) {
+        Image reference, after;
+        tbb::task_arena(threads).execute([&] {
+            OtwChannel fresh(world, ch);
+            fresh.Render(world.State(130), reference);
+            OtwChannel used(world, ch);
+            for (const int64_t frame : {128, 129, 7, 130}) used.Render(world.State(frame), after);
+        });
+        ASSERT_EQ(after.pixels.size(), reference.pixels.size());
+        EXPECT_TRUE(after.pixels == reference.pixels) << threads;
+    }
+}
+
 }  // namespace
 }  // namespace seasense::channels
