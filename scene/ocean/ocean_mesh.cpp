@@ -325,19 +325,65 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
                                            [](float w) { return !(w <= 0.0f); }));
         const int columns = int(ringStart[size_t(j) + 1] - ringStart[size_t(j)]);
         const size_t c0 = size_t(ringFirst[size_t(j)] - colLo), sj = size_t(stride[size_t(j)]);
+        const auto store = [&](size_t v, double rx, double ry, const GeometrySums& s) {
+            out.positions[v] = glm::vec3(float(req.eye_m.x + rx + double(s[kTermDispX])),
+                                         float(req.eye_m.y + ry + double(s[kTermDispY])),
+                                         float(double(s[kTermHeight]) - drop));
+            out.normals[v] = GeometryNormal(s);
+            out.jacobian[v] = GeometryJacobian(s);
+        };
+        // The surf vertices are held until SurfWaves::kBatch of them have their surf terms
+        // made at once (TermsBatch, the same bits as Terms at each: the surf path asks for no
+        // velocity, the dominant component only where the foam reads it, no variance shares,
+        // the seabed DryLandSums looked up); each vertex writes only its own outputs, so the
+        // order they are finished in changes nothing.
+        struct Pending {
+            size_t v;
+            double rx, ry;
+        };
+        std::array<Pending, SurfWaves::kBatch> pending;
+        alignas(32) std::array<double, SurfWaves::kBatch> px, py, pz;
+        size_t held = 0;
+        const auto flush = [&] {
+            if (held == 0) return;
+            const SurfWaves& waves = *frame.Surf();
+            std::array<SurfPointInfo, SurfWaves::kBatch> infos;
+            std::array<SurfaceTerms, SurfWaves::kBatch> terms;
+            waves.TermsBatch(px.data(), py.data(), pz.data(), held, frame.Time_s(), infos.data(),
+                             terms.data());
+            for (size_t b = 0; b < held; ++b) {
+                const SurfPointInfo& info = infos[b];
+                const double x0 = px[b], y0 = py[b];
+                const float rx = float(pending[b].rx), ry = float(pending[b].ry);
+                // Each part of the deep sea with its depth weight, then the surf components.
+                GeometrySums s{};
+                frame.AccumulateFft(x0, y0, filter, s, info.weights.cascade.data());
+                const double wg = info.weights.gerstner;
+                if (ringGerstner && wg == 1.0) {
+                    local.Accumulate(rx, ry, gerstnerWeights.data(), s.data());
+                } else if (ringGerstner && wg > 0.0) {
+                    GeometrySums g{};
+                    local.Accumulate(rx, ry, gerstnerWeights.data(), g.data());
+                    for (int k = 0; k < kGeometryTerms; ++k)
+                        s[size_t(k)] += float(wg) * g[size_t(k)];
+                }
+                frame.AddSurf(x0, y0, terms[b], s);
+                out.surfFoam[pending[b].v] =
+                    info.depth_m < waves.FadeDeep_m()
+                        ? float(SurfFoamCoverage(info, x0, y0, frame.Time_s(),
+                                                 waves.Bathy().Settings().foam))
+                        : 0.0f;
+                store(pending[b].v, pending[b].rx, pending[b].ry, s);
+            }
+            held = 0;
+        };
         for (int i = 0; i < columns; ++i) {
             const double rx = radius * sinAz[c0 + sj * size_t(i)],
                          ry = radius * cosAz[c0 + sj * size_t(i)];
             const size_t v = size_t(ringStart[size_t(j)]) + size_t(i);
             GeometrySums s{};
             const double x0 = req.eye_m.x + rx, y0 = req.eye_m.y + ry;
-            // The surf path: the seabed DryLandSums looked up, no velocity, the dominant
-            // component only where the foam reads it, no variance shares (none of it changes
-            // the surface's bits).
-            SurfWaves::TermsOptions options;
-            options.velocity = false;
-            options.dominant = SurfWaves::Dominant::kWhereBroken;
-            options.shareWeights = false;
+            double seabedZ = 0.0;
             if (!surf || frame.Surf()->Bathy().Frame().ShoreFromWorld(x0, y0).s_m >= openSea) {
                 frame.AccumulateFft(x0, y0, filter, s);
                 if (ringGerstner)
@@ -346,35 +392,17 @@ void BuildOceanMesh(const OceanSurfaceFrame& frame, const OceanMeshRequest& req,
                     frame.AddOpenSea(s);
                     out.surfFoam[v] = 0.0f;  // deeper than FadeDeep_m
                 }
-            } else if (frame.DryLandSums(x0, y0, s, &options.seabedZ_m)) {
+            } else if (frame.DryLandSums(x0, y0, s, &seabedZ)) {
                 out.surfFoam[v] = 0.0f;  // dry sand, never wet: no foam
             } else {
-                // Each part of the deep sea with its depth weight, then the surf components.
-                SurfPointInfo info;
-                const SurfaceTerms st = frame.Surf()->Terms(x0, y0, frame.Time_s(), &info, options);
-                frame.AccumulateFft(x0, y0, filter, s, info.weights.cascade.data());
-                const double wg = info.weights.gerstner;
-                if (ringGerstner && wg == 1.0) {
-                    local.Accumulate(float(rx), float(ry), gerstnerWeights.data(), s.data());
-                } else if (ringGerstner && wg > 0.0) {
-                    GeometrySums g{};
-                    local.Accumulate(float(rx), float(ry), gerstnerWeights.data(), g.data());
-                    for (int k = 0; k < kGeometryTerms; ++k)
-                        s[size_t(k)] += float(wg) * g[size_t(k)];
-                }
-                frame.AddSurf(x0, y0, st, s);
-                const SurfWaves& waves = *frame.Surf();
-                out.surfFoam[v] = info.depth_m < waves.FadeDeep_m()
-                                      ? float(SurfFoamCoverage(info, x0, y0, frame.Time_s(),
-                                                               waves.Bathy().Settings().foam))
-                                      : 0.0f;
+                pending[held] = {v, rx, ry};
+                px[held] = x0, py[held] = y0, pz[held] = seabedZ;
+                if (++held == SurfWaves::kBatch) flush();
+                continue;
             }
-            out.positions[v] = glm::vec3(float(req.eye_m.x + rx + double(s[kTermDispX])),
-                                         float(req.eye_m.y + ry + double(s[kTermDispY])),
-                                         float(double(s[kTermHeight]) - drop));
-            out.normals[v] = GeometryNormal(s);
-            out.jacobian[v] = GeometryJacobian(s);
+            store(v, rx, ry, s);
         }
+        flush();
     });
 
     if (sameShape) return;

@@ -29,7 +29,8 @@ constexpr int kMaxSamples = 40000;
 
 // Cosine of the fade angle at depth h for a wave fading from deep (depth ≥ deep) to nothing
 // (depth ≤ deep / 2); its sine is the weight of what replaces it, so cos² + sin² = 1. Inlined
-// into Terms (twice a surf vertex): most calls end at the first test, cheaper than the call.
+// into Terms (twice a surf point): most calls end at the first test, cheaper than the call. The
+// mesh's batches take it four points at a time (FadeLanes, below TermsImpl).
 [[gnu::always_inline]] inline double Fade(double h, double deep) {
     const double shallow = 0.5 * deep;
     if (h >= deep) return 1.0;
@@ -902,8 +903,9 @@ SurfWaves::Bound SurfWaves::BoundAtDepths(double minDepth_m, const BoundTable& t
 namespace {
 
 // Terms (wide or not) into a scratch point information, for callers that want none: out of
-// line, so that Terms itself, whose callers hand theirs (the mesh), needs no stack frame for one
-// (a scratch made on every call cost ~12 instructions a mesh vertex).
+// line, so that Terms itself, whose callers hand theirs (the sea's sample, the spray), needs no
+// stack frame for one (a scratch made on every call cost ~12 instructions a mesh vertex, when
+// the mesh still came here one vertex at a time).
 [[gnu::noinline]] SurfaceTerms TermsIntoScratch(const SurfWaves& waves, double x0, double y0,
                                                 double t, const SurfWaves::TermsOptions& options,
                                                 bool wide) {
@@ -967,86 +969,9 @@ SurfaceTerms SurfWaves::TermsImpl(double x0, double y0, double t, SurfPointInfo*
     if (SwashReaches(h)) out.displacement.z += Swash_m(p.s_m, p.u_m, t, h);
     if (weights.AllDeep() || h <= 0.0 || incoming_.empty()) return out;
 
-    // One interpolation position for every component: the depth samples and the cross-shore
-    // phases are stored by sample (see the constructor).
-    const size_t n = incoming_.size(), lanes = lanes_;
-    const double hh = std::max(h, kMinDepth_m);
-    const double dx = std::min(hh / dh_m_, double(depthSamples_ - 1));
-    const size_t di = std::min(size_t(dx), size_t(depthSamples_ - 2));
-    const double df = dx - double(di);
-    const size_t phaseSamples = phaseSamples_;
-    const double px = std::clamp(tableIndex, 0.0, double(phaseSamples - 1));
-    const size_t pi = std::min(size_t(px), phaseSamples - 2);
-    const double pf = px - double(pi);
-    const float* d0 = laneDepth_.data() + di * kLaneFields * lanes;
-    const float* d1 = d0 + kLaneFields * lanes;
-    const double* p0 = lanePhase_.data() + pi * lanes;
-    const double* p1 = p0 + lanes;
-
-    // The phases two (AVX2: four) at a time in double precision (they grow with time and
-    // distance), reduced to [−π, π] by whole turns; their sines and cosines then four (AVX2:
-    // eight) at a time in single precision (simd4::SinCosLanes, ~2e-7), and the components'
-    // terms summed four at a time in single precision too (lane m mod 4 holds components m, m + 4,
-    // ...; the lanes reduced in double as (0 + 2) + (1 + 3) at the end): a fixed order, so the mesh
-    // and the queries, which both come here, get the same bits. The surface is stored in floats and
-    // a sum of ≤ 20 float terms of ≤ a few metres is good to ~1e-6 m, so nothing visible is lost,
-    // and four lanes cost half of two. Everything is summed before the breaker cap and the
-    // steepness Q, which scale whole sums (below); the tensors and vectors are summed in the shore
-    // frame and turned to the world once.
-    const PhaseInputs phaseIn{laneOrigin_.data(),
-                              laneKu_.data(),
-                              laneOmega_.data(),
-                              laneKs0_.data(),
-                              p0,
-                              p1,
-                              pf,
-                              p.u_m,
-                              t,
-                              p.s_m,
-                              sRef_m_,
-                              p.s_m >= sRef_m_};
-    alignas(32) std::array<double, kMaxSurfComponents> psis;
-    alignas(32) std::array<float, kMaxSurfComponents> reduced;
-    size_t lane = 0;
-#if defined(__AVX2__)
-    if constexpr (kWide)
-        for (; lane + 4 <= lanes; lane += 4)
-            PhaseGroup<__m256d>(phaseIn, lane, psis.data(), reduced.data());
-#endif
-    for (; lane < lanes; lane += 2) PhaseGroup<__m128d>(phaseIn, lane, psis.data(), reduced.data());
-    const ComponentInputs in{reduced.data(),
-                             laneKuF_.data(),
-                             laneOmegaF_.data(),
-                             laneSpectral_.data(),
-                             d0,
-                             d1,
-                             lanes,
-                             float(df),
-                             float(weights.spectralSurf),
-                             float(weights.gerstnerSurf)};
-    LaneSums sums;
-    alignas(32) std::array<float, kMaxSurfComponents> amplitudes;
-    lane = 0;
-#if defined(__AVX2__)
-    if constexpr (kWide)
-        for (; lane + 8 <= lanes; lane += 8)
-            ComponentGroup<kVelocity, simd4::F8>(in, lane, sums, amplitudes.data());
-#endif
-    for (; lane < lanes; lane += 4)
-        ComponentGroup<kVelocity, F4>(in, lane, sums, amplitudes.data());
-    // Each sum's lanes reduced in double, (lane 0 + lane 2) + (lane 1 + lane 3): with kWide
-    // four sums at a time (SumLanes), else one by one, the reference the tests compare with.
-    alignas(32) std::array<double, 12> total;
-    const auto reduce = [](F4 a, F4 b, F4 c, F4 d, double* out) {
-        if constexpr (kWide) {
-            SumLanes(a, b, c, d, out);
-        } else {
-            out[0] = SumLanes(a), out[1] = SumLanes(b), out[2] = SumLanes(c), out[3] = SumLanes(d);
-        }
-    };
-    reduce(sums.re, sums.im, sums.slopeS, sums.slopeU, total.data());
-    reduce(sums.dispS, sums.dispU, sums.tSS, sums.tUU, total.data() + 4);
-    reduce(sums.tSU, sums.orbit, sums.velZ, sums.velS, total.data() + 8);
+    PointSums sums;
+    SumComponents<kVelocity, kWide>(p.s_m, p.u_m, h, t, tableIndex, weights, sums);
+    const std::array<double, 12>& total = sums.total;
     const double envelopeRe = total[0], envelopeIm = total[1];
     const double A = std::sqrt(envelopeRe * envelopeRe + envelopeIm * envelopeIm);
     // Behind a sandbar only the energy flux the bar let through arrives (Shelter).
@@ -1077,11 +1002,7 @@ SurfaceTerms SurfWaves::TermsImpl(double x0, double y0, double t, SurfPointInfo*
     // their orbits, each ∝ a/(kh), which grow without bound as h → 0. Scaling the horizontal
     // field by one factor keeps its direction; the factor's own gradient is left out of the
     // Jacobian terms.
-    alignas(16) std::array<float, 4> longestLanes;
-    _mm_store_ps(longestLanes.data(), sums.longest);
-    const double longestInvTanh =
-        double(std::max({longestLanes[0], longestLanes[1], longestLanes[2], longestLanes[3]}));
-    const double limit = std::min(cap * total[9], 0.5 * gammaH * longestInvTanh);
+    const double limit = std::min(cap * total[9], 0.5 * gammaH * sums.longestInvTanh);
     const double len = std::sqrt(horizontal.x * horizontal.x + horizontal.y * horizontal.y);
     const double f = len > limit && len > 0.0 ? limit / len : 1.0;
     out.displacement.x = f * horizontal.x;
@@ -1090,32 +1011,316 @@ SurfaceTerms SurfWaves::TermsImpl(double x0, double y0, double t, SurfPointInfo*
     out.dyy = f * dyy;
     out.dxy = f * dxy;
     if constexpr (kVelocity) {
-        const glm::dvec2 horizontalVelocity = qc * (total[11] * es + SumLanes(sums.velU) * eu);
+        const glm::dvec2 horizontalVelocity = qc * (total[11] * es + sums.velU * eu);
         out.velocity_mps.x = f * horizontalVelocity.x;
         out.velocity_mps.y = f * horizontalVelocity.y;
     }
-    if (n > 0 && (options.dominant == Dominant::kEverywhere || local.breaking.broken)) {
-        // The dominant component: the largest local amplitude (the first of equals).
-        size_t best = 0;
-        for (size_t m = 1; m < n; ++m)
-            if (amplitudes[m] > amplitudes[best]) best = m;
-        const DepthSample& s0 = depth_[di * n + best];
-        const DepthSample& s1 = depth_[(di + 1) * n + best];
-        const double k = s0.k + df * (s1.k - s0.k);
-        const double kx = s0.kx + df * (s1.kx - s0.kx);
-        const glm::dvec2 kw = bathy_.Frame().WorldFromShoreDirection({kx, laneKu_[best]});
-        local.direction_rad = std::atan2(kw.x, kw.y);
-        if (local.direction_rad < 0.0) local.direction_rad += kTwoPi;
-        local.phaseSpeed_mps = laneOmega_[best] / k;
-        local.groupSpeed_mps = s0.cg + df * (s1.cg - s0.cg);
-        local.phase_rad = std::fmod(psis[best], kTwoPi);
-        if (local.phase_rad < 0.0) local.phase_rad += kTwoPi;
-    }
+    if (options.dominant == Dominant::kEverywhere || local.breaking.broken)
+        DominantInto(sums, local);
     local.envelope_m = A * cap;
     local.unbrokenHeight_m = 2.0 * A;
     // Sheltered waves are already broken down to what the bar let through: no new breaking.
     local.breaking.intensity = cap < 1.0 && shelter == 1.0 ? 1.0 - cap * cap : 0.0;
     return out;
+}
+
+template <bool kVelocity, bool kWide>
+[[gnu::always_inline]] inline void SurfWaves::SumComponents(double s_m, double u_m, double h,
+                                                            double t, double tableIndex,
+                                                            const SurfWeights& weights,
+                                                            PointSums& sums) const {
+    // One interpolation position for every component: the depth samples and the cross-shore
+    // phases are stored by sample (see the constructor).
+    const size_t lanes = lanes_;
+    const double hh = std::max(h, kMinDepth_m);
+    const double dx = std::min(hh / dh_m_, double(depthSamples_ - 1));
+    const size_t di = std::min(size_t(dx), size_t(depthSamples_ - 2));
+    const double df = dx - double(di);
+    sums.di = di;
+    sums.df = df;
+    const size_t phaseSamples = phaseSamples_;
+    const double px = std::clamp(tableIndex, 0.0, double(phaseSamples - 1));
+    const size_t pi = std::min(size_t(px), phaseSamples - 2);
+    const double pf = px - double(pi);
+    const float* d0 = laneDepth_.data() + di * kLaneFields * lanes;
+    const float* d1 = d0 + kLaneFields * lanes;
+    const double* p0 = lanePhase_.data() + pi * lanes;
+    const double* p1 = p0 + lanes;
+
+    // The phases two (AVX2: four) at a time in double precision (they grow with time and
+    // distance), reduced to [−π, π] by whole turns; their sines and cosines then four (AVX2:
+    // eight) at a time in single precision (simd4::SinCosLanes, ~2e-7), and the components'
+    // terms summed four at a time in single precision too (lane m mod 4 holds components m, m + 4,
+    // ...; the lanes reduced in double as (0 + 2) + (1 + 3) at the end): a fixed order, so the mesh
+    // and the queries, which both come here, get the same bits. The surface is stored in floats and
+    // a sum of ≤ 20 float terms of ≤ a few metres is good to ~1e-6 m, so nothing visible is lost,
+    // and four lanes cost half of two. Everything is summed before the breaker cap and the
+    // steepness Q, which scale whole sums (the callers); the tensors and vectors are summed in the
+    // shore frame and turned to the world once.
+    const PhaseInputs phaseIn{laneOrigin_.data(),
+                              laneKu_.data(),
+                              laneOmega_.data(),
+                              laneKs0_.data(),
+                              p0,
+                              p1,
+                              pf,
+                              u_m,
+                              t,
+                              s_m,
+                              sRef_m_,
+                              s_m >= sRef_m_};
+    alignas(32) std::array<float, kMaxSurfComponents> reduced;
+    size_t lane = 0;
+#if defined(__AVX2__)
+    if constexpr (kWide)
+        for (; lane + 4 <= lanes; lane += 4)
+            PhaseGroup<__m256d>(phaseIn, lane, sums.psis.data(), reduced.data());
+#endif
+    for (; lane < lanes; lane += 2)
+        PhaseGroup<__m128d>(phaseIn, lane, sums.psis.data(), reduced.data());
+    const ComponentInputs in{reduced.data(),
+                             laneKuF_.data(),
+                             laneOmegaF_.data(),
+                             laneSpectral_.data(),
+                             d0,
+                             d1,
+                             lanes,
+                             float(df),
+                             float(weights.spectralSurf),
+                             float(weights.gerstnerSurf)};
+    LaneSums s;
+    lane = 0;
+#if defined(__AVX2__)
+    if constexpr (kWide)
+        for (; lane + 8 <= lanes; lane += 8)
+            ComponentGroup<kVelocity, simd4::F8>(in, lane, s, sums.amplitudes.data());
+#endif
+    for (; lane < lanes; lane += 4)
+        ComponentGroup<kVelocity, F4>(in, lane, s, sums.amplitudes.data());
+    // Each sum's lanes reduced in double, (lane 0 + lane 2) + (lane 1 + lane 3): with kWide
+    // four sums at a time (SumLanes), else one by one, the reference the tests compare with.
+    const auto reduce = [](F4 a, F4 b, F4 c, F4 d, double* out) {
+        if constexpr (kWide) {
+            SumLanes(a, b, c, d, out);
+        } else {
+            out[0] = SumLanes(a), out[1] = SumLanes(b), out[2] = SumLanes(c), out[3] = SumLanes(d);
+        }
+    };
+    reduce(s.re, s.im, s.slopeS, s.slopeU, sums.total.data());
+    reduce(s.dispS, s.dispU, s.tSS, s.tUU, sums.total.data() + 4);
+    reduce(s.tSU, s.orbit, s.velZ, s.velS, sums.total.data() + 8);
+    if constexpr (kVelocity) sums.velU = SumLanes(s.velU);
+    alignas(16) std::array<float, 4> longestLanes;
+    _mm_store_ps(longestLanes.data(), s.longest);
+    sums.longestInvTanh =
+        double(std::max({longestLanes[0], longestLanes[1], longestLanes[2], longestLanes[3]}));
+}
+
+void SurfWaves::DominantInto(const PointSums& sums, SurfPointInfo& local) const {
+    const size_t n = incoming_.size();
+    // The dominant component: the largest local amplitude (the first of equals).
+    size_t best = 0;
+    for (size_t m = 1; m < n; ++m)
+        if (sums.amplitudes[m] > sums.amplitudes[best]) best = m;
+    const double df = sums.df;
+    const DepthSample& s0 = depth_[sums.di * n + best];
+    const DepthSample& s1 = depth_[(sums.di + 1) * n + best];
+    const double k = s0.k + df * (s1.k - s0.k);
+    const double kx = s0.kx + df * (s1.kx - s0.kx);
+    const glm::dvec2 kw = bathy_.Frame().WorldFromShoreDirection({kx, laneKu_[best]});
+    local.direction_rad = std::atan2(kw.x, kw.y);
+    if (local.direction_rad < 0.0) local.direction_rad += kTwoPi;
+    local.phaseSpeed_mps = laneOmega_[best] / k;
+    local.groupSpeed_mps = s0.cg + df * (s1.cg - s0.cg);
+    local.phase_rad = std::fmod(sums.psis[best], kTwoPi);
+    if (local.phase_rad < 0.0) local.phase_rad += kTwoPi;
+}
+
+namespace {
+
+// Four double lanes (GCC vector extensions: each operation is the IEEE operation per lane).
+using D4 = double __attribute__((vector_size(32)));
+using I4 = int64_t __attribute__((vector_size(32)));
+
+[[gnu::always_inline]] inline D4 Sqrt(D4 v) {
+#if defined(__AVX__)
+    return (D4)_mm256_sqrt_pd((__m256d)v);
+#else
+    return D4{std::sqrt(v[0]), std::sqrt(v[1]), std::sqrt(v[2]), std::sqrt(v[3])};
+#endif
+}
+
+// cos x per lane with SinCos's operations (sincos.h) in its order: the same bits as its cosX.
+[[gnu::always_inline]] inline D4 CosLanes(D4 x) {
+    constexpr double kTwoOverPi = 0.6366197723675814;
+    constexpr double kHalfPiHi = 1.5707963267341256;
+    constexpr double kHalfPiLo = 6.077100506506192e-11;
+    constexpr double kRound = 6755399441055744.0;
+    const D4 shifted = x * kTwoOverPi + kRound;
+    const D4 n = shifted - kRound;
+    const I4 quadrant = (I4)shifted & 3;
+    const D4 r = (x - n * kHalfPiHi) - n * kHalfPiLo;
+    const D4 r2 = r * r;
+    const D4 s =
+        r + r * r2 *
+                (-1.0 / 6 +
+                 r2 * (1.0 / 120 +
+                       r2 * (-1.0 / 5040 +
+                             r2 * (1.0 / 362880 + r2 * (-1.0 / 39916800 +
+                                                        r2 * (1.0 / 6227020800 +
+                                                              r2 * (-1.0 / 1307674368000.0)))))));
+    const D4 c =
+        1.0 + r2 * (-0.5 + r2 * (1.0 / 24 +
+                                 r2 * (-1.0 / 720 +
+                                       r2 * (1.0 / 40320 +
+                                             r2 * (-1.0 / 3628800 +
+                                                   r2 * (1.0 / 479001600 +
+                                                         r2 * (-1.0 / 87178291200.0 +
+                                                               r2 * (1.0 / 20922789888000.0))))))));
+    // SinCos's double(quadrant & 1) and 1 − double((quadrant + 1) & 2), exact small integers,
+    // picked rather than converted (AVX2 has no 64-bit integer to double conversion).
+    const D4 zero{}, one = zero + 1.0;
+    const D4 swap = (quadrant & 1) != 0 ? one : zero;
+    const D4 cosSign = ((quadrant + 1) & 2) != 0 ? -one : one;
+    return cosSign * (c + swap * (s - c));
+}
+
+// Fade (above) per lane: the cosine taken in every lane, then 0 and 1 where Fade returns them.
+[[gnu::always_inline]] inline D4 FadeLanes(D4 h, double deep) {
+    const double shallow = 0.5 * deep;
+    const D4 zero{}, one = zero + 1.0;
+    D4 f = CosLanes(0.5 * std::numbers::pi * (deep - h) / (deep - shallow));
+    f = h <= shallow ? zero : f;
+    return h >= deep ? one : f;
+}
+
+// std::min(a, b), std::max(a, b) and std::clamp(v, lo, hi) per lane, their comparisons.
+[[gnu::always_inline]] inline D4 Min(D4 a, D4 b) { return b < a ? b : a; }
+[[gnu::always_inline]] inline D4 Max(D4 a, D4 b) { return a < b ? b : a; }
+[[gnu::always_inline]] inline D4 Clamp(D4 v, D4 lo, D4 hi) {
+    return v < lo ? lo : (hi < v ? hi : v);
+}
+
+}  // namespace
+
+void SurfWaves::TermsBatch(const double* x0, const double* y0, const double* seabedZ_m,
+                           size_t count, double t, SurfPointInfo* infos, SurfaceTerms* out) const {
+    CHECK(count <= kBatch);
+    // Lanes past count repeat the last point; their results are not stored.
+    alignas(32) std::array<double, kBatch> xs, ys, zBeds;
+    for (size_t l = 0; l < kBatch; ++l) {
+        const size_t i = std::min(l, count - 1);
+        xs[l] = x0[i], ys[l] = y0[i], zBeds[l] = seabedZ_m[i];
+    }
+    const auto load = [](const std::array<double, kBatch>& a) {
+        D4 v;
+        std::memcpy(&v, a.data(), sizeof v);
+        return v;
+    };
+    // ShoreFromWorld, glm::dot's order.
+    const ShoreFrame& frame = bathy_.Frame();
+    const glm::dvec2 origin = frame.Origin_m(), es = seawardWorld_, eu = alongshoreWorld_;
+    const glm::dvec2 seaward = frame.Seaward(), along = frame.Alongshore();
+    const D4 dx = load(xs) - origin.x, dy = load(ys) - origin.y;
+    const D4 sv = dx * seaward.x + dy * seaward.y, uv = dx * along.x + dy * along.y;
+    const D4 zBed = load(zBeds);
+    const D4 h = bathy_.Tide_m() - zBed;
+
+    // WeightsInto per lane. Where h ≥ FadeDeep_m it returns early with the defaults; every Fade
+    // is 1 there, so the lanes' sums give those same values (gerstnerSurf √(+0), lost +0).
+    const D4 zero{}, one = zero + 1.0;
+    const D4 gerstner = FadeLanes(h, peakFadeDeep_m_);
+    const D4 gerstnerSurf = Sqrt(Max(zero, 1.0 - gerstner * gerstner));
+    D4 spectralSurf = gerstnerSurf;
+    std::array<D4, kMaxSurfCascades> cascade;
+    if (cascadeFade_) {
+        D4 lost = zero;
+        for (size_t c = 0; c < cascades_.size(); ++c) {
+            const double deep = 0.5 * cascades_[c].wavelength_m;
+            const D4 f = deep == peakFadeDeep_m_ ? gerstner : FadeLanes(h, deep);
+            cascade[c] = f;
+            lost += cascades_[c].variance_m2 * (1.0 - f * f);
+        }
+        spectralSurf = Sqrt(Clamp(lost / cascadeVariance_m2_, zero, one));
+    }
+    const D4 tableIndex = (sRef_m_ - sv) / ds_m_;
+
+    // Per point: the information, the swash and the component sums.
+    std::array<PointSums, kBatch> sums;
+    alignas(32) std::array<double, kBatch> swash{}, shelters;
+    std::array<bool, kBatch> active{};
+    for (size_t l = 0; l < count; ++l) {
+        SurfPointInfo& local = infos[l];
+        local = SurfPointInfo{};
+        local.depth_m = h[l];
+        local.seabedZ_m = zBed[l];
+        SurfWeights& w = local.weights;
+        w.gerstner = gerstner[l];
+        w.gerstnerSurf = gerstnerSurf[l];
+        w.spectralSurf = spectralSurf[l];
+        if (cascadeFade_)
+            for (size_t c = 0; c < cascades_.size(); ++c) w.cascade[c] = cascade[c][l];
+        if (breakingLine_) {
+            local.breaking.broken = sv[l] <= sBreak_m_;
+            if (local.breaking.broken)
+                local.breaking.timeSinceBreaking_s = Interp(breakTime_s_, tableIndex[l]);
+        }
+        if (SwashReaches(h[l])) swash[l] += Swash_m(sv[l], uv[l], t, h[l]);
+        out[l] = SurfaceTerms{};
+        out[l].displacement.z = swash[l];
+        active[l] = !(w.AllDeep() || h[l] <= 0.0 || incoming_.empty());
+        shelters[l] = 1.0;
+        if (!active[l]) continue;
+        SumComponents<false, true>(sv[l], uv[l], h[l], t, tableIndex[l], w, sums[l]);
+        shelters[l] = Shelter(sv[l], uv[l], h[l]);
+    }
+    // The arithmetic after the sums (TermsImpl's), a point a lane; inactive lanes' sums are 0.
+    alignas(32) std::array<std::array<double, kBatch>, 10> totals{};
+    alignas(32) std::array<double, kBatch> longest{};
+    for (size_t l = 0; l < count; ++l) {
+        if (!active[l]) continue;
+        for (size_t k = 0; k < 10; ++k) totals[k][l] = sums[l].total[k];
+        longest[l] = sums[l].longestInvTanh;
+    }
+    const D4 envelopeRe = load(totals[0]), envelopeIm = load(totals[1]);
+    const D4 A = Sqrt(envelopeRe * envelopeRe + envelopeIm * envelopeIm);
+    const D4 shelter = load(shelters);
+    const D4 gammaH = settings_.breakerIndex * h * shelter;
+    const D4 cap = 2.0 * A > gammaH ? gammaH / (2.0 * A) : one;
+    const D4 q = settings_.deepSteepness +
+                 (1.0 - settings_.deepSteepness) * Min(one, 2.0 * A / Max(gammaH, zero + 1e-9));
+    const D4 z = load(swash) + cap * envelopeRe;
+    const D4 slopeX = cap * (load(totals[2]) * es.x + load(totals[3]) * eu.x);
+    const D4 slopeY = cap * (load(totals[2]) * es.y + load(totals[3]) * eu.y);
+    const D4 qc = q * cap;
+    const D4 horizontalX = qc * (load(totals[4]) * es.x + load(totals[5]) * eu.x);
+    const D4 horizontalY = qc * (load(totals[4]) * es.y + load(totals[5]) * eu.y);
+    const D4 ss = qc * load(totals[6]), uu = qc * load(totals[7]), su = qc * load(totals[8]);
+    const D4 dxx = ss * es.x * es.x + 2.0 * su * es.x * eu.x + uu * eu.x * eu.x;
+    const D4 dyy = ss * es.y * es.y + 2.0 * su * es.y * eu.y + uu * eu.y * eu.y;
+    const D4 dxy = ss * es.x * es.y + su * (es.x * eu.y + eu.x * es.y) + uu * eu.x * eu.y;
+    const D4 limit = Min(cap * load(totals[9]), 0.5 * gammaH * load(longest));
+    const D4 len = Sqrt(horizontalX * horizontalX + horizontalY * horizontalY);
+    const D4 f = len > limit && len > 0.0 ? limit / len : one;
+    const D4 dispX = f * horizontalX, dispY = f * horizontalY;
+    const D4 outXX = f * dxx, outYY = f * dyy, outXY = f * dxy;
+    const D4 envelope = A * cap, unbroken = 2.0 * A;
+    const D4 intensity = cap < 1.0 && shelter == 1.0 ? 1.0 - cap * cap : zero;
+    for (size_t l = 0; l < count; ++l) {
+        if (!active[l]) continue;
+        SurfaceTerms& o = out[l];
+        o.displacement = {dispX[l], dispY[l], z[l]};
+        o.sx = slopeX[l];
+        o.sy = slopeY[l];
+        o.dxx = outXX[l];
+        o.dyy = outYY[l];
+        o.dxy = outXY[l];
+        SurfPointInfo& local = infos[l];
+        if (local.breaking.broken) DominantInto(sums[l], local);
+        local.envelope_m = envelope[l];
+        local.unbrokenHeight_m = unbroken[l];
+        local.breaking.intensity = intensity[l];
+    }
 }
 
 }  // namespace seasense::scene

@@ -138,8 +138,9 @@ class SurfWaves {
     // and breaking.timeSinceBreaking_s is left −1 there (the foam reads it only where broken),
     // saving a table lookup.
     enum class Dominant { kEverywhere, kWhereBroken };
-    // What a caller that needs less than everything (the mesh) can leave out or hand in. None of
-    // it changes a bit of the terms, nor of what the surf foam reads.
+    // What a caller that needs less than everything can leave out or hand in (TermsBatch, the
+    // mesh's, runs with velocity and shareWeights false, kWhereBroken and the seabed handed
+    // in). None of it changes a bit of the terms, nor of what the surf foam reads.
     struct TermsOptions {
         bool velocity = true;  // false: velocity_mps left 0 (three sums fewer per component)
         Dominant dominant = Dominant::kEverywhere;
@@ -162,6 +163,15 @@ class SurfWaves {
     // reference the AVX2 build's eight-lane loops must equal bit for bit (tests).
     SurfaceTerms TermsFourLanes(double x0, double y0, double t_s, SurfPointInfo* info,
                                 const TermsOptions& options) const;
+    // Terms at count ≤ kBatch points at once with the options the mesh asks for (no velocity,
+    // the dominant component where broken, no variance shares, each point's seabed handed in
+    // as seabedZ_m[i]): the same bits as Terms at each point alone (tested). The depth weights
+    // (Fade's sine-cosine) and the arithmetic after the component sums, scalar double code
+    // that was most of a point's cost, run one point a lane on four double lanes with the
+    // same operations in the same order; the component sums stay per point.
+    static constexpr size_t kBatch = 4;
+    void TermsBatch(const double* x0, const double* y0, const double* seabedZ_m, size_t count,
+                    double t_s, SurfPointInfo* infos, SurfaceTerms* out) const;
 
     // Upper bounds of the sea at still-water depths ≥ minDepth_m: its height above the tide and
     // its horizontal displacement (m). The deep parts enter with their own bounds (each FFT
@@ -287,6 +297,23 @@ class SurfWaves {
     template <bool kVelocity, bool kWide>
     SurfaceTerms TermsImpl(double x0, double y0, double t_s, SurfPointInfo* info,
                            const TermsOptions& options) const;
+    // What Terms' component loops give at a point (TermsImpl and TermsBatch share them): the
+    // sums reduced in double (re, im, slopeS, slopeU, dispS, dispU, tSS, tUU, tSU, orbit, velZ,
+    // velS; velU apart), the largest 1/tanh kh, the depth interpolation and, for the dominant
+    // component, each component's phase and amplitude.
+    struct PointSums {
+        alignas(32) std::array<double, 12> total;
+        double velU, longestInvTanh;
+        size_t di;
+        double df;
+        alignas(32) std::array<double, kMaxSurfComponents> psis;
+        alignas(32) std::array<float, kMaxSurfComponents> amplitudes;
+    };
+    template <bool kVelocity, bool kWide>
+    void SumComponents(double s_m, double u_m, double h, double t_s, double tableIndex,
+                       const SurfWeights& weights, PointSums& sums) const;
+    // The dominant component's fields of info (direction, speeds, phase).
+    void DominantInto(const PointSums& sums, SurfPointInfo& info) const;
     void BuildSwash();
     SwashParameters swash_;
     std::vector<double> swashAmplitude_, swashPhase_;  // per component at the breaker line

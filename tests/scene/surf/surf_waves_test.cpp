@@ -621,5 +621,95 @@ TEST(SurfWaves, PointInformationInPlaceIsAFreshPointsWeightsAndBreaking) {
     EXPECT_GT(deep, 100u);
 }
 
+// The mesh's batches (TermsBatch, up to four points a call, one point a double lane) must give
+// Terms' bits at each point with the mesh's options: the terms and every field of the point's
+// information. A turned shoreline with a sandbar region (shelter behind the bar) and the swash,
+// two cascades (one fading with the peak, one with its own wavelength), points from the dry
+// beach through the breakers and both fades (either half of each: Fade's cosine in both
+// quadrants) to past the deepest fade, batches of every size.
+TEST(SurfWaves, BatchesGiveEachPointsTermsBitForBit) {
+    SurfSettings settings = Beach(0.05);
+    settings.shoreline = {{13.0, -7.0}, 0.7};
+    SurfRegionSettings bar, plain;
+    bar.width_m = plain.width_m = 200.0;
+    bar.sandbar = SandbarSettings{20.0, 120.0, 0.6, 40.0, 15.0};
+    settings.regions = {bar, plain};
+    const Bathymetry b(settings, 12.0);
+    std::vector<SurfComponent> components;
+    for (size_t j = 0; j < 13; ++j) {
+        SurfComponent c = Wave(0.12 + 0.02 * double(j % 4), 4.0 + 0.5 * double(j),
+                               40.0 + 25.0 * std::sin(1.3 * double(j)));
+        c.phase_rad = 0.7 * double(j);
+        c.spectral = j != 0;
+        components.push_back(c);
+    }
+    const double peak = 16.0;
+    const SurfWaves w(b, components, peak, {{0.4, peak}, {0.1, 6.0}});
+    ASSERT_TRUE(std::isfinite(w.BreakerLine_m()));
+    ASSERT_TRUE(w.Swash().active);
+    const auto bits = [](double v) { return std::bit_cast<uint64_t>(v); };
+    const auto sameInfo = [&](const SurfPointInfo& a, const SurfPointInfo& c) {
+        for (const auto field : {&SurfPointInfo::depth_m, &SurfPointInfo::seabedZ_m,
+                                 &SurfPointInfo::deepWeight, &SurfPointInfo::surfWeight,
+                                 &SurfPointInfo::envelope_m, &SurfPointInfo::unbrokenHeight_m,
+                                 &SurfPointInfo::direction_rad, &SurfPointInfo::phaseSpeed_mps,
+                                 &SurfPointInfo::groupSpeed_mps, &SurfPointInfo::phase_rad})
+            if (bits(a.*field) != bits(c.*field)) return false;
+        for (size_t k = 0; k < kMaxSurfCascades; ++k)
+            if (bits(a.weights.cascade[k]) != bits(c.weights.cascade[k])) return false;
+        return bits(a.weights.gerstner) == bits(c.weights.gerstner) &&
+               bits(a.weights.spectralSurf) == bits(c.weights.spectralSurf) &&
+               bits(a.weights.gerstnerSurf) == bits(c.weights.gerstnerSurf) &&
+               bits(a.breaking.intensity) == bits(c.breaking.intensity) &&
+               a.breaking.broken == c.breaking.broken &&
+               bits(a.breaking.timeSinceBreaking_s) == bits(c.breaking.timeSinceBreaking_s);
+    };
+    const double peakDeep = w.PeakFadeDeep_m(), chopDeep = 3.0;
+    size_t dry = 0, swash = 0, broken = 0, breaking = 0, deep = 0;
+    size_t peakHalves[2] = {0, 0}, chopHalves[2] = {0, 0};
+    int point = 0;
+    for (int group = 0; group < 2400; ++group) {
+        const size_t count = 1 + size_t(group) % SurfWaves::kBatch;
+        std::array<double, SurfWaves::kBatch> x{}, y{}, z{};
+        for (size_t l = 0; l < count; ++l, ++point) {
+            const double s = -15.0 + 0.11 * point, u = 400.0 * std::sin(0.017 * point);
+            const glm::dvec2 p = b.Frame().WorldFromShore(s, u);
+            x[l] = p.x, y[l] = p.y;
+            const ShorePoint sp = b.Frame().ShoreFromWorld(p.x, p.y);
+            z[l] = b.SeabedZAtShore_m(sp.s_m, sp.u_m);
+        }
+        const double t = 0.61 * group;
+        std::array<SurfPointInfo, SurfWaves::kBatch> infos;
+        std::array<SurfaceTerms, SurfWaves::kBatch> terms;
+        w.TermsBatch(x.data(), y.data(), z.data(), count, t, infos.data(), terms.data());
+        for (size_t l = 0; l < count; ++l) {
+            SurfWaves::TermsOptions options;
+            options.velocity = false;
+            options.dominant = SurfWaves::Dominant::kWhereBroken;
+            options.shareWeights = false;
+            options.seabedZ_m = z[l];
+            SurfPointInfo info;
+            const SurfaceTerms one = w.Terms(x[l], y[l], t, &info, options);
+            ASSERT_EQ(std::memcmp(&one, &terms[l], sizeof one), 0) << group << " " << l;
+            ASSERT_TRUE(sameInfo(info, infos[l])) << group << " " << l;
+            const double h = info.depth_m;
+            dry += h <= 0.0;
+            swash += w.SwashReaches(h) && one.displacement.z != 0.0;
+            broken += info.breaking.broken;
+            breaking += info.breaking.intensity > 0.0;
+            deep += h >= w.FadeDeep_m();
+            if (h > 0.5 * peakDeep && h < peakDeep) ++peakHalves[h > 0.75 * peakDeep];
+            if (h > 0.5 * chopDeep && h < chopDeep) ++chopHalves[h > 0.75 * chopDeep];
+        }
+    }
+    EXPECT_GT(dry, 50u);
+    EXPECT_GT(swash, 50u);
+    EXPECT_GT(broken, 150u);
+    EXPECT_GT(breaking, 50u);
+    EXPECT_GT(deep, 200u);
+    for (const size_t n : {peakHalves[0], peakHalves[1], chopHalves[0], chopHalves[1]})
+        EXPECT_GT(n, 50u);
+}
+
 }  // namespace
 }  // namespace seasense::scene
