@@ -334,6 +334,7 @@ using F4 = float __attribute__((vector_size(16)));
 using I4 = int32_t __attribute__((vector_size(16)));
 using U4 = uint32_t __attribute__((vector_size(16)));
 using I8 = int32_t __attribute__((vector_size(32)));
+using F8 = float __attribute__((vector_size(32)));
 
 // Small triangles skip the span bounds (three divisions a row) and test their bounding box
 // instead, kBoxLanes samples of a row at a time on int32 lanes: up to kBoxOctets·kBoxLanes
@@ -364,6 +365,15 @@ inline V SelectBySign(I4 mask, V a, V b) {
     return (mask >> 31) ? a : b;
 #endif
 }
+template <class V>
+inline V SelectBySign(I8 mask, V a, V b) {
+#if defined(__AVX__)
+    return V(_mm256_blendv_ps(__m256(b), __m256(a), __m256(mask)));
+#else
+    return (mask >> 31) ? a : b;
+#endif
+}
+inline F8 Concat(F4 lo, F4 hi) { return __builtin_shufflevector(lo, hi, 0, 1, 2, 3, 4, 5, 6, 7); }
 // Exact int32 to double, lane for lane (GCC's generic conversion converts two halves).
 inline D4 ToDouble(I4 v) {
 #if defined(__AVX__)
@@ -397,22 +407,31 @@ template <bool kCount, bool kClipped>
     const int64_t py = int64_t(y0) * kSubScale + kHalfSample;
     // Below 2 kBoxMaxDelta when every edge's a, b lies in [−kBoxMaxDelta, kBoxMaxDelta).
     uint64_t deltas = 0;
-    for (int k = 0; k < 3; ++k) {
-        int i = k == 2 ? 0 : k + 1, j = k == 0 ? 2 : k - 1;
-        if (!positive) std::swap(i, j);
-        const int64_t ax = s.x[i], ay = s.y[i], bx = s.x[j], by = s.y[j];
-        const int64_t a = ay - by;  // ∂E/∂x
-        const int64_t b = bx - ax;  // ∂E/∂y
-        deltas |= uint64_t(a + kBoxMaxDelta) | uint64_t(b + kBoxMaxDelta);
-        // Top-left rule (Direct3D 11.3 functional specification, rasterization rules) for a
-        // clockwise triangle on the y-down grid: a left edge runs upward (a > 0); a top edge
-        // is horizontal and runs toward +x. Other edges exclude samples with E = 0.
-        const bool topLeft = a > 0 || (a == 0 && b > 0);
-        unbias[k] = topLeft ? 0 : 1;
-        row[k] = a * (px - ax) + b * (py - ay) - unbias[k];
-        stepX[k] = a * kSubScale;
-        stepY[k] = b * kSubScale;
-    }
+    // One unrolled loop per orientation: every vertex index below is then a constant, not a
+    // swapped index to load through.
+    const auto edges = [&]<bool kPositive>() __attribute__((always_inline)) {
+#pragma GCC unroll 3
+        for (int k = 0; k < 3; ++k) {
+            int i = k == 2 ? 0 : k + 1, j = k == 0 ? 2 : k - 1;
+            if (!kPositive) std::swap(i, j);
+            const int64_t ax = s.x[i], ay = s.y[i], bx = s.x[j], by = s.y[j];
+            const int64_t a = ay - by;  // ∂E/∂x
+            const int64_t b = bx - ax;  // ∂E/∂y
+            deltas |= uint64_t(a + kBoxMaxDelta) | uint64_t(b + kBoxMaxDelta);
+            // Top-left rule (Direct3D 11.3 functional specification, rasterization rules) for a
+            // clockwise triangle on the y-down grid: a left edge runs upward (a > 0); a top edge
+            // is horizontal and runs toward +x. Other edges exclude samples with E = 0.
+            const bool topLeft = a > 0 || (a == 0 && b > 0);
+            unbias[k] = topLeft ? 0 : 1;
+            row[k] = a * (px - ax) + b * (py - ay) - unbias[k];
+            stepX[k] = a * kSubScale;
+            stepY[k] = b * kSubScale;
+        }
+    };
+    if (positive)
+        edges.template operator()<true>();
+    else
+        edges.template operator()<false>();
     const uint32_t prim = s.prim;
     const int64_t u1 = unbias[1], u2 = unbias[2];
     // E_0 + E_1 + E_2 = |2·area| exactly, so depth = Σ E_k c_k = k0 + E_1 Δc_1 + E_2 Δc_2
@@ -470,6 +489,47 @@ template <bool kCount, bool kClipped>
         std::memcpy(t.b1 + i, &outB1, sizeof outB1);
         std::memcpy(t.b2 + i, &outB2, sizeof outB2);
     };
+    // quad's work on eight samples whose E_1, E_2 are the int32 lanes f1, f2: the same operations
+    // lane for lane, the doubles in two halves of four, the depth test, blends and stores on all
+    // eight lanes at once (one test and one set of stores instead of two).
+    const I8 primV8 = I8{} + int32_t(prim);
+    const I8 primKey8 = raster_detail::DepthTestKey(primV8);
+    const auto octet = [&](size_t i, I8 f1, I8 f2, I8 out) __attribute__((always_inline)) {
+        const D4 f1l = ToDouble(LowHalf(f1)), f1h = ToDouble(HighHalf(f1));
+        const D4 f2l = ToDouble(LowHalf(f2)), f2h = ToDouble(HighHalf(f2));
+        const D4 dl = k0 + f1l * dc1 + f2l * dc2;
+        const D4 dh = k0 + f1h * dc1 + f2h * dc2;
+        const F8 depth = Concat(__builtin_convertvector(dl, F4), __builtin_convertvector(dh, F4));
+        F8 old, oldB1, oldB2;
+        I8 oldPrim;
+        std::memcpy(&old, t.depth + i, sizeof old);
+        std::memcpy(&oldPrim, t.primitive + i, sizeof oldPrim);
+        const I8 wins = ~out & raster_detail::DepthTestWins(depth, primKey8, old, oldPrim);
+        if (!SignBits(wins)) return;
+        const D4 invl = 1.0 / dl, invh = 1.0 / dh;
+        F8 nb1, nb2;
+        if constexpr (kClipped) {
+            nb1 = Concat(__builtin_convertvector((g0 + f1l * g1 + f2l * g2) * invl, F4),
+                         __builtin_convertvector((g0 + f1h * g1 + f2h * g2) * invh, F4));
+            nb2 = Concat(__builtin_convertvector((h0 + f1l * h1 + f2l * h2) * invl, F4),
+                         __builtin_convertvector((h0 + f1h * h1 + f2h * h2) * invh, F4));
+        } else {
+            nb1 = Concat(__builtin_convertvector(f1l * c1 * invl, F4),
+                         __builtin_convertvector(f1h * c1 * invh, F4));
+            nb2 = Concat(__builtin_convertvector(f2l * c2 * invl, F4),
+                         __builtin_convertvector(f2h * c2 * invh, F4));
+        }
+        std::memcpy(&oldB1, t.b1 + i, sizeof oldB1);
+        std::memcpy(&oldB2, t.b2 + i, sizeof oldB2);
+        const F8 outDepth = SelectBySign(wins, depth, old);
+        const I8 outPrim = SelectBySign(wins, primV8, oldPrim);
+        const F8 outB1 = SelectBySign(wins, nb1, oldB1);
+        const F8 outB2 = SelectBySign(wins, nb2, oldB2);
+        std::memcpy(t.depth + i, &outDepth, sizeof outDepth);
+        std::memcpy(t.primitive + i, &outPrim, sizeof outPrim);
+        std::memcpy(t.b1 + i, &outB1, sizeof outB1);
+        std::memcpy(t.b2 + i, &outB2, sizeof outB2);
+    };
 
     if constexpr (!kCount) {
         // Small triangles (the coverage count keeps the spans): the box's samples kBoxLanes at
@@ -483,6 +543,9 @@ template <bool kCount, bool kClipped>
         const auto box = [&]<int kOctets>() __attribute__((always_inline)) {
             const I8 lane8{0, 1, 2, 3, 4, 5, 6, 7};
             I8 e0[kOctets], e1[kOctets], e2[kOctets];
+            // Unrolled, so that e0..e2 stay in registers (with octet inlined GCC no longer
+            // unrolls these loops by itself: +4 M instructions a frame).
+#pragma GCC unroll 2
             for (int o = 0; o < kOctets; ++o) {
                 const I8 lane = lane8 + kBoxLanes * o;
                 e0[o] = int32_t(row[0]) + lane * int32_t(stepX[0]);
@@ -494,6 +557,7 @@ template <bool kCount, bool kClipped>
             const int32_t unbias1 = int32_t(u1), unbias2 = int32_t(u2);
             size_t i = rowBase + size_t(x0 - xo);
             for (int y = y0; y <= y1; ++y, i += size_t(t.width)) {
+#pragma GCC unroll 2
                 for (int o = 0; o < kOctets; ++o) {
                     // Sign bits: lanes outside the triangle or past the box (only the last
                     // octet reaches past it).
@@ -503,11 +567,14 @@ template <bool kCount, bool kClipped>
                     if (outside != 0xff) {
                         const I8 f1 = e1[o] + unbias1, f2 = e2[o] + unbias2;
                         const size_t at = i + size_t(kBoxLanes * o);
-                        if ((outside & 0xf) != 0xf)
-                            quad(at, ToDouble(LowHalf(f1)), ToDouble(LowHalf(f2)), LowHalf(signs));
-                        if ((outside >> 4) != 0xf)
+                        // Both halves covered somewhere: one 8-lane group; else the half's quad.
+                        if ((outside & 0xf) == 0xf)
                             quad(at + size_t(kSpanLanes), ToDouble(HighHalf(f1)),
                                  ToDouble(HighHalf(f2)), HighHalf(signs));
+                        else if ((outside >> 4) == 0xf)
+                            quad(at, ToDouble(LowHalf(f1)), ToDouble(LowHalf(f2)), LowHalf(signs));
+                        else
+                            octet(at, f1, f2, signs);
                     }
                     e0[o] += dy0;
                     e1[o] += dy1;

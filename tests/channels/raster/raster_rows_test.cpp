@@ -353,5 +353,55 @@ TEST(RasterRows, DepthTestWithoutItsPositiveTermEqualsTheStraightforwardOne) {
     EXPECT_GT(tiesWon, 100);
 }
 
+// The same cases on eight lanes (the box rows test an 8-sample group at once where both of its
+// halves hold covered samples): every lane must be the straightforward test's decision.
+TEST(RasterRows, EightLaneDepthTestEqualsTheStraightforwardOne) {
+    using raster_detail::DepthLanes8;
+    using raster_detail::IdLanes8;
+    const float inf = std::numeric_limits<float>::infinity();
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const float tiny = std::numeric_limits<float>::denorm_min();
+    const float depths[] = {-inf, -1.0f, -tiny, -0.0f, 0.0f, tiny, 1e-30f, 0.25f, 0.5f, 1.0f, nan};
+    const uint32_t ids[] = {0u,          1u,          2u,          0x7ffffffeu, 0x7fffffffu,
+                            0x80000000u, 0x80000001u, 0xfffffffdu, 0xfffffffeu};
+    std::vector<std::pair<float, uint32_t>> targets = {{0.0f, kNoPrimitive}};
+    for (float d : depths)
+        if (d > 0.0f)
+            for (uint32_t id : ids) targets.push_back({d, id});
+    int checked = 0, won = 0, tiesWon = 0;
+    for (float depth : depths) {
+        for (uint32_t id : ids) {
+            // Each target on every lane in turn: the groups start one target further each time.
+            for (size_t k = 0; k < targets.size(); ++k) {
+                DepthLanes8 old, newDepth;
+                IdLanes8 oldPrim, prim;
+                for (int l = 0; l < 8; ++l) {
+                    const auto& target = targets[(k + size_t(l)) % targets.size()];
+                    old[l] = target.first;
+                    oldPrim[l] = int32_t(target.second);
+                    newDepth[l] = depth;
+                    prim[l] = int32_t(id);
+                }
+                const IdLanes8 wins = raster_detail::DepthTestWins(
+                    newDepth, raster_detail::DepthTestKey(prim), old, oldPrim);
+                for (int l = 0; l < 8; ++l) {
+                    const float o = old[l];
+                    const uint32_t op = uint32_t(oldPrim[l]);
+                    const bool expected = depth > 0.0f && (depth > o || (depth == o && id < op));
+                    EXPECT_EQ(wins[l], expected ? -1 : 0)
+                        << "lane " << l << " depth " << depth << " id " << id << " old " << o
+                        << " id " << op;
+                    ++checked;
+                    won += expected;
+                    tiesWon += expected && depth == o;
+                }
+            }
+        }
+    }
+    EXPECT_GT(checked, 20000);
+    EXPECT_GT(won, 2000);
+    EXPECT_GT(tiesWon, 600);
+}
+
 }  // namespace
 }  // namespace seasense::channels
