@@ -216,9 +216,9 @@ namespace {
 // colour into Sc[c], for the rays to the eye along −normalize(worldFromCamera · (a, 1, b)):
 // glm::normalize's and glm::dot's operations in their order (each row's products summed left to
 // right, v · (1 / √((v_x² + v_y²) + v_z²))), and HenyeyGreensteinPhase's, lane for lane.
-void ScatteredSources(simd::VF omega, simd::VF g, simd::VF av, simd::VF bv,
-                      const glm::mat3& worldFromCamera, const PlumeLighting& light,
-                      float (*Sc)[simd::kLanes]) {
+[[gnu::always_inline]] inline void ScatteredSources(simd::VF omega, simd::VF g, simd::VF av,
+                                                    simd::VF bv, const glm::mat3& worldFromCamera,
+                                                    const PlumeLighting& light, simd::VF (&Sc)[3]) {
     using simd::VF;
     VF v[3];
     for (int r = 0; r < 3; ++r)
@@ -234,7 +234,15 @@ void ScatteredSources(simd::VF omega, simd::VF g, simd::VF av, simd::VF bv,
     const VF denom = (1.0f + gg) - (2.0f * g) * cosTheta;
     const VF phase = (1.0f - gg) / (((4.0f * kPi) * denom) * simd::Sqrt(denom));
     for (int c = 0; c < 3; ++c)
-        simd::Store(Sc[c], omega * (light.sunIlluminance[c] * phase + light.ambientRgb[c]));
+        Sc[c] = omega * (light.sunIlluminance[c] * phase + light.ambientRgb[c]);
+}
+// ScatteredSources into arrays.
+void ScatteredSources(simd::VF omega, simd::VF g, simd::VF av, simd::VF bv,
+                      const glm::mat3& worldFromCamera, const PlumeLighting& light,
+                      float (*Sc)[simd::kLanes]) {
+    simd::VF v[3];
+    ScatteredSources(omega, g, av, bv, worldFromCamera, light, v);
+    for (int c = 0; c < 3; ++c) simd::Store(Sc[c], v[c]);
 }
 
 }  // namespace
@@ -408,6 +416,127 @@ void CompositeRgb2x2Row4(float* o, size_t sampleRow, const float* T, const float
 #else
     for (int l = 0; l < 4; ++l, o += 6)
         if (tau[l] > 0.0f && !drop[l]) CompositeRgb2x2(o, sampleRow, T[l], S + 3 * l);
+#endif
+}
+
+#ifdef __AVX2__
+namespace {
+// simd4::Exp4 on eight lanes: the AVX forms of its instructions in its order, so each lane has
+// the bits of Exp4's.
+inline __m256 Exp8(__m256 x) {
+    x = _mm256_min_ps(_mm256_max_ps(x, _mm256_set1_ps(-87.0f)), _mm256_set1_ps(88.0f));
+    const __m256i n = _mm256_cvtps_epi32(_mm256_mul_ps(x, _mm256_set1_ps(1.44269504f)));
+    const __m256 fn = _mm256_cvtepi32_ps(n);
+    __m256 r = _mm256_sub_ps(x, _mm256_mul_ps(fn, _mm256_set1_ps(0.693359375f)));
+    r = _mm256_sub_ps(r, _mm256_mul_ps(fn, _mm256_set1_ps(-2.12194440e-4f)));
+    __m256 p = _mm256_set1_ps(simd4::kExpTaylor6[0]);
+    for (size_t i = 1; i < std::size(simd4::kExpTaylor6); ++i)
+        p = _mm256_add_ps(_mm256_mul_ps(p, r), _mm256_set1_ps(simd4::kExpTaylor6[i]));
+    const __m256 scale =
+        _mm256_castsi256_ps(_mm256_slli_epi32(_mm256_add_epi32(n, _mm256_set1_epi32(127)), 23));
+    return _mm256_mul_ps(p, scale);
+}
+// The values of vector idx's lanes of a pixel row's sample row (R G B R G B per pixel) from
+// the per-pixel colour planes r, g, b: lane l takes its pixel's (idx[l]) value of colour
+// kGreen / kBlue (bit l set: green / blue; neither: red), moved, not changed.
+template <int kGreen, int kBlue>
+inline __m256 Interleave(__m256 r, __m256 g, __m256 b, __m256i idx) {
+    return _mm256_blend_ps(
+        _mm256_blend_ps(_mm256_permutevar8x32_ps(r, idx), _mm256_permutevar8x32_ps(g, idx), kGreen),
+        _mm256_permutevar8x32_ps(b, idx), kBlue);
+}
+}  // namespace
+#endif
+
+void BlendedVisibleCell2x2(const BandTrace* const t[4], const float colFx[4], const float rowFy[4],
+                           const float colA[4], const float rowB[4], int drop,
+                           const glm::mat3& worldFromCamera, const PlumeLighting& light, float* o,
+                           size_t sampleRow) {
+#ifdef __AVX2__
+    // Two pixel rows on the eight lanes (row 2g on lanes 0–3, 2g + 1 on 4–7):
+    // BlendedVisibleSources' steps on those lanes, then CompositeRgb2x2Row4's per pixel row from
+    // the registers, without the pixels' arrays, the sources' RGB triples in memory and a call per
+    // row.
+    static_assert(simd::kLanes == 8);
+    using simd::VF;
+    const __m128 fx4 = _mm_loadu_ps(colFx), a4 = _mm_loadu_ps(colA);
+    const __m256 fx = _mm256_set_m128(fx4, fx4), a = _mm256_set_m128(a4, a4);
+    const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    // The pixel of each lane of a pixel row's sample row's three vectors (CompositeRgb2x2Row4's).
+    const __m256i pixel[3] = {_mm256_setr_epi32(0, 0, 0, 0, 0, 0, 1, 1),
+                              _mm256_setr_epi32(1, 1, 1, 1, 2, 2, 2, 2),
+                              _mm256_setr_epi32(2, 2, 3, 3, 3, 3, 3, 3)};
+    for (int g = 0; g < 2; ++g) {
+        const __m256 fy = _mm256_set_m128(_mm_set1_ps(rowFy[2 * g + 1]), _mm_set1_ps(rowFy[2 * g]));
+        const __m256 b = _mm256_set_m128(_mm_set1_ps(rowB[2 * g + 1]), _mm_set1_ps(rowB[2 * g]));
+        const BlendSums blend(t, VF(fx), VF(fy));
+        const VF omega = blend.Albedo();
+        VF Sc[3];
+        ScatteredSources(omega, blend.Asymmetry(), VF(a), VF(b), worldFromCamera, light, Sc);
+        const VF temperature = blend.Temperature(), hotFraction = blend.HotFraction();
+        if (light.glow &&
+            simd::Any((hotFraction > 0.0f) | (temperature >= float(BlackbodyGlowTable::kMinT_K)))) {
+            // BlendedVisibleSources' glow, lane by lane.
+            alignas(32) float f[4][8], s[3][8];
+            simd::Store(f[0], temperature), simd::Store(f[1], hotFraction);
+            simd::Store(f[2], blend.HotTemperature()), simd::Store(f[3], 1.0f - omega);
+            for (int c = 0; c < 3; ++c) simd::Store(s[c], Sc[c]);
+            for (int l = 0; l < 8; ++l) {
+                BandTrace one;
+                one.temperature_K = f[0][l], one.hotFraction = f[1][l];
+                one.hotTemperature_K = f[2][l];
+                const glm::vec3 glow = VisibleGlow(one, light);
+                for (int c = 0; c < 3; ++c) s[c][l] = s[c][l] + f[3][l] * glow[c];
+            }
+            for (int c = 0; c < 3; ++c) Sc[c] = simd::Load(s[c]);
+        }
+        const __m256 tau = __m256(blend.depth);
+        const __m256 T = Exp8(_mm256_sub_ps(_mm256_setzero_ps(), tau));
+        const __m256 oneMinusT = _mm256_sub_ps(_mm256_set1_ps(1.0f), T);
+        const __m256 keep = _mm256_andnot_ps(
+            _mm256_castsi256_ps(_mm256_cmpeq_epi32(lane, _mm256_set1_epi32(drop - 8 * g))),
+            _mm256_cmp_ps(tau, _mm256_setzero_ps(), _CMP_GT_OQ));
+        if (_mm256_movemask_ps(keep) == 0) continue;
+        const __m256 sr = _mm256_mul_ps(oneMinusT, __m256(Sc[0]));
+        const __m256 sg = _mm256_mul_ps(oneMinusT, __m256(Sc[1]));
+        const __m256 sb = _mm256_mul_ps(oneMinusT, __m256(Sc[2]));
+        for (int h = 0; h < 2; ++h) {
+            const __m256i shift = _mm256_set1_epi32(4 * h);
+            __m256i idx[3];
+            for (int v = 0; v < 3; ++v) idx[v] = _mm256_add_epi32(pixel[v], shift);
+            // Colours 0 1 2 0 1 2 0 1, 2 0 1 2 0 1 2 0 and 1 2 0 1 2 0 1 2.
+            const __m256 sv[3] = {Interleave<0x92, 0x24>(sr, sg, sb, idx[0]),
+                                  Interleave<0x24, 0x49>(sr, sg, sb, idx[1]),
+                                  Interleave<0x49, 0x92>(sr, sg, sb, idx[2])};
+            float* row = o + size_t(2 * (2 * g + h)) * sampleRow;
+            for (int v = 0; v < 3; ++v) {
+                const __m256 tv = _mm256_permutevar8x32_ps(T, idx[v]);
+                const __m256 kv = _mm256_permutevar8x32_ps(keep, idx[v]);
+                for (int j = 0; j < 2; ++j) {
+                    float* p = row + size_t(j) * sampleRow + 8 * v;
+                    const __m256 old = _mm256_loadu_ps(p);
+                    const __m256 out = _mm256_add_ps(_mm256_mul_ps(old, tv), sv[v]);
+                    _mm256_storeu_ps(p, _mm256_blendv_ps(old, out, kv));
+                }
+            }
+        }
+    }
+#else
+    float fx[16], fy[16], a[16], b[16];
+    for (int k = 0; k < 16; ++k) {
+        fx[k] = colFx[k % 4], fy[k] = rowFy[k / 4];
+        a[k] = colA[k % 4], b[k] = rowB[k / 4];
+    }
+    alignas(16) float tau[16], T[16];
+    glm::vec3 S[16];
+    BlendedVisibleSources(t, fx, fy, a, b, 16, worldFromCamera, light, tau, S);
+    for (int l = 0; l < 16; l += 4)
+        _mm_store_ps(T + l, simd4::Exp4(_mm_sub_ps(_mm_setzero_ps(), _mm_load_ps(tau + l))));
+    int32_t dropLane[16] = {};
+    if (drop >= 0) dropLane[drop] = -1;
+    for (int ly = 0; ly < 4; ++ly)
+        CompositeRgb2x2Row4(o + size_t(2 * ly) * sampleRow, sampleRow, T + 4 * ly, &S[4 * ly].x,
+                            tau + 4 * ly, dropLane + 4 * ly);
 #endif
 }
 
@@ -1155,21 +1284,42 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                 float colFx[kCell], rowFy[kCell];
                 for (int l = 0; l < kCell; ++l)
                     colFx[l] = float(ox + l) / span, rowFy[l] = float(oy + l) / span;
+                const size_t sampleRow = size_t(radiance.width) * size_t(radiance.channels);
+                if (visible && N == 2) {
+                    static_assert(kCell == 4);
+                    plume_detail::BlendedVisibleCell2x2(
+                        c, colFx, rowFy, &colA[size_t(cx * kCell)], &rowB[size_t(cy * kCell)],
+                        centre ? centreY * kCell + centreX : -1, worldFromCamera, light,
+                        radiance.At(cx * kCell * 2, cy * kCell * 2), sampleRow);
+                    if (centre) {
+                        const int cpx = cx * kCell + centreX, cpy = cy * kCell + centreY;
+                        ApplyCell(centre, &cpx, &cpy, 1);
+                    }
+                    return;
+                }
                 alignas(16) float fx[kCellPixels], fy[kCellPixels], a[kCellPixels], b[kCellPixels];
                 for (int k = 0; k < kCellPixels; ++k) {
                     const int lx = k % kCell, ly = k / kCell;
                     fx[k] = colFx[lx], fy[k] = rowFy[ly];
-                    a[k] = colA[size_t(cx * kCell + lx)], b[k] = rowB[size_t(cy * kCell + ly)];
+                    if (visible)
+                        a[k] = colA[size_t(cx * kCell + lx)], b[k] = rowB[size_t(cy * kCell + ly)];
                 }
                 // Lanes of the pixel that keeps its own trace (all bits set), else 0.
                 alignas(16) int32_t drop[kCellPixels] = {};
                 if (centre) drop[centreY * kCell + centreX] = -1;
-                alignas(16) float tau[kCellPixels], T[kCellPixels];
+                alignas(32) float tau[kCellPixels], T[kCellPixels];
                 // e^(−τ) four pixels at a time (simd4::Exp4, within 2e-7 relative of std::exp).
                 const auto Transmittances = [&] {
+#ifdef __AVX2__
+                    // Eight at a time (Exp8: each lane has Exp4's bits).
+                    for (int l = 0; l < kCellPixels; l += 8)
+                        _mm256_store_ps(T + l, plume_detail::Exp8(_mm256_sub_ps(
+                                                   _mm256_setzero_ps(), _mm256_load_ps(tau + l))));
+#else
                     for (int l = 0; l < kCellPixels; l += 4)
                         _mm_store_ps(
                             T + l, simd4::Exp4(_mm_sub_ps(_mm_setzero_ps(), _mm_load_ps(tau + l))));
+#endif
                 };
                 // The pixels CompositeAll takes one by one (other than 2 × 2 samples).
                 const auto CompositeEach = [&](const auto& source) {
@@ -1180,23 +1330,12 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
                         CompositeAll(cx * kCell + k % kCell, cy * kCell + k / kCell, T[k], Sk);
                     }
                 };
-                const size_t sampleRow = size_t(radiance.width) * size_t(radiance.channels);
                 if (visible) {
                     glm::vec3 S[kCellPixels];
                     plume_detail::BlendedVisibleSources(c, fx, fy, a, b, kCellPixels,
                                                         worldFromCamera, light, tau, S);
                     Transmittances();
-                    if (N != 2) {
-                        CompositeEach([&](int k) { return S[k]; });
-                    } else {
-                        static_assert(kCell == 4);
-                        for (int ly = 0; ly < kCell; ++ly) {
-                            float* o = radiance.At(cx * kCell * 2, (cy * kCell + ly) * 2);
-                            plume_detail::CompositeRgb2x2Row4(o, sampleRow, T + ly * kCell,
-                                                              &S[ly * kCell].x, tau + ly * kCell,
-                                                              drop + ly * kCell);
-                        }
-                    }
+                    CompositeEach([&](int k) { return S[k]; });
                 } else {
                     alignas(16) float S[kCellPixels];
                     plume_detail::BlendedInfraredSources(c, fx, fy, kCellPixels, light, tau, S);

@@ -119,6 +119,16 @@ void CompositeRgb2x2(float* o, size_t sampleRow, float T, const float* S);
 // tau[l] > 0 and drop[l] == 0, all four at once where the build has AVX2 (the same bits: tested).
 void CompositeRgb2x2Row4(float* o, size_t sampleRow, const float* T, const float* S,
                          const float* tau, const int32_t* drop);
+// A whole 4 × 4-pixel cell with 2 × 2 RGB samples blended from its corners t and composited:
+// BlendedVisibleSources of its 16 pixels in row order (pixel (lx, ly) at fx = colFx[lx],
+// fy = rowFy[ly], a = colA[lx], b = rowB[ly]), T = simd4::Exp4(−τ), then CompositeRgb2x2Row4 of
+// each pixel row ly at o + 2 ly sampleRow, with pixel drop (ly · 4 + lx; −1: none) dropped. Where
+// the build has AVX2, two pixel rows at a time with every value kept in registers (the same
+// operations lane for lane: the same bits, tested).
+void BlendedVisibleCell2x2(const BandTrace* const t[4], const float colFx[4], const float rowFy[4],
+                           const float colA[4], const float rowB[4], int drop,
+                           const glm::mat3& worldFromCamera, const PlumeLighting& light, float* o,
+                           size_t sampleRow);
 }  // namespace plume_detail
 
 struct PlumeCompositeStats {

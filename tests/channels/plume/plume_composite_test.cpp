@@ -21,6 +21,7 @@
 #include "radiometry/bands/builtin_bands.h"
 #include "radiometry/planck/planck.h"
 #include "scene/core/frames.h"
+#include "scene/core/simd4.h"
 #include "scene/plumes/plume_system.h"
 #include "tests/support/sky_view.h"
 
@@ -1026,6 +1027,75 @@ TEST(PlumeComposite, BlendedVisibleSourcesMatchTheOnePixelForms) {
         }
     }
     EXPECT_GT(compared, 2000);
+}
+
+// A whole 4 × 4 cell blended and composited at once equals its steps one by one bit for bit:
+// BlendedVisibleSources of its 16 pixels in row order, simd4::Exp4 of −τ and CompositeRgb2x2Row4
+// per pixel row, over corners of every kind (clear ones too, whose pixels are left alone), both
+// grid spans, with and without the glow, each pixel dropped in turn or none, over backgrounds
+// with signed zeros and negatives, and nothing written outside the cell's samples.
+TEST(PlumeComposite, BlendedVisibleCellEqualsItsStepsOneByOne) {
+    const std::vector<BandTrace> traces = VariedTraces();
+    const size_t n = traces.size();
+    const BlackbodyGlowTable glow;
+    scene::Attitude attitude;
+    attitude.heading_rad = 1.1;
+    attitude.pitch_rad = -0.04;
+    attitude.roll_rad = 0.02;
+    const glm::mat3 worldFromCamera(scene::WorldFromBodyRotation(attitude));
+    std::mt19937 rng(20261128);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f), wide(-50.0f, 500.0f);
+    constexpr size_t kRow = 29;  // floats from one sample row to the next (a row's 24 and more)
+    int cells = 0, changed = 0;
+    for (const bool withGlow : {false, true}) {
+        PlumeLighting light = Sunlit(glow);
+        if (!withGlow) light.glow = nullptr;
+        for (size_t c = 0; c < n * n * n * n; c += 7) {
+            const BandTrace* corner[4] = {&traces[c % n], &traces[c / n % n],
+                                          &traces[c / n / n % n], &traces[c / n / n / n % n]};
+            const int drop = int(c % 17) - 1;
+            const float span = c % 2 == 0 ? 4.0f : 8.0f;
+            const int ox = c % 3 == 0 ? 4 : 0, oy = c % 5 < 2 ? 4 : 0;
+            float colFx[4], rowFy[4], colA[4], rowB[4];
+            for (int l = 0; l < 4; ++l) {
+                colFx[l] = float(ox + l) / span, rowFy[l] = float(oy + l) / span;
+                colA[l] = -0.5f + 0.013f * float(c % 61) + 0.02f * float(l);
+                rowB[l] = 0.3f - 0.009f * float(c % 53) - 0.02f * float(l);
+            }
+            std::vector<float> before(4 * 2 * kRow + 5);
+            for (float& v : before) {
+                const float u = unit(rng);
+                v = u < 0.05f ? 0.0f : u < 0.1f ? -0.0f : wide(rng);
+            }
+            std::vector<float> once = before, steps = before;
+            plume_detail::BlendedVisibleCell2x2(corner, colFx, rowFy, colA, rowB, drop,
+                                                worldFromCamera, light, once.data() + 2, kRow);
+            float fx[16], fy[16], a[16], b[16];
+            for (int k = 0; k < 16; ++k) {
+                fx[k] = colFx[k % 4], fy[k] = rowFy[k / 4];
+                a[k] = colA[k % 4], b[k] = rowB[k / 4];
+            }
+            alignas(16) float tau[16], T[16];
+            glm::vec3 S[16];
+            plume_detail::BlendedVisibleSources(corner, fx, fy, a, b, 16, worldFromCamera, light,
+                                                tau, S);
+            for (int l = 0; l < 16; l += 4)
+                _mm_store_ps(T + l,
+                             simd4::Exp4(_mm_sub_ps(_mm_setzero_ps(), _mm_load_ps(tau + l))));
+            int32_t dropLane[16] = {};
+            if (drop >= 0) dropLane[drop] = -1;
+            for (int ly = 0; ly < 4; ++ly)
+                plume_detail::CompositeRgb2x2Row4(steps.data() + 2 + size_t(2 * ly) * kRow, kRow,
+                                                  T + 4 * ly, &S[4 * ly].x, tau + 4 * ly,
+                                                  dropLane + 4 * ly);
+            ASSERT_EQ(std::memcmp(once.data(), steps.data(), once.size() * sizeof(float)), 0)
+                << withGlow << " " << c;
+            changed += std::memcmp(once.data(), before.data(), once.size() * sizeof(float)) != 0;
+            ++cells;
+        }
+    }
+    EXPECT_GT(cells, 600);
+    EXPECT_GT(changed, 500);
 }
 
 // The infrared whole-sky-cell form likewise: Bilinear's optical depth and, where it is
