@@ -540,6 +540,48 @@ void BlendedVisibleCell2x2(const BandTrace* const t[4], const float colFx[4], co
 #endif
 }
 
+#ifdef __AVX2__
+namespace {
+// SkySamples4 of eight samples (AVX2, the same test per lane).
+inline __m256 SkySamples8(const uint32_t* primitive, const float* depth) {
+    const __m256i p = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(primitive));
+    return _mm256_or_ps(
+        _mm256_castsi256_ps(_mm256_cmpeq_epi32(p, _mm256_set1_epi32(int32_t(kNoPrimitive)))),
+        _mm256_cmp_ps(_mm256_loadu_ps(depth), _mm256_setzero_ps(), _CMP_LE_OQ));
+}
+}  // namespace
+#endif
+
+bool AllSky8(const uint32_t* primitive, const float* depth, size_t stride, int rows) {
+#ifdef __AVX2__
+    __m256 sky = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
+    for (int j = 0; j < rows; ++j, primitive += stride, depth += stride)
+        sky = _mm256_and_ps(sky, SkySamples8(primitive, depth));
+    return _mm256_movemask_ps(sky) == 0xff;
+#else
+    __m128 sky = _mm_castsi128_ps(_mm_set1_epi32(-1));
+    for (int j = 0; j < rows; ++j, primitive += stride, depth += stride)
+        for (int i = 0; i < 8; i += 4) sky = _mm_and_ps(sky, SkySamples4(primitive + i, depth + i));
+    return _mm_movemask_ps(sky) == 0xf;
+#endif
+}
+
+bool AllDepthsAtLeast8(const uint32_t* primitive, const float* depth, size_t stride, int rows,
+                       float least) {
+    for (int j = 0; j < rows; ++j, primitive += stride, depth += stride) {
+#ifdef __AVX2__
+        const __m256 sky = SkySamples8(primitive, depth);
+        const __m256 v = _mm256_blendv_ps(_mm256_loadu_ps(depth), _mm256_set1_ps(-1.0f), sky);
+        if (_mm256_movemask_ps(_mm256_cmp_ps(v, _mm256_set1_ps(least), _CMP_GE_OQ)) != 0xff)
+            return false;
+#else
+        for (int i = 0; i < 8; ++i)
+            if (!((SkySample(primitive[i], depth[i]) ? -1.0f : depth[i]) >= least)) return false;
+#endif
+    }
+    return true;
+}
+
 }  // namespace plume_detail
 
 namespace {
@@ -830,6 +872,14 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
     const auto AllDepthsAtLeast = [&](int cx, int cy, float least) {
         const int rowSamples = kCell * N, sy0 = cy * rowSamples, sx0 = cx * rowSamples;
         const int sx1 = std::min(sx0 + rowSamples, vis.width);
+        const int rows = std::min(rowSamples, vis.height - sy0);
+        // A cell row of eight samples (2 × 2 samples a pixel): eight at a time.
+        if (sx1 - sx0 == 8 && rows > 0) {
+            const size_t idx0 = vis.Index(sx0, sy0);
+            return plume_detail::AllDepthsAtLeast8(vis.primitive.data() + idx0,
+                                                   vis.depth.data() + idx0, size_t(vis.width), rows,
+                                                   least);
+        }
         // Four samples at a time (SSE2), the same test per lane, one branch per row.
         const __m128 leastV = _mm_set1_ps(least), skyDepth = _mm_set1_ps(-1.0f);
         for (int j = 0; j < std::min(rowSamples, vis.height - sy0); ++j) {
@@ -852,13 +902,19 @@ PlumeCompositeStats CompositePlumes(const scene::PlumeField& field, const Channe
         }
         return true;
     };
-    // Whether cell (cx, cy) lies wholly in the image and every sample of it sees the sky, four
-    // samples at a time (SSE2, the visibility buffer's sky test per lane).
+    // Whether cell (cx, cy) lies wholly in the image and every sample of it sees the sky (AllSky8
+    // with eight samples to a cell row, else four samples at a time, SSE2, the visibility buffer's
+    // sky test per lane).
     const auto SkyOnly = [&](int cx, int cy) {
         if ((cx + 1) * kCell > W || (cy + 1) * kCell > H) return false;
         const int rowSamples = kCell * N;
         __m128 sky = _mm_castsi128_ps(_mm_set1_epi32(-1));
         bool rest = true;
+        if (rowSamples == 8) {
+            const size_t idx0 = vis.Index(cx * rowSamples, cy * rowSamples);
+            return plume_detail::AllSky8(vis.primitive.data() + idx0, vis.depth.data() + idx0,
+                                         size_t(vis.width), rowSamples);
+        }
         for (int j = 0; j < rowSamples; ++j) {
             const size_t idx0 = vis.Index(cx * rowSamples, cy * rowSamples + j);
             const float* depth = vis.depth.data() + idx0;

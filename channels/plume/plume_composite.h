@@ -129,6 +129,14 @@ void BlendedVisibleCell2x2(const BandTrace* const t[4], const float colFx[4], co
                            const float colA[4], const float rowB[4], int drop,
                            const glm::mat3& worldFromCamera, const PlumeLighting& light, float* o,
                            size_t sampleRow);
+// Whether every sample of `rows` rows of eight visibility-buffer samples (row j at primitive and
+// depth + j·stride) sees the sky: no primitive, or no depth in front (depth ≤ 0). Eight samples
+// at a time where the build has AVX2 (tested against the one-sample test).
+bool AllSky8(const uint32_t* primitive, const float* depth, size_t stride, int rows);
+// Whether every such sample's depth, −1 where it sees the sky, is at least `least` (false at the
+// first row with one that is not).
+bool AllDepthsAtLeast8(const uint32_t* primitive, const float* depth, size_t stride, int rows,
+                       float least);
 }  // namespace plume_detail
 
 struct PlumeCompositeStats {

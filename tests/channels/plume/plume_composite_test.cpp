@@ -1098,6 +1098,63 @@ TEST(PlumeComposite, BlendedVisibleCellEqualsItsStepsOneByOne) {
     EXPECT_GT(changed, 500);
 }
 
+// The eight-sample cell-row tests equal the one-sample forms over random visibility samples: no
+// primitive, depths of zero (either sign), negative, positive and NaN, one to eight rows, with
+// both answers coming up often (rows all sky or all beyond the bound, one sample changed or not).
+TEST(PlumeComposite, EightSampleSkyAndDepthTestsMatchTheOneSampleForms) {
+    std::mt19937 rng(20261128);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    constexpr size_t kStride = 13;
+    constexpr float kLeast = 0.25f;
+    const auto Sky = [&](uint32_t& p, float& d) {
+        const float u = unit(rng);
+        p = u < 0.5f ? kNoPrimitive : uint32_t(unit(rng) * 1000.0f);
+        d = u < 0.5f ? unit(rng) - 0.5f : u < 0.7f ? 0.0f : u < 0.9f ? -0.0f : -unit(rng);
+    };
+    const auto Surface = [&](uint32_t& p, float& d) {
+        p = uint32_t(unit(rng) * 1000.0f);
+        d = unit(rng) < 0.02f ? std::numeric_limits<float>::quiet_NaN() : kLeast + unit(rng);
+        if (unit(rng) < 0.02f) d = kLeast;
+    };
+    int allSky = 0, allAtLeast = 0;
+    for (int trial = 0; trial < 20000; ++trial) {
+        const int rows = 1 + trial % 8;
+        std::vector<uint32_t> primitive(kStride * size_t(rows) + 8);
+        std::vector<float> depth(primitive.size());
+        const int kind = trial / 8 % 3;  // all sky, all surfaces, mixed
+        for (size_t i = 0; i < primitive.size(); ++i) {
+            if (kind == 0 || (kind == 2 && unit(rng) < 0.5f))
+                Sky(primitive[i], depth[i]);
+            else
+                Surface(primitive[i], depth[i]);
+        }
+        if (kind != 2 && unit(rng) < 0.5f) {
+            const size_t at = size_t(unit(rng) * float(rows)) * kStride + size_t(unit(rng) * 8.0f);
+            if (kind == 0)
+                Surface(primitive[at], depth[at]);
+            else
+                Sky(primitive[at], depth[at]);
+        }
+        bool sky = true, atLeast = true;
+        for (int j = 0; j < rows; ++j)
+            for (int i = 0; i < 8; ++i) {
+                const size_t k = size_t(j) * kStride + size_t(i);
+                const bool s = primitive[k] == kNoPrimitive || depth[k] <= 0.0f;
+                sky = sky && s;
+                atLeast = atLeast && (s ? -1.0f : depth[k]) >= kLeast;
+            }
+        ASSERT_EQ(plume_detail::AllSky8(primitive.data(), depth.data(), kStride, rows), sky)
+            << trial;
+        ASSERT_EQ(
+            plume_detail::AllDepthsAtLeast8(primitive.data(), depth.data(), kStride, rows, kLeast),
+            atLeast)
+            << trial;
+        allSky += sky, allAtLeast += atLeast;
+    }
+    EXPECT_GT(allSky, 1000);
+    EXPECT_GT(allAtLeast, 1000);
+}
+
 // The infrared whole-sky-cell form likewise: Bilinear's optical depth and, where it is
 // positive, InfraredSource of the blend (else 0), bit for bit.
 TEST(PlumeComposite, BlendedInfraredSourcesMatchTheOnePixelForms) {
