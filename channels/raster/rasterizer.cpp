@@ -458,10 +458,26 @@ template <bool kCount, bool kClipped>
     // are this thread's and padded past their last sample).
     const I4 primV = I4{} + int32_t(prim);
     const I4 primKey = raster_detail::DepthTestKey(primV);
+    // The samples from i (four or eight lanes) where wins is set take the new depth, primitive
+    // and barycentrics; the others keep theirs.
+    const auto blendStore = [&](size_t i, auto wins, auto depth, auto old, auto prims, auto oldPrim,
+                                auto nb1, auto nb2) __attribute__((always_inline)) {
+        decltype(nb1) oldB1, oldB2;
+        std::memcpy(&oldB1, t.b1 + i, sizeof oldB1);
+        std::memcpy(&oldB2, t.b2 + i, sizeof oldB2);
+        const auto outDepth = SelectBySign(wins, depth, old);
+        const auto outPrim = SelectBySign(wins, prims, oldPrim);
+        const auto outB1 = SelectBySign(wins, nb1, oldB1);
+        const auto outB2 = SelectBySign(wins, nb2, oldB2);
+        std::memcpy(t.depth + i, &outDepth, sizeof outDepth);
+        std::memcpy(t.primitive + i, &outPrim, sizeof outPrim);
+        std::memcpy(t.b1 + i, &outB1, sizeof outB1);
+        std::memcpy(t.b2 + i, &outB2, sizeof outB2);
+    };
     const auto quad = [&](size_t i, D4 f1, D4 f2, I4 out) __attribute__((always_inline)) {
         const D4 d = k0 + f1 * dc1 + f2 * dc2;
         const F4 depth = __builtin_convertvector(d, F4);
-        F4 old, oldB1, oldB2;
+        F4 old;
         I4 oldPrim;
         std::memcpy(&old, t.depth + i, sizeof old);
         std::memcpy(&oldPrim, t.primitive + i, sizeof oldPrim);
@@ -478,16 +494,7 @@ template <bool kCount, bool kClipped>
             nb1 = __builtin_convertvector(f1 * c1 * inv, F4);
             nb2 = __builtin_convertvector(f2 * c2 * inv, F4);
         }
-        std::memcpy(&oldB1, t.b1 + i, sizeof oldB1);
-        std::memcpy(&oldB2, t.b2 + i, sizeof oldB2);
-        const F4 outDepth = SelectBySign(wins, depth, old);
-        const I4 outPrim = SelectBySign(wins, primV, oldPrim);
-        const F4 outB1 = SelectBySign(wins, nb1, oldB1);
-        const F4 outB2 = SelectBySign(wins, nb2, oldB2);
-        std::memcpy(t.depth + i, &outDepth, sizeof outDepth);
-        std::memcpy(t.primitive + i, &outPrim, sizeof outPrim);
-        std::memcpy(t.b1 + i, &outB1, sizeof outB1);
-        std::memcpy(t.b2 + i, &outB2, sizeof outB2);
+        blendStore(i, wins, depth, old, primV, oldPrim, nb1, nb2);
     };
     // quad's work on eight samples whose E_1, E_2 are the int32 lanes f1, f2: the same operations
     // lane for lane, the doubles in two halves of four, the depth test, blends and stores on all
@@ -500,7 +507,7 @@ template <bool kCount, bool kClipped>
         const D4 dl = k0 + f1l * dc1 + f2l * dc2;
         const D4 dh = k0 + f1h * dc1 + f2h * dc2;
         const F8 depth = Concat(__builtin_convertvector(dl, F4), __builtin_convertvector(dh, F4));
-        F8 old, oldB1, oldB2;
+        F8 old;
         I8 oldPrim;
         std::memcpy(&old, t.depth + i, sizeof old);
         std::memcpy(&oldPrim, t.primitive + i, sizeof oldPrim);
@@ -519,16 +526,7 @@ template <bool kCount, bool kClipped>
             nb2 = Concat(__builtin_convertvector(f2l * c2 * invl, F4),
                          __builtin_convertvector(f2h * c2 * invh, F4));
         }
-        std::memcpy(&oldB1, t.b1 + i, sizeof oldB1);
-        std::memcpy(&oldB2, t.b2 + i, sizeof oldB2);
-        const F8 outDepth = SelectBySign(wins, depth, old);
-        const I8 outPrim = SelectBySign(wins, primV8, oldPrim);
-        const F8 outB1 = SelectBySign(wins, nb1, oldB1);
-        const F8 outB2 = SelectBySign(wins, nb2, oldB2);
-        std::memcpy(t.depth + i, &outDepth, sizeof outDepth);
-        std::memcpy(t.primitive + i, &outPrim, sizeof outPrim);
-        std::memcpy(t.b1 + i, &outB1, sizeof outB1);
-        std::memcpy(t.b2 + i, &outB2, sizeof outB2);
+        blendStore(i, wins, depth, old, primV8, oldPrim, nb1, nb2);
     };
 
     if constexpr (!kCount) {

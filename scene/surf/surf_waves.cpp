@@ -1152,31 +1152,9 @@ using I4 = int64_t __attribute__((vector_size(32)));
 
 // cos x per lane with SinCos's operations (sincos.h) in its order: the same bits as its cosX.
 [[gnu::always_inline]] inline D4 CosLanes(D4 x) {
-    constexpr double kTwoOverPi = 0.6366197723675814;
-    constexpr double kHalfPiHi = 1.5707963267341256;
-    constexpr double kHalfPiLo = 6.077100506506192e-11;
-    constexpr double kRound = 6755399441055744.0;
-    const D4 shifted = x * kTwoOverPi + kRound;
-    const D4 n = shifted - kRound;
+    D4 shifted, s, c;
+    SinCosReduced(x, shifted, s, c);
     const I4 quadrant = (I4)shifted & 3;
-    const D4 r = (x - n * kHalfPiHi) - n * kHalfPiLo;
-    const D4 r2 = r * r;
-    const D4 s =
-        r + r * r2 *
-                (-1.0 / 6 +
-                 r2 * (1.0 / 120 +
-                       r2 * (-1.0 / 5040 +
-                             r2 * (1.0 / 362880 + r2 * (-1.0 / 39916800 +
-                                                        r2 * (1.0 / 6227020800 +
-                                                              r2 * (-1.0 / 1307674368000.0)))))));
-    const D4 c =
-        1.0 + r2 * (-0.5 + r2 * (1.0 / 24 +
-                                 r2 * (-1.0 / 720 +
-                                       r2 * (1.0 / 40320 +
-                                             r2 * (-1.0 / 3628800 +
-                                                   r2 * (1.0 / 479001600 +
-                                                         r2 * (-1.0 / 87178291200.0 +
-                                                               r2 * (1.0 / 20922789888000.0))))))));
     // SinCos's double(quadrant & 1) and 1 − double((quadrant + 1) & 2), exact small integers,
     // picked rather than converted (AVX2 has no 64-bit integer to double conversion).
     const D4 zero{}, one = zero + 1.0;
