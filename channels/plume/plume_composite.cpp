@@ -448,6 +448,27 @@ inline __m256 Interleave(__m256 r, __m256 g, __m256 b, __m256i idx) {
 }  // namespace
 #endif
 
+void BlendedVisibleCell2x2Steps(const BandTrace* const t[4], const float colFx[4],
+                                const float rowFy[4], const float colA[4], const float rowB[4],
+                                int drop, const glm::mat3& worldFromCamera,
+                                const PlumeLighting& light, float* o, size_t sampleRow) {
+    float fx[16], fy[16], a[16], b[16];
+    for (int k = 0; k < 16; ++k) {
+        fx[k] = colFx[k % 4], fy[k] = rowFy[k / 4];
+        a[k] = colA[k % 4], b[k] = rowB[k / 4];
+    }
+    alignas(16) float tau[16], T[16];
+    glm::vec3 S[16];
+    BlendedVisibleSources(t, fx, fy, a, b, 16, worldFromCamera, light, tau, S);
+    for (int l = 0; l < 16; l += 4)
+        _mm_store_ps(T + l, simd4::Exp4(_mm_sub_ps(_mm_setzero_ps(), _mm_load_ps(tau + l))));
+    int32_t dropLane[16] = {};
+    if (drop >= 0) dropLane[drop] = -1;
+    for (int ly = 0; ly < 4; ++ly)
+        CompositeRgb2x2Row4(o + size_t(2 * ly) * sampleRow, sampleRow, T + 4 * ly, &S[4 * ly].x,
+                            tau + 4 * ly, dropLane + 4 * ly);
+}
+
 void BlendedVisibleCell2x2(const BandTrace* const t[4], const float colFx[4], const float rowFy[4],
                            const float colA[4], const float rowB[4], int drop,
                            const glm::mat3& worldFromCamera, const PlumeLighting& light, float* o,
@@ -522,21 +543,8 @@ void BlendedVisibleCell2x2(const BandTrace* const t[4], const float colFx[4], co
         }
     }
 #else
-    float fx[16], fy[16], a[16], b[16];
-    for (int k = 0; k < 16; ++k) {
-        fx[k] = colFx[k % 4], fy[k] = rowFy[k / 4];
-        a[k] = colA[k % 4], b[k] = rowB[k / 4];
-    }
-    alignas(16) float tau[16], T[16];
-    glm::vec3 S[16];
-    BlendedVisibleSources(t, fx, fy, a, b, 16, worldFromCamera, light, tau, S);
-    for (int l = 0; l < 16; l += 4)
-        _mm_store_ps(T + l, simd4::Exp4(_mm_sub_ps(_mm_setzero_ps(), _mm_load_ps(tau + l))));
-    int32_t dropLane[16] = {};
-    if (drop >= 0) dropLane[drop] = -1;
-    for (int ly = 0; ly < 4; ++ly)
-        CompositeRgb2x2Row4(o + size_t(2 * ly) * sampleRow, sampleRow, T + 4 * ly, &S[4 * ly].x,
-                            tau + 4 * ly, dropLane + 4 * ly);
+    BlendedVisibleCell2x2Steps(t, colFx, rowFy, colA, rowB, drop, worldFromCamera, light, o,
+                               sampleRow);
 #endif
 }
 

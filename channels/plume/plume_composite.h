@@ -129,6 +129,12 @@ void BlendedVisibleCell2x2(const BandTrace* const t[4], const float colFx[4], co
                            const float colA[4], const float rowB[4], int drop,
                            const glm::mat3& worldFromCamera, const PlumeLighting& light, float* o,
                            size_t sampleRow);
+// BlendedVisibleCell2x2 step by step, as its comment says (what it does without AVX2, and the
+// reference its AVX2 form is tested against).
+void BlendedVisibleCell2x2Steps(const BandTrace* const t[4], const float colFx[4],
+                                const float rowFy[4], const float colA[4], const float rowB[4],
+                                int drop, const glm::mat3& worldFromCamera,
+                                const PlumeLighting& light, float* o, size_t sampleRow);
 // Whether every sample of `rows` rows of eight visibility-buffer samples (row j at primitive and
 // depth + j·stride) sees the sky: no primitive, or no depth in front (depth ≤ 0). Eight samples
 // at a time where the build has AVX2 (tested against the one-sample test).

@@ -1070,24 +1070,9 @@ TEST(PlumeComposite, BlendedVisibleCellEqualsItsStepsOneByOne) {
             std::vector<float> once = before, steps = before;
             plume_detail::BlendedVisibleCell2x2(corner, colFx, rowFy, colA, rowB, drop,
                                                 worldFromCamera, light, once.data() + 2, kRow);
-            float fx[16], fy[16], a[16], b[16];
-            for (int k = 0; k < 16; ++k) {
-                fx[k] = colFx[k % 4], fy[k] = rowFy[k / 4];
-                a[k] = colA[k % 4], b[k] = rowB[k / 4];
-            }
-            alignas(16) float tau[16], T[16];
-            glm::vec3 S[16];
-            plume_detail::BlendedVisibleSources(corner, fx, fy, a, b, 16, worldFromCamera, light,
-                                                tau, S);
-            for (int l = 0; l < 16; l += 4)
-                _mm_store_ps(T + l,
-                             simd4::Exp4(_mm_sub_ps(_mm_setzero_ps(), _mm_load_ps(tau + l))));
-            int32_t dropLane[16] = {};
-            if (drop >= 0) dropLane[drop] = -1;
-            for (int ly = 0; ly < 4; ++ly)
-                plume_detail::CompositeRgb2x2Row4(steps.data() + 2 + size_t(2 * ly) * kRow, kRow,
-                                                  T + 4 * ly, &S[4 * ly].x, tau + 4 * ly,
-                                                  dropLane + 4 * ly);
+            plume_detail::BlendedVisibleCell2x2Steps(corner, colFx, rowFy, colA, rowB, drop,
+                                                     worldFromCamera, light, steps.data() + 2,
+                                                     kRow);
             ASSERT_EQ(std::memcmp(once.data(), steps.data(), once.size() * sizeof(float)), 0)
                 << withGlow << " " << c;
             changed += std::memcmp(once.data(), before.data(), once.size() * sizeof(float)) != 0;
