@@ -443,9 +443,17 @@ int RunHost(const RunOptions& opt) {
     for (uint32_t c = 0; c < channelCount; ++c) {
         while (children[c] > 0) {
             if (std::optional<sync::ProcessExit> e = sync::PollProcess(children[c])) {
-                if (e->signaled || e->code != 0)
+                if (e->signaled || e->code != 0) {
                     std::fprintf(stderr, "seasense: channel '%s' %s at the end of the run\n",
                                  header.channels[c].name, sync::Describe(*e).c_str());
+                    // Its last files may be missing (a renderer writes them after presenting,
+                    // and waits for them before it exits 0): the run did not complete.
+                    if (exitStatus == 0) {
+                        exitStatus = 1;
+                        status = std::string("failed: channel '") + header.channels[c].name + "' " +
+                                 sync::Describe(*e) + " at the end of the run";
+                    }
+                }
                 children[c] = 0;
             } else if (sync::MonotonicNs() > reapDeadline) {
                 break;
@@ -500,6 +508,9 @@ int RunChannelRenderer(const ChannelOptions& opt) {
     if (copyImages && uint64_t(previewW) * uint64_t(previewH) * 3 > header.imageBytes)
         throw RuntimeError("run '" + runId + "' image slots are too small for channel '" +
                            ch->name + "'");
+    // Frame i's files are encoded and synced on the pipeline's writer thread while this thread
+    // renders frame i + 1 (the fsync of each file waits milliseconds for the disk).
+    if (writeImages) pipeline->WriteInBackground();
     // The first frame's one-off work (buffers first touched, tables built on first use, the
     // display and preview transforms made) done before attaching, so that the run's first
     // frame costs what the others do and is on time when paced: the host starts its clock once
@@ -585,12 +596,15 @@ int RunChannelRenderer(const ChannelOptions& opt) {
         const bool last = lock.Done(i, /*wake=*/false);
         presenter.PresentOrPush(std::move(item), [&] { return last || lock.AllDone(i); });
         lock.WakeDone();
-        // The files of frame i are written before frame i + 1 reuses the pipeline's images.
+        // Frame i's images are copied for the writer before frame i + 1 reuses them.
         if (writeImages) arena.execute([&] { pipeline->Write(rec); });
         // Fast frames may never reach a wait's liveness poll: look at the signal here too.
         if (g_signal) return presenter.Finish(128 + g_signal);
     }
-    return presenter.Finish(0);
+    const int status = presenter.Finish(0);
+    // The last frames' files, on disk before this renderer exits 0 (the host reaps it).
+    pipeline->FinishWrites();
+    return status;
 }
 
 }  // namespace seasense::channels

@@ -321,7 +321,7 @@ void ChannelPipeline::WriteThermal(const sensors::ImageMetadata& md, const std::
         } else {  // raw_png, raw_tiff
             path = paths.rawCounts = channelDir_ / (base + "_raw." + fmt.substr(4));
         }
-        sensors::WriteThermalFrame(*imager_, paths, md);
+        sensors::WriteThermalFrame(*imager_, paths, md, sink_);
         rec.files.push_back(path);
     }
 }
@@ -346,10 +346,9 @@ void ChannelPipeline::WriteNvg(const sensors::ImageMetadata& frameMd, const std:
             }
             sensors::ExrOptions options;
             options.channelNames = {"L_p", "B"};
-            sensors::WriteExr(path, both, md, options);
+            sink_.Exr(path, both, md, options);
         } else {
-            sensors::WriteDisplayImage8(path, t.Display(), t.Brightness().width,
-                                        t.Brightness().height, 3, md);
+            sink_.Display8(path, t.Display(), t.Brightness().width, t.Brightness().height, 3, md);
         }
         rec.files.push_back(path);
     }
@@ -374,12 +373,19 @@ void ChannelPipeline::Write(FrameRecord& rec) {
     for (const std::string& fmt : formats_) {
         const std::filesystem::path path = channelDir_ / (base + "." + fmt);
         if (fmt == "exr")
-            sensors::WriteExr(path, pixels_, md);
+            sink_.Exr(path, pixels_, md);
         else
-            sensors::WriteDisplayImage8(path, DisplayRgb8(), pixels_.width, pixels_.height, 3, md);
+            sink_.Display8(path, DisplayRgb8(), pixels_.width, pixels_.height, 3, md);
         rec.files.push_back(path);
     }
     rec.writeMs = MsSince(t0);
 }
+
+void ChannelPipeline::WriteInBackground() {
+    // Two frames' files may wait: the renderer is a frame ahead of its writer at most.
+    sink_ = sensors::ImageSink(2 * formats_.size());
+}
+
+void ChannelPipeline::FinishWrites() { sink_.Finish(); }
 
 }  // namespace seasense::channels

@@ -15,6 +15,7 @@
 #include "sensors/display/display_lut.h"
 #include "sensors/display/ocio_display.h"
 #include "sensors/intensifier/intensifier.h"
+#include "sensors/output/image_sink.h"
 #include "sensors/thermal/thermal_imager.h"
 
 namespace seasense::channels {
@@ -59,6 +60,15 @@ class ChannelPipeline {
     // then writes the frame's files (the display transform runs at most once per frame).
     FrameRecord Render(const scene::FrameState& frame);
     void Write(FrameRecord& record);
+    // From now on Write copies the frame's images and hands their files to a thread of this
+    // pipeline (at most two frames' files waiting), so that the caller renders its next frame
+    // while they are encoded, synced and renamed; record.writeMs is then the time of the
+    // display transform and the copies. The files are the same bytes. A write error surfaces
+    // from a later Write or from FinishWrites; on destruction the files handed over are
+    // completed.
+    void WriteInBackground();
+    // Waits until every file handed over is written; rethrows the first write error.
+    void FinishWrites();
     // Renders frame once and forgets it: the one-off work of a pipeline's first frame (buffers
     // allocated and first touched, tables and acceleration structures built on first use) done
     // ahead of time, so that a frame-locked run's first frame costs what the others do. The
@@ -116,7 +126,8 @@ class ChannelPipeline {
     // ChannelSettings::Display::Lut).
     const sensors::DisplayLut& Lut();
     std::unique_ptr<sensors::DisplayLut> lut_;
-    Image previewSmall_;  // otw: pixels_ scaled to the preview size (kept between frames)
+    Image previewSmall_;       // otw: pixels_ scaled to the preview size (kept between frames)
+    sensors::ImageSink sink_;  // direct, or background after WriteInBackground
 };
 
 // The project's OCIO config: $SEASENSE_OCIO if set, else configs/ocio/config.ocio found

@@ -3,22 +3,30 @@
 
 #include <tbb/parallel_for.h>
 
+#include <utility>
+
 namespace seasense::sensors {
 
 void WriteThermalFrame(const ThermalImager& imager, const ThermalOutputPaths& paths,
                        ImageMetadata metadata) {
+    ImageSink direct;
+    WriteThermalFrame(imager, paths, std::move(metadata), direct);
+}
+
+void WriteThermalFrame(const ThermalImager& imager, const ThermalOutputPaths& paths,
+                       ImageMetadata metadata, ImageSink& sink) {
     for (MetadataAttribute& a : imager.Metadata().attributes)
         metadata.Set(std::move(a.name), std::move(a.value));
     const int w = imager.Radiance().width, h = imager.Radiance().height;
     if (!paths.rawCounts.empty()) {
         ImageMetadata m = metadata;
         m.Set("seasense:pixel_unit", std::string("ADC counts (14 bit)"));
-        WriteDisplayImage16(paths.rawCounts, imager.Counts(), w, h, 1, m);
+        sink.Display16(paths.rawCounts, imager.Counts(), w, h, 1, m);
     }
     if (!paths.display.empty()) {
         ImageMetadata m = metadata;
         m.Set("seasense:pixel_unit", std::string("display level (AGC)"));
-        WriteDisplayImage8(paths.display, imager.Display(), w, h, imager.DisplayChannels(), m);
+        sink.Display8(paths.display, imager.Display(), w, h, imager.DisplayChannels(), m);
     }
     if (!paths.radiometricExr.empty()) {
         const Image T = imager.ApparentTemperature();
@@ -37,7 +45,7 @@ void WriteThermalFrame(const ThermalImager& imager, const ThermalOutputPaths& pa
         m.Set("seasense:T_unit", std::string("K (apparent blackbody temperature of L)"));
         ExrOptions options;
         options.channelNames = {"L", "T"};
-        WriteExr(paths.radiometricExr, both, m, options);
+        sink.Exr(paths.radiometricExr, both, m, options);
     }
 }
 

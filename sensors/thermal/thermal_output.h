@@ -3,6 +3,7 @@
 
 #include <filesystem>
 
+#include "sensors/output/image_sink.h"
 #include "sensors/output/image_writer.h"
 #include "sensors/thermal/thermal_imager.h"
 
@@ -24,5 +25,8 @@ struct ThermalOutputPaths {
 // Atomic per file (image_writer.h). Throws RuntimeError if a file cannot be written.
 void WriteThermalFrame(const ThermalImager& imager, const ThermalOutputPaths& paths,
                        ImageMetadata metadata = {});
+// As above, the files handed to `sink` (written now, or copied and written in the background).
+void WriteThermalFrame(const ThermalImager& imager, const ThermalOutputPaths& paths,
+                       ImageMetadata metadata, ImageSink& sink);
 
 }  // namespace seasense::sensors

@@ -327,6 +327,33 @@ TEST(Run, KilledRendererStopsTheRunWithStatusOne) {
     fs::remove_all(out);
 }
 
+// A renderer writes its files on a thread of its own while it renders the next frame: a file
+// that cannot be written still ends the run with status 1, naming the file, the frames before
+// it complete on disk.
+TEST(Run, ImageThatCannotBeWrittenEndsTheRunWithStatusOne) {
+    const fs::path out = TempDir("badfile");
+    // A non-empty folder where frame 3's image of 'centre' goes: its rename must fail.
+    const fs::path blocked = out / "centre" / "centre_000003.png";
+    fs::create_directories(blocked / "x");
+    const auto result =
+        Shell(kBinary + " run --config " + kScenario + " --frames 8 --out " + out.string() +
+              " --run-id " + RunId("bf") + " --threads 1 --no-video");
+    EXPECT_EQ(result.status, 1);
+    const std::string& err = result.output;
+    EXPECT_NE(err.find(blocked.string()), std::string::npos) << err;
+    EXPECT_NE(err.find("centre"), std::string::npos) << err;
+    for (int frame = 0; frame < 3; ++frame) {
+        char name[64];
+        std::snprintf(name, sizeof name, "centre_%06d.png", frame);
+        OIIO::ImageBuf image((out / "centre" / name).string());
+        EXPECT_TRUE(image.read()) << name;
+    }
+    for (const auto& e : fs::recursive_directory_iterator(out))
+        EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
+    EXPECT_FALSE(SegmentExists(RunId("bf")));
+    fs::remove_all(out);
+}
+
 TEST(Run, KilledHostMakesRenderersExitAndRemoveTheSegment) {
     const fs::path out = TempDir("killhost");
     const std::string runId = RunId("kh");

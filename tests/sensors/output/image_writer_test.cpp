@@ -1,4 +1,5 @@
-// Image and text output: EXR/PNG/TIFF round trips with metadata, atomic replacement, clear errors.
+// Image and text output: EXR/PNG/TIFF round trips with metadata, atomic replacement, clear errors;
+// ImageSink, direct and in the background.
 #include "sensors/output/image_writer.h"
 
 #include <OpenImageIO/imageio.h>
@@ -18,6 +19,7 @@
 
 #include "scene/core/error.h"
 #include "scene/core/rng.h"
+#include "sensors/output/image_sink.h"
 
 namespace seasense::sensors {
 namespace {
@@ -376,6 +378,75 @@ TEST_F(ImageWriterTest, SameInputGivesIdenticalBytesWithoutWallClockTime) {
             EXPECT_EQ(in->spec().get_string_attribute("DateTime"), expected) << name;
         }
     }
+}
+
+// The pixels of an image file, in the type T.
+template <typename T>
+std::vector<T> ReadPixelsOf(const fs::path& path) {
+    OIIO::ImageSpec spec;
+    return ReadPixels<T>(path, spec);
+}
+
+// ImageSink: a background sink writes the same files as a direct one from copies of the pixels
+// taken at the call, and its write errors surface from Finish with the file named.
+TEST_F(ImageWriterTest, SinkBackgroundFilesHoldThePixelsOfTheCallAndMatchDirectWrites) {
+    // Large enough that encoding a file takes milliseconds: the caller overwrites its buffers
+    // while the files of the call are still queued or being written.
+    constexpr int w = 320, h = 241;
+    std::vector<uint8_t> rgb(size_t(w) * h * 3);
+    std::vector<uint16_t> gray16(size_t(w) * h);
+    Image linear(w, h, 3);
+    const auto fill = [&](int k) {
+        for (size_t i = 0; i < rgb.size(); ++i) rgb[i] = uint8_t((i * 7 + size_t(k) * 31) & 255);
+        for (size_t i = 0; i < gray16.size(); ++i) gray16[i] = uint16_t(i * 977 + size_t(k));
+        for (size_t i = 0; i < linear.pixels.size(); ++i) linear.pixels[i] = float(i) * 0.5f + k;
+    };
+    ImageMetadata md;
+    md.Set("seasense:channel", std::string("test"));
+    ImageSink background(2), direct;
+    for (int k = 0; k < 4; ++k) {
+        fill(k);
+        const std::string n = std::to_string(k);
+        background.Display8(folder_ / ("bg" + n + ".png"), rgb, w, h, 3, md);
+        background.Display16(folder_ / ("bg" + n + "_raw.png"), gray16, w, h, 1, md);
+        background.Exr(folder_ / ("bg" + n + ".exr"), linear, md);
+        fill(100 + k);  // the caller reuses its buffers at once
+    }
+    background.Finish();
+    for (int k = 0; k < 4; ++k) {
+        fill(k);
+        const std::string n = std::to_string(k);
+        direct.Display8(folder_ / ("d" + n + ".png"), rgb, w, h, 3, md);
+        direct.Display16(folder_ / ("d" + n + "_raw.png"), gray16, w, h, 1, md);
+        direct.Exr(folder_ / ("d" + n + ".exr"), linear, md);
+        EXPECT_EQ(ReadPixelsOf<uint8_t>(folder_ / ("bg" + n + ".png")), rgb) << k;
+        EXPECT_EQ(ReadPixelsOf<uint16_t>(folder_ / ("bg" + n + "_raw.png")), gray16) << k;
+        EXPECT_EQ(ReadPixelsOf<float>(folder_ / ("bg" + n + ".exr")), linear.pixels) << k;
+        for (const char* suffix : {".png", "_raw.png", ".exr"})
+            EXPECT_EQ(ReadBytes(folder_ / ("bg" + n + suffix)),
+                      ReadBytes(folder_ / ("d" + n + suffix)))
+                << k << suffix;
+    }
+}
+
+TEST_F(ImageWriterTest, SinkBackgroundWriteErrorSurfacesFromFinishNamingTheFile) {
+    // chmod does not stop root: make the folder impossible instead, its parent is a file.
+    const fs::path blocker = folder_ / "not_a_folder";
+    std::ofstream(blocker) << "x";
+    const fs::path bad = blocker / "out" / "frame.png";
+    const std::vector<uint8_t> gray(16, 128);
+    ImageSink sink(4);
+    sink.Display8(bad, gray, 4, 4, 1, {});
+    try {
+        sink.Finish();
+        FAIL() << "expected RuntimeError";
+    } catch (const RuntimeError& e) {
+        EXPECT_NE(std::string(e.what()).find(bad.string()), std::string::npos) << e.what();
+    }
+    EXPECT_NO_THROW(sink.Finish());  // reported once
+    sink.Display8(folder_ / "good.png", gray, 4, 4, 1, {});
+    sink.Finish();
+    EXPECT_EQ(ReadPixelsOf<uint8_t>(folder_ / "good.png"), gray);
 }
 
 }  // namespace
