@@ -1,4 +1,5 @@
-// Atomic image and text file output with OpenImageIO: EXR (scene-linear float), PNG/TIFF (display).
+// Atomic image and text file output: EXR (scene-linear float) and TIFF (display) with OpenImageIO,
+// PNG (display) with our own encoder.
 #include "sensors/output/image_writer.h"
 
 #include <OpenImageIO/imageio.h>
@@ -9,14 +10,17 @@
 #include <atomic>
 #include <cctype>
 #include <cerrno>
+#include <charconv>
 #include <cstring>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <system_error>
 #include <utility>
 
 #include "scene/core/check.h"
 #include "scene/core/error.h"
+#include "sensors/output/png_encoder.h"
 
 namespace seasense::sensors {
 
@@ -221,7 +225,8 @@ std::vector<std::string> ExrChannelNames(const fs::path& path, int channels,
     }
 }
 
-// OIIO plugin name for a display image, from the file extension.
+// Format of a display image, from the file extension: "png" (png_encoder.h) or "tiff" (the
+// OIIO plugin's name).
 const char* DisplayFormatFor(const fs::path& path) {
     std::string extension = path.extension().string();
     std::transform(extension.begin(), extension.end(), extension.begin(),
@@ -232,31 +237,165 @@ const char* DisplayFormatFor(const fs::path& path) {
                      path.extension().string() + "', expected .png, .tif or .tiff");
 }
 
-void WriteDisplayImage(const fs::path& path, const void* pixels, size_t pixelCount,
-                       OIIO::TypeDesc type, int width, int height, int channels,
-                       const ImageMetadata& metadata) {
+// Writes `bytes` into a new file at tempPath, checking every step.
+void WriteFileBytes(const fs::path& tempPath, const fs::path& finalPath,
+                    std::span<const std::uint8_t> bytes) {
+    const int fd = ::open(tempPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    if (fd < 0) {
+        throw RuntimeError("cannot write " + Quoted(finalPath) + ": cannot create temporary file " +
+                           Quoted(tempPath) + ": " + std::strerror(errno));
+    }
+    for (std::size_t done = 0; done < bytes.size();) {
+        const ssize_t written = ::write(fd, bytes.data() + done, bytes.size() - done);
+        if (written < 0 && errno == EINTR) continue;
+        if (written <= 0) {
+            const std::string reason = written < 0 ? std::strerror(errno) : "nothing written";
+            ::close(fd);
+            throw RuntimeError("cannot write " + Quoted(finalPath) + ": writing temporary file " +
+                               Quoted(tempPath) + " failed: " + reason);
+        }
+        done += std::size_t(written);
+    }
+    if (::close(fd) != 0) {
+        throw RuntimeError("cannot write " + Quoted(finalPath) + ": closing temporary file " +
+                           Quoted(tempPath) + " failed: " + std::strerror(errno));
+    }
+}
+
+// "YYYY:MM:DD hh:mm:ss" (the DateTime form) as tIME fields, or nothing if `text` is not in
+// that form or a field is out of range.
+std::optional<PngTime> PngTimeOf(const std::string& text) {
+    constexpr std::string_view kForm = "dddd:dd:dd dd:dd:dd";
+    if (text.size() != kForm.size()) return std::nullopt;
+    for (std::size_t i = 0; i < kForm.size(); ++i) {
+        const bool digit = std::isdigit(static_cast<unsigned char>(text[i])) != 0;
+        if (kForm[i] == 'd' ? !digit : text[i] != kForm[i]) return std::nullopt;
+    }
+    const auto field = [&](std::size_t at, std::size_t digits) {
+        int value = 0;
+        for (std::size_t i = at; i < at + digits; ++i) value = value * 10 + (text[i] - '0');
+        return value;
+    };
+    const PngTime t{field(0, 4),  field(5, 2),  field(8, 2),
+                    field(11, 2), field(14, 2), field(17, 2)};
+    if (!PngTimeIsValid(t)) return std::nullopt;
+    return t;
+}
+
+void AppendNumber(std::string& out, float value) {
+    char buffer[32];
+    // Shortest form that reads back as the same float.
+    const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
+    out.append(buffer, result.ptr);
+}
+
+void AppendNumbers(std::string& out, std::span<const float> values) {
+    for (std::size_t i = 0; i < values.size(); ++i) {
+        if (i > 0) out += ", ";
+        AppendNumber(out, values[i]);
+    }
+}
+
+// A metadata value as PNG text: strings as they are; numbers in the shortest form that reads
+// back as the same value; arrays, vectors and matrices (row by row) as their numbers separated
+// by ", ", as OIIO prints them (oiiotool --info -v).
+std::string PngTextOf(const MetadataValue& value) {
+    std::string text;
+    if (const auto* s = std::get_if<std::string>(&value)) {
+        text = *s;
+    } else if (const auto* i = std::get_if<int>(&value)) {
+        text = std::to_string(*i);
+    } else if (const auto* f = std::get_if<float>(&value)) {
+        AppendNumber(text, *f);
+    } else if (const auto* array = std::get_if<std::vector<float>>(&value)) {
+        AppendNumbers(text, *array);
+    } else if (const auto* v3 = std::get_if<Vector3f>(&value)) {
+        AppendNumbers(text, v3->v);
+    } else if (const auto* m3 = std::get_if<Matrix33f>(&value)) {
+        AppendNumbers(text, m3->m);
+    } else if (const auto* m4 = std::get_if<Matrix44f>(&value)) {
+        AppendNumbers(text, m4->m);
+    }
+    return text;
+}
+
+// The PNG metadata of `metadata`, stored as OIIO's PNG writer stored it: DateTime (the Unix
+// epoch if absent) in the tIME chunk, and a tEXt chunk for every other attribute, in order,
+// under its own name, except that ImageDescription, Artist and DocumentName take the keywords
+// PNG defines for them (§11.3.4.2: Description, Author, Title), which OIIO's reader maps back.
+// OIIO stored string attributes only; the others are stored here as text (PngTextOf), so the
+// PNG records what the EXR does. Throws InputError (without the file name) for an attribute
+// that cannot be stored.
+PngInfo PngInfoFor(const ImageMetadata& metadata) {
+    PngInfo info;
+    const MetadataValue* dateTime = metadata.Find("DateTime");
+    const auto* dateText = dateTime ? std::get_if<std::string>(dateTime) : nullptr;
+    info.time =
+        dateTime ? (dateText ? PngTimeOf(*dateText) : std::nullopt) : PngTimeOf(kDefaultDateTime);
+    for (const MetadataAttribute& attribute : metadata.attributes) {
+        const std::string& name = attribute.name;
+        if (name.empty()) throw InputError("metadata attribute with an empty name");
+        // A DateTime not in the form tIME holds is kept as text rather than lost.
+        if (name == "DateTime" && info.time) continue;
+        const auto* array = std::get_if<std::vector<float>>(&attribute.value);
+        if (array && array->empty()) {
+            throw InputError("metadata attribute '" + name + "' is an empty float array");
+        }
+        std::string keyword = name;
+        if (std::holds_alternative<std::string>(attribute.value)) {
+            if (name == "ImageDescription") keyword = "Description";
+            if (name == "Artist") keyword = "Author";
+            if (name == "DocumentName") keyword = "Title";
+        }
+        info.text.push_back({std::move(keyword), PngTextOf(attribute.value)});
+    }
+    CheckPngInfo(info);
+    return info;
+}
+
+// PNGs are encoded here (png_encoder.h) rather than through OIIO and libpng, because the
+// five-channel demo writes five of them every frame. Every row goes through the Sub filter
+// (each byte minus the one a pixel to its left; PNG specification §9.2) instead of libpng's
+// per-row trial of all five filters: the trial cost more than the compression (png_write_row
+// 131 → 55 M instructions on the demo's otw-center frame 120 at zlib level 1) and its files
+// were no smaller. The rows are compressed in one call by libdeflate at level 1 instead of by
+// zlib at level 1 through libpng (level 1 rather than the usual 6: with zlib 2.4× faster on a
+// 640×480 frame for ~1.6× the bytes). On the demo's frame 120 the PNG costs 24 M instructions
+// instead of 55 M for otw-center, 26 instead of 62 M for nvg and 15 instead of 41 M for flir
+// (gray), and the files are 127 instead of 153 kB, 156 instead of 180 kB and 169 instead of 179 kB.
+// Lossless either way: the pixels are the same.
+template <typename Sample>
+void WritePng(const fs::path& path, std::span<const Sample> pixels, int width, int height,
+              int channels, const ImageMetadata& metadata) {
+    std::vector<std::uint8_t> png;
+    try {
+        png = EncodePng(pixels, width, height, channels, PngInfoFor(metadata));
+    } catch (const InputError& e) {
+        throw InputError("cannot write " + Quoted(path) + ": " + e.what());
+    } catch (const RuntimeError& e) {
+        throw RuntimeError("cannot write " + Quoted(path) + ": " + e.what());
+    }
+    WriteAtomically(path, [&](const fs::path& tempPath) { WriteFileBytes(tempPath, path, png); });
+}
+
+template <typename Sample>
+void WriteDisplayImage(const fs::path& path, std::span<const Sample> pixels, int width, int height,
+                       int channels, const ImageMetadata& metadata) {
     const char* format = DisplayFormatFor(path);
     CheckDimensions(path, width, height, channels, 4);
-    CHECK_MSG(pixelCount == size_t(width) * size_t(height) * size_t(channels),
-              "display image buffer holds " << pixelCount << " values for " << width << "x"
+    CHECK_MSG(pixels.size() == size_t(width) * size_t(height) * size_t(channels),
+              "display image buffer holds " << pixels.size() << " values for " << width << "x"
                                             << height << "x" << channels);
-    OIIO::ImageSpec spec(width, height, channels, type);
-    if (std::string(format) == "tiff") spec.attribute("compression", "zip");
-    // zlib level 1 instead of libpng's default 6: 2.4× faster on a 640×480 frame for ~1.6×
-    // the bytes, which matters when five channels write every frame of a run. And every row
-    // through the Sub filter (each byte minus the one a pixel to its left; PNG specification,
-    // ISO/IEC 15948 §9.2) instead of libpng's per-row trial of all five filters: the trial cost
-    // more than the compression (png_write_row 131 → 55 M instructions on the five-channel
-    // demo's otw-center frame 120, 61 vs 136 M on its NVG frame), and its files were no smaller
-    // (154 vs 166 kB; NVG 180 vs 186 kB; FLIR gray 179 vs 178 kB). OIIO's "png:filter" takes
-    // libpng's filter mask, PNG_FILTER_SUB = 0x10 (png.h).
-    if (std::string(format) == "png") {
-        spec.attribute("png:compressionLevel", 1);
-        spec.attribute("png:filter", 0x10);
+    if (std::string_view(format) == "png") {
+        WritePng(path, pixels, width, height, channels, metadata);
+        return;
     }
+    const OIIO::TypeDesc type = OIIO::BaseTypeFromC<Sample>::value;
+    OIIO::ImageSpec spec(width, height, channels, type);
+    spec.attribute("compression", "zip");
     AddMetadata(spec, metadata, path);
     WriteAtomically(path, [&](const fs::path& tempPath) {
-        WriteWithOiio(format, tempPath, path, spec, type, pixels);
+        WriteWithOiio(format, tempPath, path, spec, type, pixels.data());
     });
 }
 
@@ -287,14 +426,12 @@ void WriteExr(const fs::path& path, const Image& image, const ImageMetadata& met
 
 void WriteDisplayImage8(const fs::path& path, std::span<const std::uint8_t> pixels, int width,
                         int height, int channels, const ImageMetadata& metadata) {
-    WriteDisplayImage(path, pixels.data(), pixels.size(), OIIO::TypeDesc::UINT8, width, height,
-                      channels, metadata);
+    WriteDisplayImage(path, pixels, width, height, channels, metadata);
 }
 
 void WriteDisplayImage16(const fs::path& path, std::span<const std::uint16_t> pixels, int width,
                          int height, int channels, const ImageMetadata& metadata) {
-    WriteDisplayImage(path, pixels.data(), pixels.size(), OIIO::TypeDesc::UINT16, width, height,
-                      channels, metadata);
+    WriteDisplayImage(path, pixels, width, height, channels, metadata);
 }
 
 void WriteTextFileAtomic(const fs::path& path, std::string_view text) {

@@ -1,4 +1,5 @@
-// Atomic image and text file output with OpenImageIO: EXR (scene-linear float), PNG/TIFF (display).
+// Atomic image and text file output: EXR (scene-linear float) and TIFF (display) with OpenImageIO,
+// PNG (display) with our own encoder (png_encoder.h).
 #pragma once
 
 #include <array>
@@ -46,7 +47,7 @@ struct ImageMetadata {
     void Set(std::string name, MetadataValue value);
     // The value stored under `name`, or nullptr.
     const MetadataValue* Find(std::string_view name) const;
-    // Sets "DateTime" (EXR capDate, TIFF DateTime) to `t`, to the second, in the
+    // Sets "DateTime" (EXR capDate, TIFF DateTime, PNG tIME) to `t`, to the second, in the
     // "YYYY:MM:DD hh:mm:ss" form OIIO and EXIF use. For a simulator this is the simulation
     // time of the frame. Without it the writers store the Unix epoch: OIIO would otherwise
     // stamp EXR and TIFF files with the wall clock and identical frames would differ.
@@ -72,7 +73,9 @@ void WriteExr(const std::filesystem::path& path, const Image& image,
 
 // Writes display-referred 8-bit pixels (interleaved, width×height×channels, 1..4 channels,
 // row 0 at the top) as PNG or TIFF, chosen by the extension (.png, .tif, .tiff, any case).
-// String metadata goes into the file where the format supports it. Atomic as WriteExr.
+// TIFF stores what OIIO's TIFF writer supports of the metadata; PNG stores DateTime in its tIME
+// chunk and every other attribute as a tEXt chunk (keyword = name, numbers as text; see PngInfoFor
+// in the .cpp), and throws InputError for a name that cannot be a PNG keyword. Atomic as WriteExr.
 void WriteDisplayImage8(const std::filesystem::path& path, std::span<const std::uint8_t> pixels,
                         int width, int height, int channels, const ImageMetadata& metadata = {});
 

@@ -10,10 +10,12 @@
 #include <zlib.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -314,34 +316,52 @@ TEST_F(ImageWriterTest, FailedRenameLeavesTheTargetAndNoTempFile) {
     EXPECT_EQ(ReadBytes(target / "keep.txt"), "keep");
 }
 
-TEST_F(ImageWriterTest, FailedWriteLeavesTheExistingFileUnchanged) {
-    const fs::path path = folder_ / "frame.exr";
-    WriteExr(path, NoiseImage(4, 4, 3, 6));
-    const std::string before = ReadBytes(path);
-
-    // A real write failure mid-file: limit the file size this process may write
-    // (RLIMIT_FSIZE, POSIX getrlimit), so writing a 3 MB EXR fails with EFBIG. SIGXFSZ is
-    // ignored so the failure reaches the writer as an error instead of ending the process.
+// Runs `write` while this process may write files of at most 64 kB (RLIMIT_FSIZE, POSIX
+// getrlimit), so that writing more fails mid-file with EFBIG; SIGXFSZ is ignored so the failure
+// reaches the writer as an error instead of ending the process. Returns the RuntimeError's
+// message, or nullopt if there was none.
+template <typename WriteFn>
+std::optional<std::string> RuntimeErrorUnderFileSizeLimit(WriteFn&& write) {
     rlimit saved{};
-    ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &saved), 0);
+    EXPECT_EQ(::getrlimit(RLIMIT_FSIZE, &saved), 0);
     const auto previousHandler = ::signal(SIGXFSZ, SIG_IGN);
     rlimit limited = saved;
     limited.rlim_cur = 64 * 1024;
-    ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &limited), 0);
-    bool threw = false;
-    std::string message;
+    EXPECT_EQ(::setrlimit(RLIMIT_FSIZE, &limited), 0);
+    std::optional<std::string> message;
     try {
-        WriteExr(path, NoiseImage(512, 512, 3, 7));
+        write();
     } catch (const RuntimeError& e) {
-        threw = true;
         message = e.what();
     }
     ::setrlimit(RLIMIT_FSIZE, &saved);
     ::signal(SIGXFSZ, previousHandler);
+    return message;
+}
 
-    EXPECT_TRUE(threw);
-    EXPECT_NE(message.find(path.string()), std::string::npos) << message;
+TEST_F(ImageWriterTest, FailedWriteLeavesTheExistingFileUnchanged) {
+    const fs::path path = folder_ / "frame.exr";
+    WriteExr(path, NoiseImage(4, 4, 3, 6));
+    const std::string before = ReadBytes(path);
+    // A 3 MB EXR.
+    const auto message =
+        RuntimeErrorUnderFileSizeLimit([&] { WriteExr(path, NoiseImage(512, 512, 3, 7)); });
+    ASSERT_TRUE(message);
+    EXPECT_NE(message->find(path.string()), std::string::npos) << *message;
     EXPECT_EQ(ReadBytes(path), before);
+
+    // A PNG of noise, which does not compress: 192 kB.
+    const fs::path png = folder_ / "frame.png";
+    WriteDisplayImage8(png, std::vector<std::uint8_t>(12, 10), 2, 2, 3);
+    const std::string pngBefore = ReadBytes(png);
+    std::vector<std::uint8_t> noise(256 * 256 * 3);
+    for (size_t i = 0; i < noise.size(); ++i) noise[i] = std::uint8_t(scene::HashBits(9, 0, i));
+    const auto pngMessage =
+        RuntimeErrorUnderFileSizeLimit([&] { WriteDisplayImage8(png, noise, 256, 256, 3); });
+    ASSERT_TRUE(pngMessage);
+    EXPECT_NE(pngMessage->find(png.string()), std::string::npos) << *pngMessage;
+    EXPECT_NE(pngMessage->find("File too large"), std::string::npos) << *pngMessage;
+    EXPECT_EQ(ReadBytes(png), pngBefore);
 }
 
 TEST_F(ImageWriterTest, SuccessfulOverwriteReplacesTheFile) {
@@ -360,7 +380,7 @@ TEST_F(ImageWriterTest, SuccessfulOverwriteReplacesTheFile) {
 TEST_F(ImageWriterTest, SameInputGivesIdenticalBytesWithoutWallClockTime) {
     // Frames must be bit-identical across runs, but OIIO stamps EXR and TIFF headers with the
     // current time unless told otherwise: the writer stores the Unix epoch, or the capture
-    // time the caller gives.
+    // time the caller gives (in a PNG's tIME chunk).
     const Image image = NoiseImage(20, 10, 3, 8);
     const std::vector<std::uint8_t> codes(20 * 10 * 3, 5);
     ImageMetadata captured;
@@ -370,9 +390,12 @@ TEST_F(ImageWriterTest, SameInputGivesIdenticalBytesWithoutWallClockTime) {
           {captured, "2024:06:01 12:34:56"}}) {
         WriteExr(folder_ / "a.exr", image, metadata);
         WriteDisplayImage8(folder_ / "a.tif", codes, 20, 10, 3, metadata);
+        WriteDisplayImage8(folder_ / "a.png", codes, 20, 10, 3, metadata);
         WriteExr(folder_ / "b.exr", image, metadata);
+        WriteDisplayImage8(folder_ / "b.png", codes, 20, 10, 3, metadata);
         EXPECT_EQ(ReadBytes(folder_ / "a.exr"), ReadBytes(folder_ / "b.exr"));
-        for (const char* name : {"a.exr", "a.tif"}) {
+        EXPECT_EQ(ReadBytes(folder_ / "a.png"), ReadBytes(folder_ / "b.png"));
+        for (const char* name : {"a.exr", "a.tif", "a.png"}) {
             auto in = OIIO::ImageInput::open((folder_ / name).string());
             ASSERT_TRUE(in) << OIIO::geterror();
             EXPECT_EQ(in->spec().get_string_attribute("DateTime"), expected) << name;
@@ -447,6 +470,120 @@ TEST_F(ImageWriterTest, SinkBackgroundWriteErrorSurfacesFromFinishNamingTheFile)
     sink.Display8(folder_ / "good.png", gray, 4, 4, 1, {});
     sink.Finish();
     EXPECT_EQ(ReadPixelsOf<uint8_t>(folder_ / "good.png"), gray);
+}
+
+// The chunk types and data of a PNG file, in order (ISO/IEC 15948 §5.3).
+std::vector<std::pair<std::string, std::string>> PngChunks(const fs::path& path) {
+    const std::string bytes = ReadBytes(path);
+    std::vector<std::pair<std::string, std::string>> chunks;
+    for (size_t at = 8; at + 12 <= bytes.size();) {
+        const size_t length =
+            (size_t(uint8_t(bytes[at])) << 24) | (size_t(uint8_t(bytes[at + 1])) << 16) |
+            (size_t(uint8_t(bytes[at + 2])) << 8) | size_t(uint8_t(bytes[at + 3]));
+        chunks.emplace_back(bytes.substr(at + 4, 4), bytes.substr(at + 8, length));
+        at += 12 + length;
+    }
+    return chunks;
+}
+
+TEST_F(ImageWriterTest, PngStoresEveryAttributeAsTextAndDateTimeInTime) {
+    ImageMetadata metadata;
+    metadata.Set("seasense:channel", std::string("otw-center"));
+    metadata.Set("seasense:frame_index", 43);
+    metadata.Set("seasense:exposure_ev", -3.25f);
+    metadata.Set("seasense:fov_deg", std::vector<float>{60.0f, 45.5f});
+    metadata.Set("seasense:eyepoint_m", Vector3f{{1.5f, -2.0f, 30.25f}});
+    metadata.Set("seasense:intrinsics", Matrix33f{{1, 2, 3, 4, 5, 6, 7, 8, 9}});
+    Matrix44f pose;
+    for (int i = 0; i < 16; ++i) pose.m[size_t(i)] = 0.5f * float(i) - 3.0f;
+    metadata.Set("seasense:worldFromCamera", pose);
+    // Floats whose shortest decimal form needs care: each must read back as the same float.
+    const std::vector<float> hard = {0.1f,
+                                     1.0f / 3.0f,
+                                     16777216.0f,
+                                     std::numeric_limits<float>::max(),
+                                     std::numeric_limits<float>::denorm_min(),
+                                     -0.0f};
+    metadata.Set("seasense:hard", hard);
+    metadata.Set("oiio:ColorSpace", std::string("Linear Rec.709 (sRGB)"));
+    metadata.Set("ImageDescription", std::string("seasense otw"));
+    metadata.SetCaptureTime(*scene::ParseIso8601("2024-06-01T12:34:56.789Z"));
+    const fs::path path = folder_ / "frame.png";
+    WriteDisplayImage8(path, std::vector<std::uint8_t>(5 * 4 * 3, 7), 5, 4, 3, metadata);
+
+    auto in = OIIO::ImageInput::open(path.string());
+    ASSERT_TRUE(in) << OIIO::geterror();
+    const OIIO::ImageSpec& spec = in->spec();
+    EXPECT_EQ(spec.get_string_attribute("seasense:channel"), "otw-center");
+    EXPECT_EQ(spec.get_string_attribute("seasense:frame_index"), "43");
+    EXPECT_EQ(spec.get_string_attribute("seasense:exposure_ev"), "-3.25");
+    EXPECT_EQ(spec.get_string_attribute("seasense:fov_deg"), "60, 45.5");
+    EXPECT_EQ(spec.get_string_attribute("seasense:eyepoint_m"), "1.5, -2, 30.25");
+    EXPECT_EQ(spec.get_string_attribute("seasense:intrinsics"), "1, 2, 3, 4, 5, 6, 7, 8, 9");
+    EXPECT_EQ(spec.get_string_attribute("seasense:worldFromCamera"),
+              "-3, -2.5, -2, -1.5, -1, -0.5, 0, 0.5, 1, 1.5, 2, 2.5, 3, 3.5, 4, 4.5");
+    const std::string hardText = spec.get_string_attribute("seasense:hard");
+    const char* at = hardText.c_str();
+    for (const float expected : hard) {
+        char* end = nullptr;
+        const float value = std::strtof(at, &end);
+        ASSERT_NE(end, at) << hardText;
+        EXPECT_EQ(std::memcmp(&value, &expected, sizeof(float)), 0) << hardText;
+        at = end;
+        if (*at == ',') at += 2;
+    }
+    EXPECT_EQ(*at, '\0') << hardText;
+    EXPECT_EQ(spec.get_string_attribute("oiio:ColorSpace"), "Linear Rec.709 (sRGB)");
+    EXPECT_EQ(spec.get_string_attribute("ImageDescription"), "seasense otw");
+    EXPECT_EQ(spec.get_string_attribute("DateTime"), "2024:06:01 12:34:56");
+
+    // As OIIO's PNG writer stored them: DateTime only in tIME, ImageDescription under PNG's own
+    // keyword, every attribute in the order it was set.
+    std::vector<std::string> keywords;
+    for (const auto& [type, data] : PngChunks(path)) {
+        if (type == "tIME") {
+            EXPECT_EQ(data, std::string("\x07\xe8\x06\x01\x0c\x22\x38", 7));
+        }
+        if (type == "tEXt") keywords.push_back(data.substr(0, data.find('\0')));
+    }
+    EXPECT_EQ(keywords,
+              (std::vector<std::string>{
+                  "seasense:channel", "seasense:frame_index", "seasense:exposure_ev",
+                  "seasense:fov_deg", "seasense:eyepoint_m", "seasense:intrinsics",
+                  "seasense:worldFromCamera", "seasense:hard", "oiio:ColorSpace", "Description"}));
+}
+
+TEST_F(ImageWriterTest, PngKeepsADateTimeTimeCannotHoldAsText) {
+    ImageMetadata metadata;
+    metadata.Set("DateTime", std::string("2024:13:01 00:00:00"));  // month 13
+    const fs::path path = folder_ / "frame.png";
+    WriteDisplayImage8(path, std::vector<std::uint8_t>(3, 7), 1, 1, 3, metadata);
+    for (const auto& [type, data] : PngChunks(path)) EXPECT_NE(type, "tIME");
+    auto in = OIIO::ImageInput::open(path.string());
+    ASSERT_TRUE(in) << OIIO::geterror();
+    EXPECT_EQ(in->spec().get_string_attribute("DateTime"), "2024:13:01 00:00:00");
+}
+
+TEST_F(ImageWriterTest, PngRejectsAttributesItCannotStore) {
+    const std::vector<std::uint8_t> pixels(12, 0);
+    for (const auto& [name, value] : {std::pair<std::string, MetadataValue>{"two  spaces", 1},
+                                      {std::string(80, 'k'), 1},
+                                      {"tab\tkey", 1},
+                                      {"nul", std::string("a\0b", 3)},
+                                      {"empty", std::vector<float>{}},
+                                      {"", 1}}) {
+        ImageMetadata metadata;
+        metadata.Set("seasense:channel", std::string("flir"));
+        metadata.Set(name, value);
+        const fs::path path = folder_ / "frame.png";
+        try {
+            WriteDisplayImage8(path, pixels, 2, 2, 3, metadata);
+            ADD_FAILURE() << "expected InputError for '" << name << "'";
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find(path.string()), std::string::npos) << e.what();
+        }
+        EXPECT_TRUE(fs::is_empty(folder_)) << name;
+    }
 }
 
 }  // namespace
