@@ -146,7 +146,7 @@ struct ChannelSettings {
     // Otw channels: how the display images (png, tiff) are made from the linear image. Exact:
     // the OCIO display transform of every pixel (~1800 instructions a pixel with the ACES
     // output transform). Lut: a 65³ table of that transform, interpolated in log2 of each
-    // component (sensors::DisplayLut, the run's mosaic preview), ~1/12 of the instructions, within
+    // component (sensors::DisplayLut, the run's mosaic preview), ~1/34 of the instructions, within
     // one code value of the exact transform on the five-channel demo's frames (README,
     // Configuration).
     enum class Display { Exact, Lut } display = Display::Exact;

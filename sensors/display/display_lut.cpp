@@ -73,7 +73,144 @@ void DisplayLut::Trilinear(const int i0[3], const float f[3], float out[3]) cons
     out[0] = lanes[0], out[1] = lanes[1], out[2] = lanes[2];
 }
 
+#if defined(__AVX2__)
+namespace {
+
+// Eight pixels' red, green and blue (24 interleaved floats at p) in one vector each, pixel l in
+// lane l: in each 128-bit half the four-pixel deinterleave by five shuffles.
+inline void LoadRgb8(const float* p, __m256& r, __m256& g, __m256& b) {
+    const __m256 m03 = _mm256_loadu2_m128(p + 12, p);      // r0 g0 b0 r1 | r4 g4 b4 r5
+    const __m256 m14 = _mm256_loadu2_m128(p + 16, p + 4);  // g1 b1 r2 g2 | g5 b5 r6 g6
+    const __m256 m25 = _mm256_loadu2_m128(p + 20, p + 8);  // b2 r3 g3 b3 | b6 r7 g7 b7
+    const __m256 xy = _mm256_shuffle_ps(m14, m25, _MM_SHUFFLE(2, 1, 3, 2));  // r2 g2 r3 g3
+    const __m256 yz = _mm256_shuffle_ps(m03, m14, _MM_SHUFFLE(1, 0, 2, 1));  // g0 b0 g1 b1
+    r = _mm256_shuffle_ps(m03, xy, _MM_SHUFFLE(2, 0, 3, 0));
+    g = _mm256_shuffle_ps(yz, xy, _MM_SHUFFLE(3, 1, 2, 0));
+    b = _mm256_shuffle_ps(yz, m25, _MM_SHUFFLE(3, 0, 3, 1));
+}
+
+// The three floats at base + at[l] + offset (and one more, dropped) of eight lanes, one vector
+// per component: eight 16-byte loads, transposed four lanes at a time.
+inline void LoadNodes8(const float* base, const uint32_t at[8], size_t offset, __m256 out[3]) {
+    const float* p = base + offset;
+    const __m256 a0 = _mm256_loadu2_m128(p + at[4], p + at[0]);  // r g b · of lanes 0 | 4
+    const __m256 a1 = _mm256_loadu2_m128(p + at[5], p + at[1]);
+    const __m256 a2 = _mm256_loadu2_m128(p + at[6], p + at[2]);
+    const __m256 a3 = _mm256_loadu2_m128(p + at[7], p + at[3]);
+    const __m256 t0 = _mm256_unpacklo_ps(a0, a1), t1 = _mm256_unpacklo_ps(a2, a3);  // r r g g
+    const __m256 t2 = _mm256_unpackhi_ps(a0, a1), t3 = _mm256_unpackhi_ps(a2, a3);  // b b · ·
+    out[0] = _mm256_shuffle_ps(t0, t1, _MM_SHUFFLE(1, 0, 1, 0));
+    out[1] = _mm256_shuffle_ps(t0, t1, _MM_SHUFFLE(3, 2, 3, 2));
+    out[2] = _mm256_shuffle_ps(t2, t3, _MM_SHUFFLE(1, 0, 1, 0));
+}
+
+// Eight pixels' codes (each lane in [0, 255]) interleaved into 24 bytes at out: packed to bytes
+// per 128-bit half (r0-3 g0-3 b0-3 | r4-7 g4-7 b4-7), each half's twelve bytes into pixel
+// order, and the halves joined.
+inline void StoreRgb8(__m256i r, __m256i g, __m256i b, std::uint8_t* out) {
+    const __m256i bytes = _mm256_packus_epi16(_mm256_packus_epi32(r, g), _mm256_packus_epi32(b, b));
+    const __m256i order = _mm256_setr_epi8(0, 4, 8, 1, 5, 9, 2, 6, 10, 3, 7, 11, -1, -1, -1, -1, 0,
+                                           4, 8, 1, 5, 9, 2, 6, 10, 3, 7, 11, -1, -1, -1, -1);
+    const __m256i rgb = _mm256_permutevar8x32_epi32(_mm256_shuffle_epi8(bytes, order),
+                                                    _mm256_setr_epi32(0, 1, 2, 4, 5, 6, 7, 7));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out), _mm256_castsi256_si128(rgb));
+    _mm_storel_epi64(reinterpret_cast<__m128i*>(out + 16), _mm256_extracti128_si256(rgb, 1));
+}
+
+}  // namespace
+#endif
+
+// Eight pixels at a time, each lane one pixel throughout: its grid coordinates, its eight
+// corners' weights, the sums per component (each the same products and sums, in the same
+// order, as Trilinear's lane for that component) and the codes. QuantizeUnorm8 as
+// ⌊min(max(v, 0), 1) · 255 + 0.5⌋: maxps gives 0 for NaN, so each case (NaN and v ≤ 0 → 0,
+// v ≥ 1 → 255, else the same product and sum) gives QuantizeUnorm8's code. Tested equal to
+// ToDisplay8Steps byte for byte.
 std::vector<std::uint8_t> DisplayLut::ToDisplay8(const Image& linear, float exposureScale) const {
+#if defined(__AVX2__)
+    CHECK(linear.channels == 3);
+    std::vector<std::uint8_t> codes(linear.pixels.size());
+    const size_t n = linear.pixels.size() / 3;
+    const float* in = linear.pixels.data();
+    std::uint8_t* out = codes.data();
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, (n + 7) / 8, 512), [&](const tbb::blocked_range<size_t>& r) {
+            using simd::VF;
+            using simd::VI;
+            const __m256 lowest = _mm256_set1_ps(1e-30f), zero = _mm256_setzero_ps();
+            const VF minLog2 = simd::Splat(minLog2_), scale = simd::Splat(scale_);
+            const VF one = simd::Splat(1.0f), top = simd::Splat(float(edge_ - 1));
+            const VI lastCell = VI{} + (edge_ - 2);
+            const int e = edge_;
+            const size_t dg = 3 * size_t(e), db = 3 * size_t(e) * size_t(e);
+            const size_t cornerOffset[8] = {0, 3, dg, dg + 3, db, db + 3, db + dg, db + dg + 3};
+            const float* table = table_.data();
+            const auto eight = [&](const float* src, std::uint8_t* dst)
+                __attribute__((always_inline)) {
+                __m256 rgb[3];
+                LoadRgb8(src, rgb[0], rgb[1], rgb[2]);
+                VF f[3];
+                VI i0[3];
+                for (int c = 0; c < 3; ++c) {
+                    // As ToDisplay8Steps: non-positive, tiny and NaN values clamp to the grid's
+                    // lower end (maxps(x, lowest) is x > lowest ? x : lowest), +∞ to its top;
+                    // maxps(0, v) and minps(top, v) are simd::Max(v, 0) and simd::Min(v, top).
+                    const VF x = _mm256_max_ps(VF(rgb[c]) * exposureScale, lowest);
+                    const VF u =
+                        _mm256_min_ps(top, _mm256_max_ps(zero, (simd::Log2(x) - minLog2) * scale));
+                    i0[c] = __builtin_convertvector(u, VI);
+                    i0[c] = i0[c] < lastCell ? i0[c] : lastCell;
+                    f[c] = u - __builtin_convertvector(i0[c], VF);
+                }
+                // Unsigned, so that each lane's offset needs no sign extension (they are ≥ 0).
+                alignas(32) uint32_t at[8];
+                const VI node = ((i0[2] * e + i0[1]) * e + i0[0]) * 3;
+                std::memcpy(at, &node, sizeof at);
+                // Trilinear's weights lane for lane: rg = w_r · w_g per corner of the r-g
+                // square, then rg · (1 − f_b) and rg · f_b.
+                const VF wr0 = one - f[0], wg0 = one - f[1], wb0 = one - f[2];
+                const VF rg[4] = {wr0 * wg0, f[0] * wg0, wr0 * f[1], f[0] * f[1]};
+                VF sum[3] = {zero, zero, zero};
+#pragma GCC unroll 8
+                for (int k = 0; k < 8; ++k) {
+                    const VF w = rg[k % 4] * (k < 4 ? wb0 : f[2]);
+                    __m256 corner[3];
+                    LoadNodes8(table, at, cornerOffset[k], corner);
+                    for (int c = 0; c < 3; ++c) sum[c] = sum[c] + w * VF(corner[c]);
+                    // Each corner's sums here: GCC would otherwise load all 64 corner values
+                    // first and sum one component at a time, spilling (11 % more instructions).
+                    asm("" : "+x"(sum[0]), "+x"(sum[1]), "+x"(sum[2]));
+                }
+                VI q[3];
+                for (int c = 0; c < 3; ++c) {
+                    const __m256 v = _mm256_min_ps(_mm256_max_ps(sum[c], zero), one);
+                    q[c] = VI(_mm256_cvttps_epi32(_mm256_add_ps(
+                        _mm256_mul_ps(v, _mm256_set1_ps(255.0f)), _mm256_set1_ps(0.5f))));
+                }
+                StoreRgb8(__m256i(q[0]), __m256i(q[1]), __m256i(q[2]), dst);
+            };
+            for (size_t group = r.begin(); group < r.end(); ++group) {
+                const size_t i = 8 * group;
+                if (i + 8 <= n) {
+                    eight(in + 3 * i, out + 3 * i);
+                } else {
+                    // The last partial group: zeros (the grid's lower end) pad it.
+                    alignas(32) float padded[24] = {};
+                    alignas(32) std::uint8_t codes8[24];
+                    std::memcpy(padded, in + 3 * i, 3 * (n - i) * sizeof(float));
+                    eight(padded, codes8);
+                    std::memcpy(out + 3 * i, codes8, 3 * (n - i));
+                }
+            }
+        });
+    return codes;
+#else
+    return ToDisplay8Steps(linear, exposureScale);
+#endif
+}
+
+std::vector<std::uint8_t> DisplayLut::ToDisplay8Steps(const Image& linear,
+                                                      float exposureScale) const {
     CHECK(linear.channels == 3);
     std::vector<std::uint8_t> codes(linear.pixels.size());
     const size_t n = linear.pixels.size() / 3;

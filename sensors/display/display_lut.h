@@ -26,6 +26,9 @@ class DisplayLut {
     // 8-bit display RGB of linear · exposureScale (QuantizeUnorm8 of the interpolated value).
     // linear: 3 interleaved channels. Parallel; the result does not depend on thread count.
     std::vector<std::uint8_t> ToDisplay8(const Image& linear, float exposureScale) const;
+    // ToDisplay8 with one Trilinear call per pixel (what it does without AVX2, and the
+    // reference its eight-pixel AVX2 form is tested against byte for byte).
+    std::vector<std::uint8_t> ToDisplay8Steps(const Image& linear, float exposureScale) const;
     // One colour, display-encoded float (1.0 = peak).
     void Apply(const float rgb[3], float out[3]) const;
 

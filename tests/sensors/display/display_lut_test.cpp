@@ -91,6 +91,48 @@ TEST(DisplayLut, ToDisplay8AgreesWithApplyPerPixel) {
     EXPECT_GT(same, size_t(3 * img.width) * 99 / 100);
 }
 
+// ToDisplay8 (eight pixels at a time where the build has AVX2) gives ToDisplay8Steps' codes byte
+// for byte: colours over 63 octaves (below the grid's lower end to far above its top), grid
+// nodes and the ends (±0, negatives, −∞, NaN, tiny and subnormal values, huge ones, +∞)
+// in every lane, under several exposures, for sizes with every remainder of eight pixels.
+TEST(DisplayLut, ToDisplay8EqualsItsStepsByteForByte) {
+    const OcioDisplay exact(kConfig, "sRGB", "ACES 1.0 - SDR Video");
+    const DisplayLut lut(exact);
+    const float inf = std::numeric_limits<float>::infinity();
+    const float ends[] = {0.0f,   -0.0f,   -1.0f,  -inf,  std::numeric_limits<float>::quiet_NaN(),
+                          1e-30f, 1e-35f,  1e-40f, 1e30f, std::numeric_limits<float>::max(),
+                          inf,    0.0625f, 64.0f,  65.0f, std::exp2(-14.0f)};
+    size_t differ = 0, values = 0;
+    // 307200 pixels, then 1, 18, 3, 20, 13, 6, 7 and 217: each remainder 0 .. 7 of eight.
+    for (const auto& [w, h] :
+         {std::pair{640, 480}, std::pair{1, 1}, std::pair{9, 2}, std::pair{3, 1}, std::pair{5, 4},
+          std::pair{13, 1}, std::pair{3, 2}, std::pair{7, 1}, std::pair{31, 7}}) {
+        Image img(w, h, 3);
+        for (size_t k = 0; k < img.pixels.size(); ++k) {
+            const uint64_t kind = uint64_t(w) * 1000003u + k;
+            const double u = scene::Uniform01(7, kind, 0);
+            float& v = img.pixels[k];
+            if (k % 5 == 1) {  // an end, in every lane and component over the image
+                v = ends[size_t(scene::Uniform01(7, kind, 1) * double(std::size(ends)))];
+            } else if (k % 5 == 3) {  // a grid node, 0.3125 stop apart (64 cells over 20 stops)
+                v = std::exp2(-14.0f + 0.3125f * float(int(u * 65.0)));
+            } else {
+                v = float(std::exp2(-40.0 + 63.0 * u));
+            }
+        }
+        for (const float exposure : {1.0f, 0.25f, 3.7f, 1e-3f, 0.0f, -1.0f, inf}) {
+            const std::vector<uint8_t> fast = lut.ToDisplay8(img, exposure);
+            const std::vector<uint8_t> steps = lut.ToDisplay8Steps(img, exposure);
+            ASSERT_EQ(fast.size(), steps.size());
+            for (size_t k = 0; k < fast.size(); ++k) differ += fast[k] != steps[k];
+            values += fast.size();
+            EXPECT_EQ(std::memcmp(fast.data(), steps.data(), fast.size()), 0)
+                << w << "x" << h << " exposure " << exposure;
+        }
+    }
+    EXPECT_EQ(differ, 0u) << "of " << values;
+}
+
 // The preview's 2× downscale is OpenCV's INTER_AREA bit for bit (the preview was made with
 // cv::resize before): random values over 40 octaves, the default preview size and an odd one.
 TEST(DisplayLut, HalveRgbEqualsOpenCvAreaResize) {
