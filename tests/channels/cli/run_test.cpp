@@ -104,12 +104,15 @@ std::vector<CsvRow> ReadSyncCsv(const fs::path& p) {
     return rows;
 }
 
-// Waits until the run's segment exists and index `frames` has been published; then the
-// renderer pid of each channel.
+// Waits until the run's segment exists and its first `frames` frames have been presented by
+// every channel and consumed by the host; then the renderer pid of each channel.
 std::vector<int> WaitRunning(const std::string& runId, uint32_t frames) {
     sync::Segment seg = sync::Segment::Attach(runId, 30.0);
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-    while (seg.Header().presentedTotal.load() < frames * seg.Header().channelCount &&
+    // Presented by every channel and consumed by the host (which publishes index i + 2 once it
+    // has consumed i): a host lagging its renderers would otherwise stop before `frames`.
+    while ((seg.Header().presentedTotal.load() < frames * seg.Header().channelCount ||
+            seg.Header().published.load() < frames + sync::kSlotCount) &&
            std::chrono::steady_clock::now() < deadline)
         std::this_thread::sleep_for(std::chrono::milliseconds(10));
     std::vector<int> pids;
