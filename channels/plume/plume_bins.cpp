@@ -618,25 +618,33 @@ void PlumeScreenBins::GatherRow(const RowSource& from, int x0, int y0, int y1, i
         blockPuffs.resize(size_t(blockCount) * stride);
         blockMasks.resize(size_t(blockCount) * stride);
     }
-    size_t fill[64];
-    std::fill(fill, fill + blockCount, size_t(0));
+    // Block b's next slot (b · stride + its puffs so far), and the slots' arrays.
+    size_t next[64];
+    for (int b = 0; b < blockCount; ++b) next[b] = size_t(b) * stride;
+    uint32_t* const puffSlots = blockPuffs.data();
+    uint32_t* const maskSlots = blockMasks.data();
     const auto Put = [&](int b, uint32_t k, uint32_t mask) {
-        const size_t at = size_t(b) * stride + fill[b]++;
-        blockPuffs[at] = k, blockMasks[at] = mask;
+        const size_t at = next[b]++;
+        puffSlots[at] = k, maskSlots[at] = mask;
     };
+    // All the rectangles of a block of cellsPerBlock.
+    const uint32_t whole = uint32_t((uint64_t(1) << cellsPerBlock) - 1);
     for (const ListRow::Reach& reach : reached) {
+        const uint32_t k = reach.k;
         uint64_t bits = reach.blocks;
         if (reach.edge == 0) {
             // Blocks of cells first … last alone: the first from bit first − cb0 on, the last
             // up to bit last − cb0, those between whole (they precede the last block, so they
-            // hold cellsPerBlock rectangles): the masks of the general form below.
+            // hold cellsPerBlock rectangles): the masks of the general form below. Every block
+            // takes the whole mask, then the first's and the last's (each block's last slot
+            // now: a puff takes one slot per block) are cut to the puff's rectangles.
             const int b0 = reach.first / cellsPerBlock, b1 = reach.last / cellsPerBlock;
-            for (; bits != 0; bits &= bits - 1) {
-                const int b = __builtin_ctzll(bits), cb0 = b * cellsPerBlock;
-                const int lo = b == b0 ? reach.first - cb0 : 0;
-                const int hi = b == b1 ? reach.last - cb0 : cellsPerBlock - 1;
-                Put(b, reach.k, uint32_t((uint64_t(2) << hi) - (uint64_t(1) << lo)));
-            }
+            for (; bits != 0; bits &= bits - 1) Put(__builtin_ctzll(bits), k, whole);
+            if ((reach.blocks >> b0) & 1u)
+                maskSlots[next[b0] - 1] &= ~uint32_t(0) << (reach.first - b0 * cellsPerBlock);
+            if ((reach.blocks >> b1) & 1u)
+                maskSlots[next[b1] - 1] &=
+                    uint32_t((uint64_t(2) << (reach.last - b1 * cellsPerBlock)) - 1);
             continue;
         }
         for (; bits != 0; bits &= bits - 1) {
@@ -654,7 +662,7 @@ void PlumeScreenBins::GatherRow(const RowSource& from, int x0, int y0, int y1, i
                                   : shift > -64 ? reach.edge >> -shift
                                                 : 0;
             mask |= uint32_t(edge) & uint32_t((uint64_t(1) << n) - 1);
-            Put(b, reach.k, mask);
+            Put(b, k, mask);
         }
     }
     // The row's lists' ranges, sums, counts and starts, written per block below (one resize
@@ -670,13 +678,21 @@ void PlumeScreenBins::GatherRow(const RowSource& from, int x0, int y0, int y1, i
     alignas(32) float smallA[kVectors * kLanes], halfSmallA[kVectors * kLanes];
     alignas(32) float twiceSmallA[kVectors * kLanes];
     alignas(32) int32_t countA[kVectors * kLanes];
+    // σ below this: small at one of the three sizes (a NaN smallPixels makes all three NaN,
+    // and every comparison false, as in Add).
+    const float smallBound = std::max({smallPixels, 0.5f * smallPixels, 2.0f * smallPixels});
     // The ranges, sums and counts of a block's n rectangles from its puffs and masks into the
     // arrays above, on V vectors of kLanes rectangles (V = ⌈n / kLanes⌉, a constant: the
     // vectors stay in registers). Every vector takes every puff: a lane whose rectangle the
     // puff does not reach keeps its values (the selects), so the lanes hold what adding the
-    // puff to those it reaches alone gives.
+    // puff to those it reaches alone gives. A puff that reaches all n rectangles and adds to no
+    // sum changes only their ranges and counts, the same for every lane: those are kept in
+    // scalars (wholeNear, wholeFar, wholeCount) and merged into the lanes at the end. The
+    // ranges' order does not matter: the nearest and farthest of a set of floats without NaN
+    // or −0 (distances ≥ +0) are the same in any order (PlumeScreenBins.
+    // GatherRowOfBlocksEqualsGatherFromEachBlockForAnySmallSize).
     const auto accumulate = [&]<size_t V>(const uint32_t* puffs, const uint32_t* masks,
-                                          size_t count) {
+                                          size_t count, uint32_t all) {
         // As Begin starts them.
         VF nearV[V], farV[V], smallV[V], halfSmallV[V], twiceSmallV[V];
         VI countV[V];
@@ -685,16 +701,24 @@ void PlumeScreenBins::GatherRow(const RowSource& from, int x0, int y0, int y1, i
             farV[v] = smallV[v] = halfSmallV[v] = twiceSmallV[v] = simd::Splat(0.0f);
             countV[v] = VI{};
         }
+        float wholeNear = std::numeric_limits<float>::infinity(), wholeFar = 0.0f;
+        int32_t wholeCount = 0;
         for (size_t j = 0; j < count; ++j) {
             const uint32_t k = puffs[j], mask = masks[j];
             // The puff's ranges and sums into the rectangles it reaches, in from's order as Add
             // puts them in one list: std::min and std::max are simd::Min and Max lane for lane,
             // and a rectangle the puff does not reach keeps its values.
             const Footprint& fp = footprint_[k];
-            const VF nearK = simd::Splat(fp.near_m), farK = simd::Splat(fp.far_m);
+            if (mask == all && !(fp.sigmaPixels < smallBound)) {
+                wholeNear = std::min(wholeNear, fp.near_m);
+                wholeFar = std::max(wholeFar, fp.far_m);
+                ++wholeCount;
+                continue;
+            }
             const bool small = fp.sigmaPixels < smallPixels;
             const bool halfSmall = fp.sigmaPixels < 0.5f * smallPixels;
             const bool twiceSmall = fp.sigmaPixels < 2.0f * smallPixels;
+            const VF nearK = simd::Splat(fp.near_m), farK = simd::Splat(fp.far_m);
             const VF tau = simd::Splat(fp.tauMax);
             for (size_t v = 0; v < V; ++v) {
                 const VI in = ((VI{} + int32_t(mask >> (v * kLanes))) & laneBit) != 0;
@@ -708,6 +732,9 @@ void PlumeScreenBins::GatherRow(const RowSource& from, int x0, int y0, int y1, i
             }
         }
         for (size_t v = 0; v < V; ++v) {
+            nearV[v] = simd::Min(nearV[v], simd::Splat(wholeNear));
+            farV[v] = simd::Max(farV[v], simd::Splat(wholeFar));
+            countV[v] += wholeCount;
             simd::Store(nearA + v * kLanes, nearV[v]);
             simd::Store(farA + v * kLanes, farV[v]);
             simd::Store(smallA + v * kLanes, smallV[v]);
@@ -719,17 +746,18 @@ void PlumeScreenBins::GatherRow(const RowSource& from, int x0, int y0, int y1, i
     // accumulate with V = vectors (1 … kVectors).
     const auto accumulateOn = [&]<size_t... I>(std::index_sequence<I...>, size_t vectors,
                                                const uint32_t* puffs, const uint32_t* masks,
-                                               size_t count) {
-        ((vectors == I + 1 ? (accumulate.template operator()<I + 1>(puffs, masks, count), true)
+                                               size_t count, uint32_t all) {
+        ((vectors == I + 1 ? (accumulate.template operator()<I + 1>(puffs, masks, count, all), true)
                            : false) ||
          ...);
     };
     for (int b = 0; b < blockCount; ++b) {
         const int cb0 = b * cellsPerBlock, n = std::min(cellsPerBlock, cells - cb0);
-        uint32_t* puffs = blockPuffs.data() + size_t(b) * stride;
-        uint32_t* masks = blockMasks.data() + size_t(b) * stride;
+        uint32_t* puffs = puffSlots + size_t(b) * stride;
+        uint32_t* masks = maskSlots + size_t(b) * stride;
+        const size_t fill = next[b] - size_t(b) * stride;
         accumulateOn(std::make_index_sequence<kVectors>{}, (size_t(n) + kLanes - 1) / kLanes, puffs,
-                     masks, fill[b]);
+                     masks, fill, uint32_t((uint64_t(1) << n) - 1));
         // The block's lists, one after the other, each padded to a multiple of 4 with the
         // inert puff.
         size_t end = out.index.size();
@@ -737,9 +765,9 @@ void PlumeScreenBins::GatherRow(const RowSource& from, int x0, int y0, int y1, i
         // kLanes − 1 slots more: CompressStore writes a whole lane group at the list's end.
         out.index.resize(end + kLanes);
         // Whole lane groups: the padding puffs reach no rectangle.
-        const size_t groups = (fill[b] + kLanes - 1) / kLanes * kLanes;
-        std::fill(puffs + fill[b], puffs + groups, inert_);
-        std::fill(masks + fill[b], masks + groups, 0u);
+        const size_t groups = (fill + kLanes - 1) / kLanes * kLanes;
+        std::fill(puffs + fill, puffs + groups, inert_);
+        std::fill(masks + fill, masks + groups, 0u);
         const size_t list0 = base + size_t(cb0);
         uint32_t* dst = out.index.data() + out.start[list0];
         for (int c = 0; c < n; ++c) {

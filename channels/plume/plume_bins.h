@@ -131,7 +131,8 @@ class PlumeScreenBins {
     // lists bit for bit). One pass over from's puffs finds the rectangles each reaches (its
     // ellipse's span once for the row, not once per block), then per block its ranges and
     // sums are added to the rectangles it reaches on SIMD lanes, one rectangle a lane, and
-    // the lists are written once, without growing them puff by puff.
+    // the lists are written once, without growing them puff by puff (a puff that reaches all of
+    // a block's rectangles and adds to no small-puff sum: its ranges and count once, as scalars).
     void GatherRow(const RowSource& from, int x0, int y0, int y1, int step, int width,
                    int cellsPerBlock, int cells, float smallPixels, ListRow& out) const;
     // Copies a gathered list's data (no-op when copied already).

@@ -366,6 +366,74 @@ TEST(PlumeScreenBins, GatherRowOfBlocksOfAnySizeEqualsGatherFromEachBlock) {
     EXPECT_GT(multiBlock, 1000u);
 }
 
+// GatherRow keeps the ranges and count of a puff that reaches every rectangle of a block and
+// adds to none of the small-puff sums aside (their order does not change a nearest or farthest
+// range: no list's range is NaN or −0) and merges them at the end; the others go through the
+// lanes in order. With no puff small (smallPixels 0), some small at one size and not at
+// another (2 and 4 pixels), every one (1e9: none aside, the sums of whole blocks) and a NaN
+// size (no puff small either, as Add compares), each cell's list is still what Gather from the
+// cell's block gives, bit for bit, with puffs spanning up to tens of blocks (the fire view)
+// whose middle blocks take them whole.
+TEST(PlumeScreenBins, GatherRowOfBlocksEqualsGatherFromEachBlockForAnySmallSize) {
+    const scene::PlumeField field = CommittedPlumes();
+    const std::array<ChannelCamera, 2> cameras = WideAndFireCameras(200);
+    size_t nonEmpty = 0, compared = 0, wholeBlocks = 0, smallSums = 0;
+    for (const ChannelCamera& cam : cameras) {
+        for (const ObscurantBand band : {ObscurantBand::Visible, ObscurantBand::Lwir}) {
+            const PlumeScreenBins bins(field, cam, band);
+            const int areaW = cam.width + PlumeScreenBins::kMargin;
+            const int areaH = cam.height + PlumeScreenBins::kMargin;
+            for (const int cellsPerBlock : {3, 8}) {
+                const int cells = (areaW + 3) / 4;
+                const int blocksX = (cells + cellsPerBlock - 1) / cellsPerBlock;
+                std::vector<PlumeScreenBins::List> blocks(static_cast<size_t>(blocksX));
+                PlumeScreenBins::RowSource source;
+                PlumeScreenBins::ListRow row;
+                PlumeScreenBins::List single, l;
+                for (const float smallPixels : {0.0f, 2.0f, 4.0f, 1e9f, std::nanf("")}) {
+                    for (int by = 0; by < areaH; by += 32) {
+                        for (int bx = 0; bx < blocksX; ++bx)
+                            bins.Gather(bx * cellsPerBlock * 4, by,
+                                        (bx + 1) * cellsPerBlock * 4 + 1, by + 33, smallPixels,
+                                        false, blocks[size_t(bx)]);
+                        bins.MergeBlocks(blocks, source);
+                        for (size_t j = 0; j < source.index.size(); ++j)
+                            wholeBlocks +=
+                                size_t(std::max(__builtin_popcountll(source.blocks[j]) - 2, 0));
+                        for (int cy = by; cy < std::min(by + 32, areaH); cy += 4) {
+                            row.Clear();
+                            bins.GatherRow(source, 0, cy, cy + 5, 4, 5, cellsPerBlock, cells,
+                                           smallPixels, row);
+                            ASSERT_EQ(row.size(), size_t(cells));
+                            for (int c = 0; c < cells; ++c) {
+                                bins.Gather(blocks[size_t(c / cellsPerBlock)], c * 4, cy, c * 4 + 5,
+                                            cy + 5, smallPixels, false, single);
+                                row.Take(size_t(c), l);
+                                ASSERT_NO_FATAL_FAILURE(ExpectSameList(
+                                    l, single,
+                                    std::to_string(smallPixels) + " pixels small, " +
+                                        std::to_string(c) + ", " + std::to_string(cy)));
+                                if (single.count > 0) {
+                                    ASSERT_FALSE(std::isnan(single.near_m));
+                                    ASSERT_FALSE(std::signbit(single.near_m));
+                                    ASSERT_FALSE(std::isnan(single.far_m));
+                                }
+                                nonEmpty += single.count > 0;
+                                smallSums += single.smallOpticalDepth > 0.0f;
+                                ++compared;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    EXPECT_GT(nonEmpty, 3000u);
+    EXPECT_GT(nonEmpty * 10, compared);
+    EXPECT_GT(wholeBlocks, 1000u);  // (puff, block) pairs between a puff's first and last block
+    EXPECT_GT(smallSums, 1000u);    // lists with small-puff sums (smallPixels 1e9)
+}
+
 // A cell's list holds every puff whose cutoff ellipsoid (τ_max e^(−r²/2) = ε) a ray through
 // the cell meets: the squared Mahalanobis distance of the ray's closest approach, in double
 // precision, m² = min_s |q + s d|²_M ≤ r², checked for the rays through every pixel centre
