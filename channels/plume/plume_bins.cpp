@@ -23,6 +23,10 @@ namespace {
 
 // PlumeScreenBins::kStride, the floats of one puff's record (for the loaders below).
 constexpr size_t kPuffRecord = 16;
+// A copied list's groups of eight puffs: their records transposed, field f of puff l of a group
+// at f · 8 + l of its kGroupFloats (List::data).
+constexpr size_t kGroupPuffs = 8;
+constexpr size_t kGroupFloats = kGroupPuffs * kPuffRecord;
 
 // For each set of lanes (bit l for lane l), the indices of its lanes in increasing order,
 // then the other lanes': a shuffle that moves the set's values to the front, in order. Stored
@@ -795,29 +799,6 @@ void PlumeScreenBins::GatherRow(const RowSource& from, int x0, int y0, int y1, i
     }
 }
 
-void PlumeScreenBins::Copy(List& list) const {
-    static_assert(std::size(decltype(List::data){}) == kFields);
-    if (list.copied) return;
-    const size_t n = list.index.size();  // a multiple of 4
-    for (int f = 0; f < kFields; ++f) list.data[f].resize(n);
-    // Four puffs at a time: each block of four fields of their records transposed into four
-    // fields of four puffs (SSE2 shuffles: the values are moved, not changed).
-    for (size_t j = 0; j < n; j += 4) {
-        const float* rec[4];
-        for (int l = 0; l < 4; ++l)
-            rec[l] = puffData_.data() + size_t(list.index[j + size_t(l)]) * kStride;
-        for (int f0 = 0; f0 < kFields; f0 += 4) {
-            __m128 r0 = _mm_loadu_ps(rec[0] + f0), r1 = _mm_loadu_ps(rec[1] + f0);
-            __m128 r2 = _mm_loadu_ps(rec[2] + f0), r3 = _mm_loadu_ps(rec[3] + f0);
-            _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
-            const __m128 fields[4] = {r0, r1, r2, r3};
-            for (int f = f0; f < std::min(f0 + 4, int(kFields)); ++f)
-                _mm_storeu_ps(list.data[f].data() + j, fields[f - f0]);
-        }
-    }
-    list.copied = true;
-}
-
 namespace {
 
 using simd4::Exp4;
@@ -897,15 +878,16 @@ inline BandTrace Result(const BandAccumulator& lo, const BandAccumulator& hi) {
     return t;
 }
 
-// Four values of a field from k on: contiguous in a copied list, else gathered by index from
-// the records (field: the field in the first record).
+// Four values of field f from k on (k a multiple of 4): contiguous in a copied list's group
+// (copied: its data), else gathered by index from the records.
 template <bool Copied>
-inline F4 Load4(const std::vector<float>& copied, const float* field, const uint32_t* index,
-                size_t k) {
+inline F4 Load4(const float* copied, const float* records, const uint32_t* index, size_t k, int f) {
     if constexpr (Copied) {
-        return _mm_loadu_ps(copied.data() + k);
+        return _mm_loadu_ps(copied + k / kGroupPuffs * kGroupFloats + size_t(f) * kGroupPuffs +
+                            k % kGroupPuffs);
     } else {
         const uint32_t* i = index + k;
+        const float* field = records + f;
         constexpr size_t m = kPuffRecord;
         return _mm_setr_ps(field[i[0] * m], field[i[1] * m], field[i[2] * m], field[i[3] * m]);
     }
@@ -951,22 +933,6 @@ __attribute__((target("avx2"), always_inline)) inline F8 ErfOrSign8(F8 x, F8 use
         _mm256_mul_ps(poly, Exp8(_mm256_sub_ps(_mm256_setzero_ps(), _mm256_mul_ps(ax, ax)))));
     e = _mm256_blendv_ps(e, _mm256_set1_ps(1.0f), saturated);
     return _mm256_or_ps(e, sign);
-}
-
-// Eight values of a field from k on: contiguous in a copied list, else gathered by index from
-// the records (field: the field in the first record).
-template <bool Copied>
-__attribute__((target("avx2"))) inline F8 Load8(const std::vector<float>& copied,
-                                                const float* field, const uint32_t* index,
-                                                size_t k) {
-    if constexpr (Copied) {
-        return _mm256_loadu_ps(copied.data() + k);
-    } else {
-        const uint32_t* i = index + k;
-        constexpr size_t m = kPuffRecord;
-        return _mm256_setr_ps(field[i[0] * m], field[i[1] * m], field[i[2] * m], field[i[3] * m],
-                              field[i[4] * m], field[i[5] * m], field[i[6] * m], field[i[7] * m]);
-    }
 }
 
 // The fields of the eight records at records + index[l] · kPuffRecord, l = 0 … 7: out[f] holds
@@ -1106,26 +1072,31 @@ __attribute__((target("avx2"))) void PlumeScreenBins::TraceWide(const List& l, c
         if constexpr (Ranges >= 2) to(r1, use01, s1);
         if constexpr (Ranges == 4) to(r2, use23, s2), to(r3, use23, s3);
     };
-    size_t k = 0;
-    for (; k + 8 <= l.index.size(); k += 8) {
-        if constexpr (Copied) {
+    if constexpr (Copied) {
+        // Whole groups: the last one of four puffs holds the inert puff in its high lanes (Copy
+        // pads it), the values the last group of four below gives.
+        const float* group = l.data.data();
+        for (size_t k = 0; k < l.index.size(); k += kGroupPuffs, group += kGroupFloats)
             eight([&](int f) __attribute__((target("avx2"), always_inline)) {
-                return Load8<true>(l.data[f], puffData_.data() + f, l.index.data(), k);
+                return _mm256_loadu_ps(group + size_t(f) * kGroupPuffs);
             });
-        } else {
+    } else {
+        size_t k = 0;
+        for (; k + 8 <= l.index.size(); k += 8) {
             F8 fields[kPuffRecord];
             TransposeRecords8(puffData_.data(), l.index.data() + k, fields);
             eight([&](int f) __attribute__((target("avx2"), always_inline)) { return fields[f]; });
         }
+        // A last group of four (lists hold a multiple of four): in the low lanes, the inert
+        // puff in the high ones (unused, so they add zeros to the odd groups' sums).
+        if (k < l.index.size())
+            eight([&](int f) __attribute__((target("avx2"), always_inline)) {
+                return _mm256_insertf128_ps(_mm256_castps128_ps256(Load4<false>(
+                                                nullptr, puffData_.data(), l.index.data(), k, f)),
+                                            _mm_set1_ps(puffData_[inert_ * kStride + size_t(f)]),
+                                            1);
+            });
     }
-    // A last group of four (lists hold a multiple of four): in the low lanes, the inert puff
-    // in the high ones (unused, so they add zeros to the odd groups' sums).
-    if (k < l.index.size())
-        eight([&](int f) __attribute__((target("avx2"), always_inline)) {
-            return _mm256_insertf128_ps(_mm256_castps128_ps256(Load4<Copied>(
-                                            l.data[f], puffData_.data() + f, l.index.data(), k)),
-                                        _mm_set1_ps(puffData_[inert_ * kStride + size_t(f)]), 1);
-        });
     const auto result = [](const BandAccumulator8& sums) __attribute__((target("avx2"))) {
         BandAccumulator lo, hi;
         sums.Split(lo, hi);
@@ -1136,6 +1107,61 @@ __attribute__((target("avx2"))) void PlumeScreenBins::TraceWide(const List& l, c
     if constexpr (Ranges == 4) out[2] = result(s2), out[3] = result(s3);
 }
 #endif
+
+#ifdef SEASENSE_PLUME_WIDE
+namespace {
+
+// Copy of one group: the eight records' fields transposed (AVX2).
+__attribute__((target("avx2"))) void CopyGroup8(const float* records, const uint32_t* index,
+                                                float* out) {
+    F8 fields[kPuffRecord];
+    TransposeRecords8(records, index, fields);
+    for (size_t f = 0; f < kPuffRecord; ++f) _mm256_storeu_ps(out + f * kGroupPuffs, fields[f]);
+}
+
+}  // namespace
+#endif
+
+void PlumeScreenBins::Copy(List& list) const {
+    static_assert(size_t(kStride) == kPuffRecord);
+    if (list.copied) return;
+    const size_t n = list.index.size();  // a multiple of 4
+    const size_t groups = (n + kGroupPuffs - 1) / kGroupPuffs;
+    list.data.resize(groups * kGroupFloats);
+    for (size_t g = 0; g < groups; ++g) {
+        // The group's puffs, a last group of four padded with the inert puff.
+        const uint32_t* index = list.index.data() + g * kGroupPuffs;
+        uint32_t padded[kGroupPuffs];
+        if (n - g * kGroupPuffs < kGroupPuffs) {
+            std::fill(std::begin(padded), std::end(padded), inert_);
+            std::copy(index, index + (n - g * kGroupPuffs), padded);
+            index = padded;
+        }
+        float* out = list.data.data() + g * kGroupFloats;
+#ifdef SEASENSE_PLUME_WIDE
+        if (wide_) {
+            CopyGroup8(puffData_.data(), index, out);
+            continue;
+        }
+#endif
+        // Four puffs at a time: each block of four fields of their records transposed into
+        // four fields of four puffs (SSE2 shuffles: the values are moved, not changed).
+        for (size_t half = 0; half < kGroupPuffs; half += 4) {
+            const float* rec[4];
+            for (size_t l = 0; l < 4; ++l)
+                rec[l] = puffData_.data() + size_t(index[half + l]) * kStride;
+            for (size_t f0 = 0; f0 < kPuffRecord; f0 += 4) {
+                __m128 r0 = _mm_loadu_ps(rec[0] + f0), r1 = _mm_loadu_ps(rec[1] + f0);
+                __m128 r2 = _mm_loadu_ps(rec[2] + f0), r3 = _mm_loadu_ps(rec[3] + f0);
+                _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+                const __m128 fields[4] = {r0, r1, r2, r3};
+                for (size_t f = f0; f < f0 + 4; ++f)
+                    _mm_storeu_ps(out + f * kGroupPuffs + half, fields[f - f0]);
+            }
+        }
+    }
+    list.copied = true;
+}
 
 // Four puffs at a time. Per puff, along the ray the exponent of the Gaussian is
 // −(A s² + 2 B s + C) / 2, so ∫ over [0, S] = e^(−m²/2) (√π / 2) / √(A/2) · (erf u1 − erf u0),
@@ -1164,7 +1190,7 @@ void PlumeScreenBins::TraceImpl(const List& l, const glm::vec3& dir, const float
                                 BandTrace* out) const {
     static_assert(Ranges == 1 || Ranges == 2 || Ranges == 4);
     const auto load = [&](int f, size_t k) {
-        return Load4<Copied>(l.data[f], puffData_.data() + f, l.index.data(), k);
+        return Load4<Copied>(l.data.data(), puffData_.data(), l.index.data(), k, f);
     };
 #ifdef SEASENSE_PLUME_WIDE
     if (wide_) {

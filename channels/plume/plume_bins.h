@@ -82,7 +82,10 @@ class PlumeScreenBins {
         float twiceSmallOpticalDepth = 0.0f;
         bool copied = false;
         std::vector<uint32_t> index;  // kept positions
-        std::vector<float> data[13];  // per field of Arrays, when copied
+        // When copied, the records in groups of eight puffs (the last padded with the inert
+        // puff), transposed: field f of puff 8g + l at data[128 g + 8 f + l], so that a trace
+        // loads a group's fields from one pointer.
+        std::vector<float> data;
         size_t size() const { return count; }
     };
     void Gather(int x0, int y0, int x1, int y1, float smallPixels, bool copy, List& out) const;
@@ -187,8 +190,8 @@ class PlumeScreenBins {
         kFields
     };
     // The fields of kept puff k at puffData_[k · kStride + field]: one puff's record in one 64-byte
-    // block, so that Copy reads a puff's fields together (four puffs transposed at a time)
-    // instead of thirteen scattered values.
+    // block, so that Copy reads a puff's fields together (eight puffs transposed at a time,
+    // four without AVX2) instead of thirteen scattered values.
     static constexpr int kStride = 16;
     static_assert(kFields <= kStride);
     std::vector<float> puffData_;

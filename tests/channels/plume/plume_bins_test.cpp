@@ -541,6 +541,52 @@ TEST(PlumeScreenBins, WideAndNarrowTracesAreBitIdentical) {
     EXPECT_GT(seen, 50);
 }
 
+// A copied list (its records in groups of eight, a last group of four padded with the inert
+// puff) holds the same values whether Copy ran eight puffs at a time (AVX2) or four (SSE2), and
+// its traces, to one, two and four ranges, four and eight puffs at a time, are those of the list
+// not copied, bit for bit, for lists of 4 mod 8 puffs and of 0 mod 8.
+TEST(PlumeScreenBins, CopiedListsTraceAsTheListsNotCopied) {
+    const scene::PlumeField field = CommittedPlumes();
+    const ChannelCamera cam = NorthCamera({0.0, 0.0, 20.0}, 96, 72, 40.0, 3.0);
+    PlumeScreenBins bins(field, cam, ObscurantBand::Visible);
+    if (!bins.WideTraces()) GTEST_SKIP() << "no AVX2 on this CPU";
+    int lengths = 0, seen = 0;
+    ForEachPixelList(
+        bins, cam, [&](PlumeScreenBins::List& list, const glm::vec3& dir, int px, int py) {
+            lengths |= 1 << (list.index.size() / 4 % 2);
+            PlumeScreenBins::List copied[2] = {list, list};  // [copied eight at a time]
+            for (int wide = 0; wide < 2; ++wide) {
+                bins.UseWideTraces(wide == 1);
+                bins.Copy(copied[wide]);
+            }
+            ASSERT_EQ(copied[0].data.size(), copied[1].data.size());
+            ASSERT_EQ(std::memcmp(copied[0].data.data(), copied[1].data.data(),
+                                  copied[0].data.size() * sizeof(float)),
+                      0)
+                << px << ", " << py;
+            const float ranges[4] = {1800.0f, kPlumeSkyRange_m, 900.0f, 2600.0f};
+            for (int wide = 0; wide < 2; ++wide) {
+                bins.UseWideTraces(wide == 1);
+                BandTrace want[7], got[7];
+                const auto traces = [&](const PlumeScreenBins::List& l, BandTrace(&t)[7]) {
+                    t[0] = bins.Trace(l, dir, ranges[0]);
+                    bins.Trace2(l, dir, ranges[0], ranges[1], t[1], t[2]);
+                    bins.Trace4(l, dir, ranges, reinterpret_cast<BandTrace(&)[4]>(t[3]));
+                };
+                traces(list, want);
+                for (const PlumeScreenBins::List& l : copied) {
+                    traces(l, got);
+                    EXPECT_EQ(std::memcmp(want, got, sizeof want), 0)
+                        << px << ", " << py << " wide " << wide;
+                }
+                seen += want[2].opticalDepth > 0.01f;
+            }
+        });
+    bins.UseWideTraces(true);
+    EXPECT_EQ(lengths, 3);  // lists of 4 mod 8 and 0 mod 8 puffs (a padded group and none)
+    EXPECT_GT(seen, 50);
+}
+
 // Trace4 is Trace2 of its two pairs of ranges, bit for bit: eight puffs at a time and four,
 // gathered and copied lists, ranges that end before, inside and beyond the plumes (CompositePlumes
 // traces a node's surface, the sky and 10 % before and beyond the surface at once). The larger
