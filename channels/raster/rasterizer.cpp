@@ -354,6 +354,11 @@ inline int SignBits(I8 v) {
            _mm_movemask_ps(__m128(__builtin_shufflevector(v, v, 4, 5, 6, 7))) << 4;
 #endif
 }
+// Lane k of v in all eight lanes.
+template <int k>
+[[gnu::always_inline]] inline I8 Spread(I4 v) {
+    return __builtin_shufflevector(v, v, k, k, k, k, k, k, k, k);
+}
 inline I4 LowHalf(I8 v) { return __builtin_shufflevector(v, v, 0, 1, 2, 3); }
 inline I4 HighHalf(I8 v) { return __builtin_shufflevector(v, v, 4, 5, 6, 7); }
 // Lanes of a where mask's sign bit is set, else b's (only the sign bits of mask matter).
@@ -373,7 +378,14 @@ inline V SelectBySign(I8 mask, V a, V b) {
     return (mask >> 31) ? a : b;
 #endif
 }
-inline F8 Concat(F4 lo, F4 hi) { return __builtin_shufflevector(lo, hi, 0, 1, 2, 3, 4, 5, 6, 7); }
+inline F8 Concat(F4 lo, F4 hi) {
+#if defined(__AVX__)
+    // GCC's shufflevector form first zero-extends each half, one more instruction per half.
+    return F8(_mm256_insertf128_ps(_mm256_castps128_ps256(__m128(lo)), __m128(hi), 1));
+#else
+    return __builtin_shufflevector(lo, hi, 0, 1, 2, 3, 4, 5, 6, 7);
+#endif
+}
 // Exact int32 to double, lane for lane (GCC's generic conversion converts two halves).
 inline D4 ToDouble(I4 v) {
 #if defined(__AVX__)
@@ -387,6 +399,53 @@ struct TileRect {
     int x0, y0, x1, y1;  // inclusive samples
 };
 
+// A small triangle's three edges on int32 lanes (lane k: edge k, as RasterTriangle orients it;
+// lane 3 repeats edge 0): E_k − unbias_k at one sample centre, its steps per sample in x and y,
+// unbias_k, and |2·area|.
+struct BoxEdges {
+    I4 row, stepX, stepY, unbias;
+    int32_t absArea2;
+};
+
+// RasterTriangle's edge set-up for the box rows, all three edges at once on lanes, at the sample
+// centre (px, py) of its box ∩ tile. Returns false, and the box rows are not taken, unless every
+// edge's ∂E/∂x and ∂E/∂y lie in [−kBoxMaxDelta, kBoxMaxDelta). The lanes compute modulo 2^32;
+// when the test passes the values are the int64 set-up's: the differences of fixed-point
+// coordinates (|x|, |y| <= 2^27) fit, so ±a, ±b pass only where |a|, |b| <= 2^14 whichever
+// orientation was taken; then 2·area (two products below 2^28) is exact and orients the edges
+// right, and E_k at a sample of the box (within 2^14 of every vertex) lies below 2^29.
+[[gnu::always_inline]] inline bool SetUpBoxEdges(const TriSetup& s, int64_t px, int64_t py,
+                                                 BoxEdges& e) {
+    U4 x, y;
+    static_assert(offsetof(TriSetup, y) == 12 && offsetof(TriSetup, c) == 24);
+    std::memcpy(&x, &s.x[0], sizeof x);  // x0 x1 x2, then y0 (not used)
+    std::memcpy(&y, &s.y[0], sizeof y);  // y0 y1 y2, then half of c[0] (not used)
+    // Edge k runs from vertex i = k + 1 to j = k − 1 (mod 3) where 2·area > 0; else from j to i,
+    // which negates a, b and E_k exactly.
+    const U4 xi = __builtin_shufflevector(x, x, 1, 2, 0, 1);
+    const U4 xj = __builtin_shufflevector(x, x, 2, 0, 1, 2);
+    const U4 yi = __builtin_shufflevector(y, y, 1, 2, 0, 1);
+    const U4 yj = __builtin_shufflevector(y, y, 2, 0, 1, 2);
+    const U4 a = yi - yj, b = xj - xi;
+    // a_k b_{k+1} − a_{k+1} b_k is 2·area for every k.
+    const U4 area2 = a * __builtin_shufflevector(b, b, 1, 2, 0, 1) -
+                     __builtin_shufflevector(a, a, 1, 2, 0, 1) * b;
+    const U4 flip = U4(I4(area2) >> 31);  // all ones where 2·area < 0
+    const U4 ao = (a ^ flip) - flip, bo = (b ^ flip) - flip;
+    const U4 biased = (ao + uint32_t(kBoxMaxDelta)) | (bo + uint32_t(kBoxMaxDelta));
+    if (_mm_movemask_ps(__m128((biased >> 15) != 0)) != 0) return false;
+    const U4 rowU = a * (uint32_t(px) - xi) + b * (uint32_t(py) - yi);
+    const I4 ai = I4(ao), bi = I4(bo);
+    // RasterTriangle's top-left rule.
+    const I4 topLeft = (ai > 0) | ((ai == 0) & (bi > 0));
+    e.unbias = ~topLeft & 1;
+    e.row = I4((rowU ^ flip) - flip) - e.unbias;
+    e.stepX = ai * int32_t(kSubScale);
+    e.stepY = bi * int32_t(kSubScale);
+    e.absArea2 = int32_t((area2[0] ^ flip[0]) - flip[0]);
+    return true;
+}
+
 // Half-space rasterization of one set-up triangle over its bounding box ∩ tile (Pineda, "A
 // parallel algorithm for polygon rasterization", SIGGRAPH 1988): exact int64 edge functions,
 // stepped incrementally from row to row and from sample to sample.
@@ -397,46 +456,21 @@ template <bool kCount, bool kClipped>
     const int y0 = std::max<int>(s.by0, r.y0), y1 = std::min<int>(s.by1, r.y1);
     if (x0 > x1 || y0 > y1) return;
 
-    // Edge k runs between the two vertices other than k, oriented so that the inside is
-    // positive; E_k is then |2·area| times vertex k's screen-space barycentric.
-    const int64_t area2 = (int64_t(s.x[1]) - s.x[0]) * (int64_t(s.y[2]) - s.y[0]) -
-                          (int64_t(s.y[1]) - s.y[0]) * (int64_t(s.x[2]) - s.x[0]);
-    const bool positive = area2 > 0;
-    int64_t row[3], stepX[3], stepY[3], unbias[3];
     const int64_t px = int64_t(x0) * kSubScale + kHalfSample;
     const int64_t py = int64_t(y0) * kSubScale + kHalfSample;
-    // Below 2 kBoxMaxDelta when every edge's a, b lies in [−kBoxMaxDelta, kBoxMaxDelta).
-    uint64_t deltas = 0;
-    // One unrolled loop per orientation: every vertex index below is then a constant, not a
-    // swapped index to load through.
-    const auto edges = [&]<bool kPositive>() __attribute__((always_inline)) {
-#pragma GCC unroll 3
-        for (int k = 0; k < 3; ++k) {
-            int i = k == 2 ? 0 : k + 1, j = k == 0 ? 2 : k - 1;
-            if (!kPositive) std::swap(i, j);
-            const int64_t ax = s.x[i], ay = s.y[i], bx = s.x[j], by = s.y[j];
-            const int64_t a = ay - by;  // ∂E/∂x
-            const int64_t b = bx - ax;  // ∂E/∂y
-            deltas |= uint64_t(a + kBoxMaxDelta) | uint64_t(b + kBoxMaxDelta);
-            // Top-left rule (Direct3D 11.3 functional specification, rasterization rules) for a
-            // clockwise triangle on the y-down grid: a left edge runs upward (a > 0); a top edge
-            // is horizontal and runs toward +x. Other edges exclude samples with E = 0.
-            const bool topLeft = a > 0 || (a == 0 && b > 0);
-            unbias[k] = topLeft ? 0 : 1;
-            row[k] = a * (px - ax) + b * (py - ay) - unbias[k];
-            stepX[k] = a * kSubScale;
-            stepY[k] = b * kSubScale;
-        }
-    };
-    if (positive)
-        edges.template operator()<true>();
-    else
-        edges.template operator()<false>();
+    // Small triangles (the coverage count keeps the spans) take the box rows below: up to
+    // kBoxOctets·kBoxLanes samples wide (bounding box ∩ tile) and their edges set up on lanes.
+    BoxEdges boxEdges;
+    const bool inBox =
+        !kCount && x1 - x0 < kBoxOctets * kBoxLanes && SetUpBoxEdges(s, px, py, boxEdges);
+    // 2·area of the triangles that take the spans.
+    const int64_t area2 = inBox ? 0
+                                : (int64_t(s.x[1]) - s.x[0]) * (int64_t(s.y[2]) - s.y[0]) -
+                                      (int64_t(s.y[1]) - s.y[0]) * (int64_t(s.x[2]) - s.x[0]);
     const uint32_t prim = s.prim;
-    const int64_t u1 = unbias[1], u2 = unbias[2];
     // E_0 + E_1 + E_2 = |2·area| exactly, so depth = Σ E_k c_k = k0 + E_1 Δc_1 + E_2 Δc_2
     // needs two conversions per sample instead of three.
-    const int64_t absArea2 = positive ? area2 : -area2;
+    const int64_t absArea2 = inBox ? boxEdges.absArea2 : area2 < 0 ? -area2 : area2;
     const double c1 = s.c[1], c2 = s.c[2];
     const double k0 = double(absArea2) * s.c[0], dc1 = c1 - s.c[0], dc2 = c2 - s.c[0];
     double g0 = 0.0, g1 = 0.0, g2 = 0.0, h0 = 0.0, h1 = 0.0, h2 = 0.0;
@@ -530,14 +564,13 @@ template <bool kCount, bool kClipped>
     };
 
     if constexpr (!kCount) {
-        // Small triangles (the coverage count keeps the spans): the box's samples kBoxLanes at
-        // a time, inside where all three E_k − unbias_k are >= 0 (the span's own condition,
-        // without its divisions). With every |a|, |b| <= 2^14 the box's sample centres, the
-        // lanes up to kBoxLanes − 1 past it and the row stepped to past the last lie within
-        // 2^14 + 2^11 of every vertex in x and 2^14 + 2^8 in y, so every E_k stays below 2^30 in
-        // magnitude: exact in int32 lanes, and its double the span's. Only lane groups with a
-        // sample in the box are loaded and stored, so they reach no further past the box than
-        // the span's.
+        // Small triangles: the box's samples kBoxLanes at a time, inside where all three
+        // E_k − unbias_k are >= 0 (the span's own condition, without its divisions). With every
+        // |a|, |b| <= 2^14 the box's sample centres, the lanes up to kBoxLanes − 1 past it and
+        // the row stepped to past the last lie within 2^14 + 2^11 of every vertex in x and
+        // 2^14 + 2^8 in y, so every E_k stays below 2^30 in magnitude: exact in int32 lanes, and
+        // its double the span's. Only lane groups with a sample in the box are loaded and
+        // stored, so they reach no further past the box than the span's.
         const auto box = [&]<int kOctets>() __attribute__((always_inline)) {
             const I8 lane8{0, 1, 2, 3, 4, 5, 6, 7};
             I8 e0[kOctets], e1[kOctets], e2[kOctets];
@@ -546,13 +579,14 @@ template <bool kCount, bool kClipped>
 #pragma GCC unroll 2
             for (int o = 0; o < kOctets; ++o) {
                 const I8 lane = lane8 + kBoxLanes * o;
-                e0[o] = int32_t(row[0]) + lane * int32_t(stepX[0]);
-                e1[o] = int32_t(row[1]) + lane * int32_t(stepX[1]);
-                e2[o] = int32_t(row[2]) + lane * int32_t(stepX[2]);
+                e0[o] = Spread<0>(boxEdges.row) + lane * Spread<0>(boxEdges.stepX);
+                e1[o] = Spread<1>(boxEdges.row) + lane * Spread<1>(boxEdges.stepX);
+                e2[o] = Spread<2>(boxEdges.row) + lane * Spread<2>(boxEdges.stepX);
             }
             const I8 outBox = lane8 + kBoxLanes * (kOctets - 1) > x1 - x0;
-            const int32_t dy0 = int32_t(stepY[0]), dy1 = int32_t(stepY[1]), dy2 = int32_t(stepY[2]);
-            const int32_t unbias1 = int32_t(u1), unbias2 = int32_t(u2);
+            const I8 dy0 = Spread<0>(boxEdges.stepY), dy1 = Spread<1>(boxEdges.stepY),
+                     dy2 = Spread<2>(boxEdges.stepY);
+            const I8 unbias1 = Spread<1>(boxEdges.unbias), unbias2 = Spread<2>(boxEdges.unbias);
             size_t i = rowBase + size_t(x0 - xo);
             for (int y = y0; y <= y1; ++y, i += size_t(t.width)) {
 #pragma GCC unroll 2
@@ -580,7 +614,7 @@ template <bool kCount, bool kClipped>
                 }
             }
         };
-        if (deltas < uint64_t(2 * kBoxMaxDelta) && x1 - x0 < kBoxOctets * kBoxLanes) {
+        if (inBox) {
             if (x1 - x0 < kBoxLanes)
                 box.template operator()<1>();
             else
@@ -589,6 +623,34 @@ template <bool kCount, bool kClipped>
         }
     }
 
+    // Edge k runs between the two vertices other than k, oriented so that the inside is
+    // positive; E_k is then |2·area| times vertex k's screen-space barycentric.
+    int64_t row[3], stepX[3], stepY[3], unbias[3];
+    // One unrolled loop per orientation: every vertex index below is then a constant, not a
+    // swapped index to load through.
+    const auto edges = [&]<bool kPositive>() __attribute__((always_inline)) {
+#pragma GCC unroll 3
+        for (int k = 0; k < 3; ++k) {
+            int i = k == 2 ? 0 : k + 1, j = k == 0 ? 2 : k - 1;
+            if (!kPositive) std::swap(i, j);
+            const int64_t ax = s.x[i], ay = s.y[i], bx = s.x[j], by = s.y[j];
+            const int64_t a = ay - by;  // ∂E/∂x
+            const int64_t b = bx - ax;  // ∂E/∂y
+            // Top-left rule (Direct3D 11.3 functional specification, rasterization rules) for a
+            // clockwise triangle on the y-down grid: a left edge runs upward (a > 0); a top edge
+            // is horizontal and runs toward +x. Other edges exclude samples with E = 0.
+            const bool topLeft = a > 0 || (a == 0 && b > 0);
+            unbias[k] = topLeft ? 0 : 1;
+            row[k] = a * (px - ax) + b * (py - ay) - unbias[k];
+            stepX[k] = a * kSubScale;
+            stepY[k] = b * kSubScale;
+        }
+    };
+    if (area2 > 0)
+        edges.template operator()<true>();
+    else
+        edges.template operator()<false>();
+    const int64_t u1 = unbias[1], u2 = unbias[2];
     // Inside the triangle every E_k lies in [0, |2·area|]: below 2^53 the samples' E_1, E_2
     // are exact in doubles, and so are their sums, so the span steps them in doubles, the
     // same values as converting each sample's integer.
@@ -680,11 +742,24 @@ inline void StreamLineAndRefill(void* dst, void* src, simd::VI fill) {
     }
 }
 
+// Streams one cache line of fill to the line-aligned dst.
+inline void StreamLineOf(void* dst, simd::VI fill) {
+    char* to = static_cast<char*>(dst);
+    for (size_t at = 0; at < kLineSamples * 4; at += sizeof fill) {
+#if defined(__AVX__)
+        _mm256_stream_si256(reinterpret_cast<__m256i*>(to + at), __m256i(fill));
+#else
+        _mm_stream_si128(reinterpret_cast<__m128i*>(to + at), __m128i(fill));
+#endif
+    }
+}
+
 // Copies a w × h tile drawn into local (rows of w samples) to the frame's targets at (x0, y0),
 // line by line, and clears local's first w·h samples. Every destination row starts on a cache
 // line and w is a multiple of kLineSamples. kWidth, when not 0, is w known at compile time, so
-// that a row is straight-line code.
-template <size_t kWidth>
+// that a row is straight-line code. kEmpty: no triangle touched the tile, so local is still
+// clear and its rows go out as the fill values without being read or cleared again.
+template <size_t kWidth, bool kEmpty>
 void StreamRowsOut(const Targets& t, int x0, int y0, const Targets& local, size_t w, size_t h,
                    simd::VI zeros, simd::VI empties) {
     if constexpr (kWidth != 0) w = kWidth;
@@ -700,10 +775,17 @@ void StreamRowsOut(const Targets& t, int x0, int y0, const Targets& local, size_
     float* b2 = local.b2;
     for (size_t y = 0; y < h; ++y) {
         for (size_t i = 0; i < w; i += kLineSamples) {
-            StreamLineAndRefill(outDepth + i, depth + i, zeros);
-            StreamLineAndRefill(outPrimitive + i, primitive + i, empties);
-            StreamLineAndRefill(outB1 + i, b1 + i, zeros);
-            StreamLineAndRefill(outB2 + i, b2 + i, zeros);
+            if constexpr (kEmpty) {
+                StreamLineOf(outDepth + i, zeros);
+                StreamLineOf(outPrimitive + i, empties);
+                StreamLineOf(outB1 + i, zeros);
+                StreamLineOf(outB2 + i, zeros);
+            } else {
+                StreamLineAndRefill(outDepth + i, depth + i, zeros);
+                StreamLineAndRefill(outPrimitive + i, primitive + i, empties);
+                StreamLineAndRefill(outB1 + i, b1 + i, zeros);
+                StreamLineAndRefill(outB2 + i, b2 + i, zeros);
+            }
         }
         outDepth += stride;
         outPrimitive += stride;
@@ -783,10 +865,12 @@ void RasterTile(int tile, const Context& ctx, const std::vector<Chunk>& chunks, 
             scratch.clear = padded;
         }
     }
+    bool empty = true;  // no triangle binned to the tile
     for (size_t c = 0; c < numChunks; ++c) {
         const Chunk& chunk = chunks[c];
         const uint32_t begin = chunk.tileStart[size_t(tile)],
                        end = chunk.tileStart[size_t(tile) + 1];
+        empty &= begin == end;
         const double* attrs = chunk.attrs.data();
         for (uint32_t k = begin; k < end; ++k) {
             const TriSetup& s = chunk.setups[chunk.binned[k]];
@@ -805,10 +889,14 @@ void RasterTile(int tile, const Context& ctx, const std::vector<Chunk>& chunks, 
         if (t.width % kLineSamples == 0 && size_t(r.x0) % kLineSamples == 0 &&
             w % kLineSamples == 0) {
             const simd::VI zeros{}, empties = simd::VI{} + int32_t(kNoPrimitive);
-            if (w == 64)
-                StreamRowsOut<64>(t, r.x0, r.y0, local, w, h, zeros, empties);
+            if (w == 64 && empty)
+                StreamRowsOut<64, true>(t, r.x0, r.y0, local, w, h, zeros, empties);
+            else if (w == 64)
+                StreamRowsOut<64, false>(t, r.x0, r.y0, local, w, h, zeros, empties);
+            else if (empty)
+                StreamRowsOut<0, true>(t, r.x0, r.y0, local, w, h, zeros, empties);
             else
-                StreamRowsOut<0>(t, r.x0, r.y0, local, w, h, zeros, empties);
+                StreamRowsOut<0, false>(t, r.x0, r.y0, local, w, h, zeros, empties);
         } else {
             scratch.clear = 0;
             for (size_t y = 0; y < h; ++y) {
@@ -1005,6 +1093,18 @@ bool TransformVertices4(const ClipRows& rows, const Context& ctx, const glm::vec
     const I4 iy = snap ? __builtin_convertvector(ry, I4) - int32_t(kOffset) : I4{};
     const D4 iw = snap64 ? invW : D4{};
     for (int l = 0; l < 4; ++l) screen[l] = ScreenVertex{ix[l], iy[l], uint32_t(outcode[l]), iw[l]};
+    return true;
+}
+
+bool BoxEdgesAt(const int32_t (&x)[3], const int32_t (&y)[3], int64_t px, int64_t py,
+                EdgeSetUp (&edges)[3], int64_t& absArea2) {
+    TriSetup s{};
+    std::copy_n(x, 3, s.x);
+    std::copy_n(y, 3, s.y);
+    BoxEdges e;
+    if (!SetUpBoxEdges(s, px, py, e)) return false;
+    for (int k = 0; k < 3; ++k) edges[k] = {e.row[k], e.stepX[k], e.stepY[k], e.unbias[k]};
+    absArea2 = e.absArea2;
     return true;
 }
 

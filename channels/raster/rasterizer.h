@@ -107,6 +107,20 @@ void TransformVertex(const ClipRows& rows, const Context& ctx, const glm::vec3& 
 bool TransformVertices4(const ClipRows& rows, const Context& ctx, const glm::vec3* p,
                         glm::vec3* clip, ScreenVertex* screen);
 
+// One edge of a screen triangle as the rasterizer sets it up at a sample centre: E − unbias
+// there (E > 0 inside, unbias 1 where the top-left rule leaves E = 0 outside, else 0) and E's
+// steps to the next sample in x and in y.
+struct EdgeSetUp {
+    int64_t row, stepX, stepY, unbias;
+};
+
+// The small triangles' edge set-up (int32 lanes) for fixed-point vertices (x[k], y[k]) of a
+// non-degenerate triangle at a sample centre (px, py) inside their bounding box: false where
+// some edge's ∂E/∂x or ∂E/∂y lies outside [−2^14, 2^14) and the rasterizer sets the triangle up
+// in int64 instead; else edge k and |2·area| as that int64 set-up has them.
+bool BoxEdgesAt(const int32_t (&x)[3], const int32_t (&y)[3], int64_t px, int64_t py,
+                EdgeSetUp (&edges)[3], int64_t& absArea2);
+
 }  // namespace raster_detail
 
 // Coverage rule: a sample belongs to a triangle when its centre is inside the triangle with

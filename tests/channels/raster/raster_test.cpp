@@ -923,7 +923,8 @@ TEST(RasterTargets, ReusedBufferHoldsOnlyTheLastFramesTriangles) {
 }
 
 // Tiles whose rows are whole cache lines of the frame go out line by line and clear the
-// thread's tile targets behind them; the others (a frame width or tile column off the 16-sample
+// thread's tile targets behind them (tiles no triangle was binned to go out as empty lines
+// without reading the targets); the others (a frame width or tile column off the 16-sample
 // lines, tile rows not whole lines) are copied sample-exactly and cleared before the next tile.
 // Frames of different content drawn one after another into one buffer, in grids that mix both
 // kinds of tile within a thread, must equal tile size 8 (never whole lines: every tile cleared
