@@ -508,8 +508,10 @@ int RunChannelRenderer(const ChannelOptions& opt) {
     if (copyImages && uint64_t(previewW) * uint64_t(previewH) * 3 > header.imageBytes)
         throw RuntimeError("run '" + runId + "' image slots are too small for channel '" +
                            ch->name + "'");
-    // Frame i's files are encoded and synced on the pipeline's writer thread while this thread
-    // renders frame i + 1 (the fsync of each file waits milliseconds for the disk).
+    // Frame i's files are encoded, synced and renamed on the pipeline's writer thread while this
+    // thread renders frame i + 1: a slow fsync (milliseconds, more on a busy disk) then holds
+    // neither this renderer nor, through it, the frame lock. (With the cores saturated it
+    // does not raise the frame rate: README, Performance, twenty-second round.)
     if (writeImages) pipeline->WriteInBackground();
     // The first frame's one-off work (buffers first touched, tables built on first use, the
     // display and preview transforms made) done before attaching, so that the run's first
