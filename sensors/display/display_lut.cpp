@@ -73,6 +73,31 @@ void DisplayLut::Trilinear(const int i0[3], const float f[3], float out[3]) cons
     out[0] = lanes[0], out[1] = lanes[1], out[2] = lanes[2];
 }
 
+namespace {
+
+// A vector of one component of kLanes pixels to its grid coordinates: the cell (the last cell
+// at most) and the fraction within it. Non-positive, tiny and NaN values clamp to the grid's
+// lower end, +∞ to its top (the comparison is false for NaN, which then takes `lowest`).
+struct GridCoordinates {
+    GridCoordinates(float minLog2, float scale, int edge)
+        : minLog2(simd::Splat(minLog2)),
+          scale(simd::Splat(scale)),
+          top(simd::Splat(float(edge - 1))),
+          lastCell(simd::VI{} + (edge - 2)) {}
+    void operator()(simd::VF x, simd::VI& i0, simd::VF& f) const {
+        x = simd::Select(x > lowest, x, lowest);
+        const simd::VF u = simd::Min(simd::Max((simd::Log2(x) - minLog2) * scale, zero), top);
+        i0 = __builtin_convertvector(u, simd::VI);
+        i0 = i0 < lastCell ? i0 : lastCell;
+        f = u - __builtin_convertvector(i0, simd::VF);
+    }
+    simd::VF lowest = simd::Splat(1e-30f), zero = simd::Splat(0.0f);
+    simd::VF minLog2, scale, top;
+    simd::VI lastCell;
+};
+
+}  // namespace
+
 #if defined(__AVX2__)
 namespace {
 
@@ -137,10 +162,8 @@ std::vector<std::uint8_t> DisplayLut::ToDisplay8(const Image& linear, float expo
         tbb::blocked_range<size_t>(0, (n + 7) / 8, 512), [&](const tbb::blocked_range<size_t>& r) {
             using simd::VF;
             using simd::VI;
-            const __m256 lowest = _mm256_set1_ps(1e-30f), zero = _mm256_setzero_ps();
-            const VF minLog2 = simd::Splat(minLog2_), scale = simd::Splat(scale_);
-            const VF one = simd::Splat(1.0f), top = simd::Splat(float(edge_ - 1));
-            const VI lastCell = VI{} + (edge_ - 2);
+            const VF zero = simd::Splat(0.0f), one = simd::Splat(1.0f);
+            const GridCoordinates grid(minLog2_, scale_, edge_);
             const int e = edge_;
             const size_t dg = 3 * size_t(e), db = 3 * size_t(e) * size_t(e);
             const size_t cornerOffset[8] = {0, 3, dg, dg + 3, db, db + 3, db + dg, db + dg + 3};
@@ -151,17 +174,7 @@ std::vector<std::uint8_t> DisplayLut::ToDisplay8(const Image& linear, float expo
                 LoadRgb8(src, rgb[0], rgb[1], rgb[2]);
                 VF f[3];
                 VI i0[3];
-                for (int c = 0; c < 3; ++c) {
-                    // As ToDisplay8Steps: non-positive, tiny and NaN values clamp to the grid's
-                    // lower end (maxps(x, lowest) is x > lowest ? x : lowest), +∞ to its top;
-                    // maxps(0, v) and minps(top, v) are simd::Max(v, 0) and simd::Min(v, top).
-                    const VF x = _mm256_max_ps(VF(rgb[c]) * exposureScale, lowest);
-                    const VF u =
-                        _mm256_min_ps(top, _mm256_max_ps(zero, (simd::Log2(x) - minLog2) * scale));
-                    i0[c] = __builtin_convertvector(u, VI);
-                    i0[c] = i0[c] < lastCell ? i0[c] : lastCell;
-                    f[c] = u - __builtin_convertvector(i0[c], VF);
-                }
+                for (int c = 0; c < 3; ++c) grid(VF(rgb[c]) * exposureScale, i0[c], f[c]);
                 // Unsigned, so that each lane's offset needs no sign extension (they are ≥ 0).
                 alignas(32) uint32_t at[8];
                 const VI node = ((i0[2] * e + i0[1]) * e + i0[0]) * 3;
@@ -217,10 +230,7 @@ std::vector<std::uint8_t> DisplayLut::ToDisplay8Steps(const Image& linear,
     using simd::kLanes;
     using simd::VF;
     using simd::VI;
-    const VF lowest = simd::Splat(1e-30f), minLog2 = simd::Splat(minLog2_);
-    const VF scale = simd::Splat(scale_), zero = simd::Splat(0.0f);
-    const VF top = simd::Splat(float(edge_ - 1));
-    const VI lastCell = VI{} + (edge_ - 2);
+    const GridCoordinates grid(minLog2_, scale_, edge_);
     tbb::parallel_for(
         tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
             // The grid coordinates of kLanes pixels at a time (one vector per component, the
@@ -235,14 +245,9 @@ std::vector<std::uint8_t> DisplayLut::ToDisplay8Steps(const Image& linear,
                 alignas(32) int cell[3][kLanes];
                 alignas(32) float frac[3][kLanes];
                 for (int c = 0; c < 3; ++c) {
-                    // Non-positive, tiny and NaN values clamp to the grid's lower end, +∞ to
-                    // its top (the comparison is false for NaN, which then takes `lowest`).
-                    VF x = simd::Load(comp[c]);
-                    x = simd::Select(x > lowest, x, lowest);
-                    const VF u = simd::Min(simd::Max((simd::Log2(x) - minLog2) * scale, zero), top);
-                    VI i0 = __builtin_convertvector(u, VI);
-                    i0 = i0 < lastCell ? i0 : lastCell;
-                    const VF f = u - __builtin_convertvector(i0, VF);
+                    VI i0;
+                    VF f;
+                    grid(simd::Load(comp[c]), i0, f);
                     std::memcpy(cell[c], &i0, sizeof i0);
                     simd::Store(frac[c], f);
                 }

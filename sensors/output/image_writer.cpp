@@ -135,14 +135,25 @@ void WriteAtomically(const fs::path& finalPath, WriteFn&& writeTemp) {
     }
 }
 
+// Throws InputError (without the file name) for an attribute no format can store: an empty
+// name or an empty float array.
+void CheckAttribute(const MetadataAttribute& attribute) {
+    if (attribute.name.empty()) throw InputError("metadata attribute with an empty name");
+    const auto* array = std::get_if<std::vector<float>>(&attribute.value);
+    if (array && array->empty()) {
+        throw InputError("metadata attribute '" + attribute.name + "' is an empty float array");
+    }
+}
+
 void AddMetadata(OIIO::ImageSpec& spec, const ImageMetadata& metadata, const fs::path& finalPath) {
     if (!metadata.Find("DateTime")) spec.attribute("DateTime", kDefaultDateTime);
     for (const MetadataAttribute& attribute : metadata.attributes) {
-        const std::string& name = attribute.name;
-        if (name.empty()) {
-            throw InputError("cannot write " + Quoted(finalPath) +
-                             ": metadata attribute with an empty name");
+        try {
+            CheckAttribute(attribute);
+        } catch (const InputError& e) {
+            throw InputError("cannot write " + Quoted(finalPath) + ": " + e.what());
         }
+        const std::string& name = attribute.name;
         const MetadataValue& value = attribute.value;
         if (const auto* s = std::get_if<std::string>(&value)) {
             spec.attribute(name, *s);
@@ -151,10 +162,6 @@ void AddMetadata(OIIO::ImageSpec& spec, const ImageMetadata& metadata, const fs:
         } else if (const auto* f = std::get_if<float>(&value)) {
             spec.attribute(name, *f);
         } else if (const auto* array = std::get_if<std::vector<float>>(&value)) {
-            if (array->empty()) {
-                throw InputError("cannot write " + Quoted(finalPath) + ": metadata attribute '" +
-                                 name + "' is an empty float array");
-            }
             spec.attribute(name, OIIO::TypeDesc(OIIO::TypeDesc::FLOAT, int(array->size())),
                            array->data());
         } else if (const auto* v3 = std::get_if<Vector3f>(&value)) {
@@ -333,14 +340,10 @@ PngInfo PngInfoFor(const ImageMetadata& metadata) {
     info.time =
         dateTime ? (dateText ? PngTimeOf(*dateText) : std::nullopt) : PngTimeOf(kDefaultDateTime);
     for (const MetadataAttribute& attribute : metadata.attributes) {
+        CheckAttribute(attribute);
         const std::string& name = attribute.name;
-        if (name.empty()) throw InputError("metadata attribute with an empty name");
         // A DateTime not in the form tIME holds is kept as text rather than lost.
         if (name == "DateTime" && info.time) continue;
-        const auto* array = std::get_if<std::vector<float>>(&attribute.value);
-        if (array && array->empty()) {
-            throw InputError("metadata attribute '" + name + "' is an empty float array");
-        }
         std::string keyword = name;
         if (std::holds_alternative<std::string>(attribute.value)) {
             if (name == "ImageDescription") keyword = "Description";
